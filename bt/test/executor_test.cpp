@@ -1,0 +1,85 @@
+// The root that generates ticks: rate, lockstep clock, stop, time limit.
+
+#include "bt/executor.h"
+
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "bt/test/test_support.h"
+
+namespace costar::bt {
+namespace {
+
+using namespace std::chrono_literals;
+
+TEST(Executor, TicksAtItsRateOnTheSimulatedClockWithoutWaiting) {
+  testing::TestTree t(R"(<Sequence><Sleep msec="500"/><TestLeaf name="a"/></Sequence>)");
+  Executor executor(t.tree, t.clock, {.tick_period = 10ms});
+  const auto wall_start = std::chrono::steady_clock::now();
+  const RunResult result = executor.run();
+  EXPECT_EQ(result.status, Status::kSuccess);
+  EXPECT_EQ(result.elapsed, 500ms);
+  EXPECT_EQ(result.ticks, 51u);
+  EXPECT_LT(std::chrono::steady_clock::now() - wall_start, 400ms);  // lockstep, not real time
+}
+
+TEST(Executor, LoopsThatFinishARunEveryTickDoNotAdvanceTheClock) {
+  testing::TestTree t(R"(<Repeat num_cycles="1000"><TestLeaf name="a"/></Repeat>)");
+  Executor executor(t.tree, t.clock);
+  const RunResult result = executor.run();
+  EXPECT_EQ(result.status, Status::kSuccess);
+  EXPECT_EQ(t.log.count("a:success"), 1000);
+  EXPECT_EQ(result.elapsed, 0ms);
+}
+
+TEST(Executor, ReportsTheFailingNodesPathAndReason) {
+  testing::TestTree t(R"(<Sequence><TestLeaf name="grasp" results="failure" reason="no reachable candidate"/></Sequence>)");
+  Executor executor(t.tree, t.clock);
+  const RunResult result = executor.run();
+  EXPECT_EQ(result.status, Status::kFailure);
+  EXPECT_EQ(result.failure_path, R"(main/Sequence[1]/TestLeaf "grasp")");
+  EXPECT_EQ(result.failure_reason, "no reachable candidate");
+}
+
+TEST(Executor, TimeLimitHaltsTheTreeAndFails) {
+  testing::TestTree t(R"(<TestLeaf name="forever" ticks="1000000"/>)");
+  Executor executor(t.tree, t.clock, {.tick_period = 10ms, .time_limit = 1s});
+  const RunResult result = executor.run();
+  EXPECT_EQ(result.status, Status::kFailure);
+  EXPECT_EQ(result.elapsed, 1s);
+  EXPECT_EQ(t.log.count("forever:halt"), 1);
+  EXPECT_NE(result.failure_reason.find("time limit"), std::string::npos);
+}
+
+TEST(Executor, StopFromAnotherThreadHaltsAndCancelsTheRunningOperation) {
+  testing::EventLog log;
+  const NodeRegistry registry = testing::registryWithTestLeaf(log);
+  RealClock clock;
+  Tree tree = buildTree(loadPlanText(testing::planXml(R"(<TestLeaf name="move" ticks="1000000"/>)"), "t"),
+                        registry, clock);
+  Executor executor(tree, clock, {.tick_period = 1ms});
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(50ms);
+    executor.requestStop();
+  });
+  const RunResult result = executor.run();
+  stopper.join();
+  EXPECT_TRUE(result.stopped);
+  EXPECT_EQ(result.status, Status::kIdle);
+  EXPECT_EQ(log.count("move:halt"), 1);
+  EXPECT_EQ(tree.root().status(), Status::kIdle);
+}
+
+TEST(Executor, BeforeTickHookRunsBeforeEveryTick) {
+  testing::TestTree t(R"(<TestLeaf ticks="4"/>)");
+  Executor executor(t.tree, t.clock);
+  int calls = 0;
+  executor.setBeforeTick([&] { ++calls; });
+  const RunResult result = executor.run();
+  EXPECT_EQ(calls, 5);
+  EXPECT_EQ(result.ticks, 5u);
+}
+
+}  // namespace
+}  // namespace costar::bt

@@ -1,0 +1,290 @@
+// Plan files: BehaviorTree.CPP v4 XML in and out, and every validation error with its line.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "bt/nodes_model.h"
+#include "bt/test/test_support.h"
+
+namespace costar::bt {
+namespace {
+
+using testing::planXml;
+
+std::vector<Diagnostic> problems(const std::string& xml) {
+  testing::EventLog log;
+  const NodeRegistry registry = testing::registryWithTestLeaf(log);
+  try {
+    return validatePlan(loadPlanText(xml, "plan.xml", {.follow_includes = false}), registry);
+  } catch (const PlanError& error) {
+    return error.diagnostics();
+  }
+}
+
+/// The single problem of `xml`, as "line: message".
+std::string problem(const std::string& xml) {
+  const auto diagnostics = problems(xml);
+  if (diagnostics.size() != 1) {
+    std::string all = std::to_string(diagnostics.size()) + " problems:";
+    for (const auto& d : diagnostics) {
+      all += "\n  " + d.str();
+    }
+    return all;
+  }
+  return std::to_string(diagnostics[0].where.line) + ": " + diagnostics[0].message;
+}
+
+// --- reading ------------------------------------------------------------------------------
+
+TEST(PlanXml, ReadsCompactAndExplicitFormsAlike) {
+  const PlanFile compact = parsePlanFile(planXml(R"(<Sequence name="s"><Repeat num_cycles="2"><AlwaysSuccess/></Repeat></Sequence>)"), "a");
+  const PlanFile explicit_form = parsePlanFile(
+      planXml(R"(<Control ID="Sequence" name="s"><Decorator ID="Repeat" num_cycles="2"><Action ID="AlwaysSuccess"/></Decorator></Control>)"),
+      "b");
+  EXPECT_TRUE(sameContent(compact, explicit_form));
+  EXPECT_EQ(compact.main_tree, "main");
+  ASSERT_EQ(compact.trees.size(), 1u);
+  EXPECT_EQ(compact.trees[0].root.name(), "s");
+  EXPECT_EQ(compact.trees[0].root.children[0].attribute("num_cycles"), "2");
+}
+
+TEST(PlanXml, IgnoresTreeNodesModelAndRecordsLines) {
+  const PlanFile file = parsePlanFile(
+      "<root BTCPP_format=\"4\">\n"
+      "  <BehaviorTree ID=\"only\">\n"
+      "    <Sequence>\n"
+      "      <AlwaysSuccess/>\n"
+      "    </Sequence>\n"
+      "  </BehaviorTree>\n"
+      "  <TreeNodesModel><Action ID=\"Move\"/></TreeNodesModel>\n"
+      "</root>\n",
+      "p.xml");
+  EXPECT_EQ(file.trees[0].root.location.line, 3);
+  EXPECT_EQ(file.trees[0].root.children[0].location.line, 4);
+  Plan plan;
+  plan.file = file;
+  EXPECT_EQ(plan.mainTreeId(), "only");
+}
+
+// --- round trip -----------------------------------------------------------------------------
+
+TEST(PlanXml, LoadSaveLoadIsLosslessAndSavingIsStable) {
+  const std::string xml = R"(<root BTCPP_format="4" main_tree_to_execute="main">
+    <include path="lib/grasp.xml"/>
+    <BehaviorTree ID="main">
+      <Sequence name="assemble &amp; check">
+        <Reset num_resets="3"><SubTree ID="grasp" _autoremap="false"/></Reset>
+        <Parallel success_count="1" failure_count="-1"><Sleep msec="10"/><AlwaysSuccess name="quote &quot;here&quot;"/></Parallel>
+        <Iterator><AlwaysFailure/></Iterator>
+      </Sequence>
+    </BehaviorTree>
+    <BehaviorTree ID="other"><Timeout msec="5"><AlwaysSuccess/></Timeout></BehaviorTree>
+  </root>)";
+  const PlanFile first = parsePlanFile(xml, "a.xml");
+  const std::string saved = writePlanFile(first);
+  const PlanFile second = parsePlanFile(saved, "b.xml");
+  EXPECT_TRUE(sameContent(first, second)) << saved;
+  EXPECT_EQ(writePlanFile(second), saved);
+  EXPECT_EQ(second.trees[0].root.name(), "assemble & check");
+  ASSERT_EQ(second.includes.size(), 1u);
+  EXPECT_EQ(second.includes[0].path, "lib/grasp.xml");
+}
+
+TEST(PlanXml, SaveWithModelDescribesTheNonBuiltinNodesUsed) {
+  testing::EventLog log;
+  const NodeRegistry registry = testing::registryWithTestLeaf(log);
+  const PlanFile file = parsePlanFile(planXml(R"(<Reset num_resets="1"><TestLeaf ticks="2"/></Reset>)"), "a");
+  const std::string saved = writePlanFile(file, {.model_from = &registry});
+  EXPECT_NE(saved.find(R"(<Decorator ID="Reset">)"), std::string::npos) << saved;
+  EXPECT_NE(saved.find(R"(<Action ID="TestLeaf">)"), std::string::npos);
+  EXPECT_EQ(saved.find(R"(ID="Sequence")"), std::string::npos);
+  // The model in the file does not change what is read back.
+  EXPECT_TRUE(sameContent(parsePlanFile(saved, "b"), file));
+}
+
+// --- TreeNodesModel -------------------------------------------------------------------------
+
+TEST(NodesModel, ListsCostarNodesWithPortsTypesAndDefaults) {
+  const std::string model = treeNodesModelXml(builtinRegistry());
+  EXPECT_NE(model.find(R"(<Decorator ID="Reset">)"), std::string::npos) << model;
+  EXPECT_NE(model.find(R"(<Control ID="Iterator">)"), std::string::npos);
+  EXPECT_NE(model.find(R"(<input_port name="num_resets" type="int">)"), std::string::npos);
+  EXPECT_EQ(model.find(R"(ID="Fallback")"), std::string::npos);  // Groot2 knows it
+  const std::string all = treeNodesModelXml(builtinRegistry(), {.include_btcpp_builtins = true});
+  EXPECT_NE(all.find(R"(<input_port name="success_count" type="int" default="-1">)"), std::string::npos) << all;
+}
+
+// --- validation errors ----------------------------------------------------------------------
+
+TEST(Validation, MalformedXmlNamesTheLine) {
+  // The line of the element left open.
+  const auto unclosed = problems("<root BTCPP_format=\"4\">\n<BehaviorTree ID=\"m\">\n<Sequence>\n</BehaviorTree></root>");
+  ASSERT_EQ(unclosed.size(), 1u);
+  EXPECT_EQ(unclosed[0].where.line, 3);
+  EXPECT_NE(unclosed[0].message.find("MISMATCHED_ELEMENT"), std::string::npos);
+  EXPECT_NE(unclosed[0].message.find("Sequence"), std::string::npos);
+  EXPECT_NE(problem("<root><BehaviorTree ID=\"m\"><Sequence></root>").find("malformed XML"), std::string::npos);
+}
+
+TEST(Validation, UnknownNodeWithASuggestion) {
+  EXPECT_EQ(problem(planXml("\n<Sequense><AlwaysSuccess/></Sequense>")),
+            "2: unknown node 'Sequense' (did you mean 'Sequence'?)");
+  EXPECT_EQ(problem(planXml("<Frobnicate/>")), "1: unknown node 'Frobnicate'");
+}
+
+TEST(Validation, MissingIllTypedAndUnknownParameters) {
+  EXPECT_EQ(problem(planXml("<Repeat><AlwaysSuccess/></Repeat>")),
+            "1: Repeat needs parameter 'num_cycles' (successful runs to complete (-1 = forever))");
+  EXPECT_EQ(problem(planXml(R"(<Repeat num_cycles="three"><AlwaysSuccess/></Repeat>)")),
+            "1: parameter 'num_cycles' of Repeat: 'three' is not an integer");
+  EXPECT_EQ(problem(planXml(R"(<Sleep msec="10" sec="1"/>)")),
+            "1: Sleep has no parameter 'sec' (it takes msec)");
+  EXPECT_EQ(problem(planXml(R"(<TestLeaf ticks="1.5"/>)")),
+            "1: parameter 'ticks' of TestLeaf: '1.5' is not an integer");
+}
+
+TEST(Validation, BadCounts) {
+  EXPECT_EQ(problem(planXml(R"(<Repeat num_cycles="0"><AlwaysSuccess/></Repeat>)")),
+            "1: parameter 'num_cycles' of Repeat: 0 is out of range: expected an integer from 1 to "
+            "1000000000, or -1");
+  EXPECT_EQ(problem(planXml(R"(<Reset num_resets="-2"><AlwaysSuccess/></Reset>)")),
+            "1: parameter 'num_resets' of Reset: -2 is out of range: expected an integer from 0 to "
+            "1000000000, or -1");
+  EXPECT_NE(problem(planXml(R"(<Parallel success_count="3"><AlwaysSuccess/><AlwaysSuccess/></Parallel>)"))
+                .find("success_count=3 does not fit 2 children"),
+            std::string::npos);
+}
+
+TEST(Validation, ChildCounts) {
+  EXPECT_EQ(problem(planXml("<Sequence/>")), "1: Sequence needs at least one child");
+  EXPECT_EQ(problem(planXml("<Inverter><AlwaysSuccess/><AlwaysSuccess/></Inverter>")),
+            "1: Inverter needs exactly one child, has 2");
+  EXPECT_EQ(problem(planXml("<AlwaysSuccess><AlwaysSuccess/></AlwaysSuccess>")),
+            "1: AlwaysSuccess is a leaf and cannot have children, has 1");
+}
+
+TEST(Validation, UnknownAndRecursiveSubtrees) {
+  EXPECT_EQ(problem(planXml(R"(<SubTree ID="grasp"/>)")),
+            "1: unknown subtree 'grasp' (the plan defines: main)");
+  const std::string recursive = planXml(R"(<SubTree ID="a"/>)",
+                                        R"(<BehaviorTree ID="a"><Sequence><SubTree ID="b"/></Sequence></BehaviorTree>
+                                           <BehaviorTree ID="b"><SubTree ID="a"/></BehaviorTree>)");
+  EXPECT_EQ(problem(recursive), "2: subtree 'a' contains itself: main -> a -> b -> a");
+}
+
+TEST(Validation, NoVariablesNoScripts) {
+  EXPECT_NE(problem(planXml(R"(<Sleep msec="{delay}"/>)")).find("blackboard references are not supported"),
+            std::string::npos);
+  EXPECT_NE(problem(planXml(R"(<AlwaysSuccess _skipIf="x == 1"/>)")).find("script"), std::string::npos);
+  EXPECT_NE(problem(planXml(R"(<SubTree ID="main2" target="{t}"/>)",
+                            R"(<BehaviorTree ID="main2"><AlwaysSuccess/></BehaviorTree>)"))
+                .find("remapping needs a blackboard"),
+            std::string::npos);
+}
+
+TEST(Validation, ReactiveNodesOnlyLetTheirLastChildRun) {
+  EXPECT_NE(problem(planXml(R"(<ReactiveSequence><TestLeaf/><TestLeaf/></ReactiveSequence>)"))
+                .find("only the last child of a ReactiveSequence may take time"),
+            std::string::npos);
+  EXPECT_NE(problem(planXml(R"(<ReactiveFallback><Repeat num_cycles="2"><TestCondition/></Repeat><TestLeaf/></ReactiveFallback>)"))
+                .find("Repeat can be RUNNING"),
+            std::string::npos);
+  EXPECT_TRUE(problems(planXml(R"(<ReactiveSequence><Inverter><TestCondition/></Inverter><TestLeaf/></ReactiveSequence>)")).empty());
+}
+
+TEST(Validation, StructureOfTheFile) {
+  EXPECT_EQ(problem(R"(<root BTCPP_format="3"><BehaviorTree ID="m"><AlwaysSuccess/></BehaviorTree></root>)"),
+            "1: BTCPP_format=\"3\" is not supported: plans use BehaviorTree.CPP's format 4");
+  EXPECT_EQ(problem("<root BTCPP_format=\"4\"><BehaviorTree ID=\"m\">\n<AlwaysSuccess/><AlwaysSuccess/></BehaviorTree></root>"),
+            "2: BehaviorTree 'm' has more than one root node: wrap them in a Sequence");
+  EXPECT_EQ(problem(R"(<root BTCPP_format="4" main_tree_to_execute="nope"><BehaviorTree ID="m"><AlwaysSuccess/></BehaviorTree></root>)"),
+            "0: main_tree_to_execute names 'nope', but no BehaviorTree has that ID");
+  EXPECT_EQ(problem(R"(<root BTCPP_format="4"><BehaviorTree ID="a"><AlwaysSuccess/></BehaviorTree><BehaviorTree ID="b"><AlwaysSuccess/></BehaviorTree></root>)"),
+            "0: the file defines several BehaviorTrees but no main_tree_to_execute");
+  EXPECT_EQ(problem(R"(<plan/>)"), "1: the top element must be <root BTCPP_format=\"4\">, found <plan>");
+}
+
+TEST(Validation, ReportsEveryProblemNotJustTheFirst) {
+  const auto diagnostics = problems(planXml("<Sequence>\n<Foo/>\n<Repeat/>\n<Sleep msec=\"x\"/></Sequence>"));
+  ASSERT_EQ(diagnostics.size(), 4u);  // Foo, Repeat without child, Repeat without num_cycles, msec
+  EXPECT_EQ(diagnostics[0].where.line, 2);
+  EXPECT_EQ(diagnostics[3].where.line, 4);
+}
+
+TEST(Validation, SizeLimitsStopExponentialSubtrees) {
+  std::string trees;
+  for (int i = 0; i < 30; ++i) {
+    trees += "<BehaviorTree ID=\"t" + std::to_string(i) + "\"><Sequence><SubTree ID=\"t" +
+             std::to_string(i + 1) + "\"/><SubTree ID=\"t" + std::to_string(i + 1) + "\"/></Sequence></BehaviorTree>";
+  }
+  trees += "<BehaviorTree ID=\"t30\"><AlwaysSuccess/></BehaviorTree>";
+  EXPECT_NE(problem(planXml(R"(<SubTree ID="t0"/>)", trees)).find("expands to more than 1000000 nodes"),
+            std::string::npos);
+}
+
+// --- includes ---------------------------------------------------------------------------------
+
+class IncludeTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("costar_include_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_ / "lib");
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  void write(const std::string& name, const std::string& text) { std::ofstream(dir_ / name) << text; }
+  std::filesystem::path dir_;
+};
+
+TEST_F(IncludeTest, IncludedTreesAreUsableAndRelativeToTheIncludingFile) {
+  write("main.xml", R"(<root BTCPP_format="4" main_tree_to_execute="main"><include path="lib/a.xml"/>
+    <BehaviorTree ID="main"><SubTree ID="a"/></BehaviorTree></root>)");
+  write("lib/a.xml", R"(<root BTCPP_format="4"><include path="b.xml"/><BehaviorTree ID="a"><SubTree ID="b"/></BehaviorTree></root>)");
+  write("lib/b.xml", R"(<root BTCPP_format="4"><BehaviorTree ID="b"><AlwaysSuccess/></BehaviorTree></root>)");
+  const Plan plan = loadPlan(dir_ / "main.xml");
+  EXPECT_EQ(plan.included.size(), 2u);
+  SimClock clock;
+  Tree tree = buildTree(plan, builtinRegistry(), clock);
+  EXPECT_EQ(tree.tick(), Status::kSuccess);
+}
+
+TEST_F(IncludeTest, ACycleOfIncludesIsAnErrorNamingTheCycle) {
+  write("main.xml", "<root BTCPP_format=\"4\">\n<include path=\"lib/a.xml\"/><BehaviorTree ID=\"m\"><AlwaysSuccess/></BehaviorTree></root>");
+  write("lib/a.xml", "<root BTCPP_format=\"4\">\n\n<include path=\"../main.xml\"/></root>");
+  try {
+    loadPlan(dir_ / "main.xml");
+    FAIL() << "expected a PlanError";
+  } catch (const PlanError& error) {
+    ASSERT_EQ(error.diagnostics().size(), 1u);
+    EXPECT_EQ(error.diagnostics()[0].where.line, 3);
+    EXPECT_NE(error.diagnostics()[0].message.find("cycle of includes"), std::string::npos);
+    EXPECT_NE(error.diagnostics()[0].where.file.find("a.xml"), std::string::npos);
+  }
+}
+
+TEST_F(IncludeTest, AMissingIncludeNamesTheIncludingLine) {
+  write("main.xml", "<root BTCPP_format=\"4\">\n<include path=\"nope.xml\"/><BehaviorTree ID=\"m\"><AlwaysSuccess/></BehaviorTree></root>");
+  try {
+    loadPlan(dir_ / "main.xml");
+    FAIL() << "expected a PlanError";
+  } catch (const PlanError& error) {
+    EXPECT_EQ(error.diagnostics()[0].where.line, 2);
+    EXPECT_NE(error.diagnostics()[0].message.find("nope.xml"), std::string::npos);
+  }
+}
+
+TEST_F(IncludeTest, SavingIsAtomicAndReadable) {
+  const PlanFile file = parsePlanFile(planXml("<AlwaysSuccess/>"), "x");
+  savePlanFile(file, dir_ / "saved.xml");
+  EXPECT_TRUE(sameContent(loadPlan(dir_ / "saved.xml").file, file));
+  for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
+    EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace costar::bt

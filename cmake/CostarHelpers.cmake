@@ -1,0 +1,34 @@
+# Shared helpers for costar's per-concept CMakeLists.
+
+# Warnings for the project's own code (third-party headers are included as SYSTEM).
+function(costar_warnings target)
+  target_compile_options(${target} PRIVATE
+    $<$<CXX_COMPILER_ID:GNU,Clang>:-Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
+      -Wold-style-cast -Woverloaded-virtual -Wno-unused-parameter
+      -Wno-missing-field-initializers>)
+endfunction()
+
+# costar_library(NAME SOURCES ... [DEPS ...] [PRIVATE_DEPS ...])
+# Defines costar_<NAME>, with the repository root as its include root so headers read
+# as #include "bt/node.h".
+function(costar_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(costar_${name} ${ARG_SOURCES})
+  target_include_directories(costar_${name} PUBLIC ${PROJECT_SOURCE_DIR})
+  target_link_libraries(costar_${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  costar_warnings(costar_${name})
+endfunction()
+
+# costar_test(NAME SOURCES ... DEPS ...): a GoogleTest executable registered with CTest.
+function(costar_test name)
+  if(NOT COSTAR_BUILD_TESTS)
+    return()
+  endif()
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main GTest::gmock)
+  costar_warnings(${name})
+  include(GoogleTest)
+  gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+    PROPERTIES LABELS "${ARG_LABELS}" DISCOVERY_TIMEOUT 60)
+endfunction()
