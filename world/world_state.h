@@ -1,0 +1,104 @@
+#pragma once
+// The world state a task plan sees: exactly the union of the symbols and predicates that
+// the components report (the paper, Sec. III-A). Symbols are 6-DOF frames, joint
+// configurations and object classes; predicates are named relations over symbol names.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <variant>
+#include <vector>
+
+#include "core/clock.h"
+#include "world/pose.h"
+
+namespace costar::world {
+
+/// A coordinate frame: pose relative to `parent` ("world" is the root).
+struct FrameValue {
+  std::string parent = "world";
+  Pose pose = Pose::Identity();
+};
+
+/// A joint configuration (radians / metres per joint).
+struct JointsValue {
+  std::vector<std::string> joint_names;
+  std::vector<double> positions;
+};
+
+/// An object class, e.g. "node" or "link", with what perception and SmartMove need to know.
+struct ObjectClassValue {
+  std::string description;
+};
+
+enum class SymbolKind { kFrame, kJoints, kObjectClass };
+const char* toString(SymbolKind kind);
+
+struct Symbol {
+  std::string name;
+  std::string source;  // the component that reports it
+  TimePoint stamp{};
+  std::variant<FrameValue, JointsValue, ObjectClassValue> value;
+
+  SymbolKind kind() const { return static_cast<SymbolKind>(value.index()); }
+  const FrameValue* frame() const { return std::get_if<FrameValue>(&value); }
+  const JointsValue* joints() const { return std::get_if<JointsValue>(&value); }
+};
+
+struct Predicate {
+  std::string name;
+  std::vector<std::string> args;
+  bool value = true;
+  std::string source;
+
+  /// "name(arg1,arg2)".
+  std::string str() const;
+};
+
+/// What one component reports: its symbols and predicates, replacing what it reported before.
+struct Report {
+  std::vector<Symbol> symbols;
+  std::vector<Predicate> predicates;
+};
+
+/// The union of every source's report. Not thread-safe: one thread updates and reads it
+/// (the executor's); others get copies.
+class WorldState {
+ public:
+  /// Replaces everything `source` reported. Symbols and predicates get `source` stamped in.
+  void update(const std::string& source, Report report);
+  void removeSource(const std::string& source);
+
+  const Symbol* symbol(std::string_view name) const;
+  std::vector<const Symbol*> symbols() const;
+
+  /// True when some source reports name(args) with value true and none reports it false.
+  bool holds(std::string_view name, std::span<const std::string> args) const;
+  /// Every predicate reported with this name (all of them if `name` is empty).
+  std::vector<const Predicate*> predicates(std::string_view name = {}) const;
+
+  /// Pose of a frame symbol in "world", composing parents; nullopt when the frame or one of
+  /// its parents is unknown (or the parents form a loop).
+  std::optional<Pose> worldPose(std::string_view frame) const;
+
+  /// Grows on every update; lets readers skip work when nothing changed.
+  std::uint64_t version() const { return version_; }
+
+ private:
+  void rebuildIndex();
+
+  std::map<std::string, Report, std::less<>> reports_;
+  // name -> symbol, and "name(args)" -> (true votes, false votes), rebuilt on update.
+  std::unordered_map<std::string, const Symbol*> symbol_index_;
+  std::unordered_map<std::string, std::pair<int, int>> predicate_index_;
+  std::uint64_t version_ = 0;
+};
+
+/// "name(a,b)": the key a predicate is indexed under.
+std::string predicateKey(std::string_view name, std::span<const std::string> args);
+
+}  // namespace costar::world
