@@ -154,7 +154,7 @@ Status Parallel::onTick() {
       onReset();
       haltChildren();
       return last_failed != nullptr ? failFrom(*last_failed)
-                                    : fail("Parallel: success threshold can no longer be reached");
+                                    : failStatic("Parallel: success threshold can no longer be reached");
     }
   }
   return Status::kRunning;

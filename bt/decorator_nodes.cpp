@@ -8,7 +8,7 @@ Status Inverter::onTick() {
   switch (child_->tick()) {
     case Status::kSuccess:
       child_->halt();
-      return fail("Inverter: child succeeded, inverted to FAILURE");
+      return failStatic("Inverter: child succeeded, inverted to FAILURE");
     case Status::kFailure:
       child_->halt();
       return Status::kSuccess;
@@ -33,7 +33,7 @@ Status ForceFailure::onTick() {
   }
   child_->halt();
   return status == Status::kFailure ? failFrom(*child_)
-                                    : fail("ForceFailure: child succeeded, forced to FAILURE");
+                                    : failStatic("ForceFailure: child succeeded, forced to FAILURE");
 }
 
 // --- Repeat ----------------------------------------------------------------------------
@@ -124,7 +124,10 @@ void Reset::onReset() {
 // --- Timeout ---------------------------------------------------------------------------
 
 Timeout::Timeout(std::string id, std::string name, Duration limit)
-    : DecoratorNode(std::move(id), std::move(name)), limit_(limit) {}
+    : DecoratorNode(std::move(id), std::move(name)),
+      limit_(limit),
+      reason_("Timeout: child did not complete within " +
+              std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(limit).count()) + " ms") {}
 
 Status Timeout::onTick() {
   const TimePoint now = context().now();
@@ -134,8 +137,7 @@ Status Timeout::onTick() {
   } else if (now >= deadline_) {
     child_->halt();
     started_ = false;
-    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(limit_).count();
-    return fail("Timeout: child did not complete within " + std::to_string(ms) + " ms");
+    return fail(reason_);
   }
   const Status status = child_->tick();
   if (status == Status::kRunning) {

@@ -93,6 +93,7 @@ class Timeout final : public DecoratorNode {
   void onHalt() override;
   void onReset() override { started_ = false; }
   Duration limit_;
+  std::string reason_;  // composed once: failing must not allocate
   TimePoint deadline_{};
   bool started_ = false;
 };

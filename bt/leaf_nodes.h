@@ -18,7 +18,7 @@ class AlwaysFailure final : public LeafNode {
   using LeafNode::LeafNode;
 
  private:
-  Status onTick() override { return fail("AlwaysFailure"); }
+  Status onTick() override { return failStatic("AlwaysFailure"); }
 };
 
 /// RUNNING until `msec` of clock time have passed since its first tick, then SUCCESS.

@@ -36,6 +36,7 @@ void TreeContext::notify(const TreeNode& node, Status from, Status to) {
 TreeNode::TreeNode(std::string id, std::string name) : id_(std::move(id)), name_(std::move(name)) {}
 
 Status TreeNode::tick() {
+  context_->countNodeTick();
   const Status status = onTick();
   setStatus(status);
   return status;
@@ -58,6 +59,7 @@ void TreeNode::reset() {
 
 Status TreeNode::fail(std::string_view reason) {
   reason_.assign(reason);
+  reason_view_ = reason_;
   failure_origin_ = this;
   return Status::kFailure;
 }

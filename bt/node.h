@@ -56,6 +56,10 @@ class TreeContext {
     return requested;
   }
 
+  /// Node ticks since the tree was built (every TreeNode::tick() of every node).
+  std::uint64_t nodeTicks() const { return node_ticks_; }
+  void countNodeTick() { ++node_ticks_; }
+
   void addObserver(TreeObserver* observer);
   void removeObserver(TreeObserver* observer);
   bool observed() const { return !observers_.empty(); }
@@ -64,6 +68,7 @@ class TreeContext {
  private:
   const Clock* clock_;
   std::vector<TreeObserver*> observers_;
+  std::uint64_t node_ticks_ = 0;
   bool immediate_tick_ = false;
 };
 
@@ -100,7 +105,7 @@ class TreeNode {
   /// For a node whose last completion was FAILURE: the node where the failure arose (this
   /// node or a descendant) and its reason.
   const TreeNode& failureOrigin() const { return *failure_origin_; }
-  std::string_view failureReason() const { return failure_origin_->reason_; }
+  std::string_view failureReason() const { return failure_origin_->reason_view_; }
 
   /// Path segment of this node below its parent: `ID "name"` when named, else `ID[k]` with
   /// k the 1-based position among its siblings. SubTree nodes use their subtree's ID.
@@ -114,8 +119,14 @@ class TreeNode {
   /// the base class.
   virtual void onReset() {}
 
-  /// Records a FAILURE that arises here, with its reason; returns kFailure.
+  /// Records a FAILURE that arises here, with its reason (copied); returns kFailure.
   Status fail(std::string_view reason);
+  /// As fail(), for a reason that lives as long as the program (a string literal): no copy.
+  Status failStatic(const char* reason) {
+    reason_view_ = reason;
+    failure_origin_ = this;
+    return Status::kFailure;
+  }
   /// Records a FAILURE passed on from `child` (origin and reason stay the child's).
   Status failFrom(const TreeNode& child);
 
@@ -129,6 +140,7 @@ class TreeNode {
   std::string name_;
   std::string path_;
   std::string reason_;
+  std::string_view reason_view_;  // reason_, or a static string
   const TreeNode* failure_origin_ = this;
   const TreeNode* parent_ = nullptr;
   TreeContext* context_ = nullptr;

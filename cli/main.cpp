@@ -1,0 +1,22 @@
+// costar: teach a collaborative robot a task as a behavior tree, and run it.
+
+#include <CLI/CLI.hpp>
+
+#include "cli/plan_commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "costar: build task plans as behavior trees of robot operations (DetectObjects, SmartMove, Close "
+      "gripper, ...) and run them on a workcell (CoSTAR, ICRA 2017)."};
+  app.set_version_flag("--version", "costar 0.1.0");
+  app.require_subcommand(1);
+  int exit_code = 0;
+  costar::cli::addPlanCommands(app, exit_code);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);
+    return code == 0 ? 0 : 2;
+  }
+  return exit_code;
+}

@@ -1,0 +1,285 @@
+#include "cli/plan_commands.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "bt/builder.h"
+#include "bt/executor.h"
+#include "bt/nodes_model.h"
+#include "bt/plan_xml.h"
+#include "bt/trace.h"
+#include "workcell/workcell.h"
+
+namespace costar::cli {
+
+namespace {
+
+constexpr int kExitSuccess = 0;
+constexpr int kExitFailure = 1;
+constexpr int kExitInvalid = 2;
+constexpr int kExitStopped = 130;
+
+std::atomic<bt::Executor*> g_running_executor{nullptr};
+
+void onInterrupt(int /*signal*/) {
+  if (bt::Executor* executor = g_running_executor.load()) {
+    executor->requestStop();  // an atomic store: safe in a signal handler
+  }
+}
+
+struct Colors {
+  explicit Colors(bool on)
+      : green(on ? "\033[32m" : ""), red(on ? "\033[31m" : ""), dim(on ? "\033[2m" : ""), reset(on ? "\033[0m" : "") {}
+  const char* green;
+  const char* red;
+  const char* dim;
+  const char* reset;
+};
+
+/// Live status lines: one per start and end of every leaf (robot action, knowledge
+/// operation, condition).
+class ConsoleStatus final : public bt::TreeObserver {
+ public:
+  ConsoleStatus(const bt::Tree& tree, const bt::NodeRegistry& registry, bool all_nodes, Colors colors)
+      : colors_(colors) {
+    for (const bt::TreeNode* node : tree.nodes()) {
+      const bt::NodeSpec* spec = registry.find(node->id());
+      const bool leaf = node->children().empty() && node->id() != "SubTree";
+      if (all_nodes || (leaf && spec != nullptr && spec->category != bt::NodeCategory::kInternal)) {
+        shown_.insert(node->uid());
+      }
+    }
+  }
+
+  void onTransition(TimePoint time, const bt::TreeNode& node, bt::Status from, bt::Status to) override {
+    if (to == bt::Status::kIdle || !shown_.contains(node.uid())) {
+      return;
+    }
+    const char* color = to == bt::Status::kSuccess ? colors_.green : to == bt::Status::kFailure ? colors_.red : "";
+    std::printf("%s[%9.3f s]%s %s%-7s%s %s", colors_.dim, toSeconds(time), colors_.reset, color, toString(to),
+                colors_.reset, node.path().c_str());
+    if (to == bt::Status::kFailure) {
+      std::printf(": %s", std::string(node.failureReason()).c_str());
+    }
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+
+ private:
+  Colors colors_;
+  std::set<std::uint32_t> shown_;
+};
+
+void printDiagnostics(const bt::PlanError& error) {
+  for (const auto& diagnostic : error.diagnostics()) {
+    std::cerr << "error: " << diagnostic.str() << "\n";
+  }
+  std::cerr << error.diagnostics().size() << " problem(s); nothing was run.\n";
+}
+
+struct RunOptions {
+  std::string plan;
+  std::string workcell = "test";
+  std::string trace;
+  double rate_hz = 100.0;
+  double time_limit_s = 0.0;
+  bool quiet = false;
+  bool all_nodes = false;
+};
+
+int runPlan(const RunOptions& options) {
+  std::unique_ptr<workcell::Workcell> cell;
+  try {
+    cell = workcell::makeWorkcell(options.workcell);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitInvalid;
+  }
+  std::optional<bt::Tree> tree;
+  try {
+    tree.emplace(bt::buildTree(bt::loadPlan(options.plan), cell->nodes(), cell->clock()));
+  } catch (const bt::PlanError& error) {
+    printDiagnostics(error);
+    return kExitInvalid;
+  }
+
+  std::ofstream trace_file;
+  std::optional<bt::JsonLinesTrace> trace;
+  if (!options.trace.empty()) {
+    trace_file.open(options.trace, std::ios::trunc);
+    if (!trace_file) {
+      std::cerr << "error: cannot write trace file '" << options.trace << "'\n";
+      return kExitInvalid;
+    }
+    trace.emplace(trace_file);
+    tree->addObserver(&*trace);
+  }
+  const Colors colors(::isatty(STDOUT_FILENO) != 0);
+  std::optional<ConsoleStatus> console;
+  if (!options.quiet) {
+    console.emplace(*tree, cell->nodes(), options.all_nodes, colors);
+    tree->addObserver(&*console);
+    std::printf("costar: running %s (tree '%s', %zu nodes) on workcell '%s' at %.0f Hz\n", options.plan.c_str(),
+                tree->mainTreeId().c_str(), tree->nodes().size(), cell->name().c_str(), options.rate_hz);
+  }
+
+  bt::ExecutorOptions executor_options;
+  executor_options.tick_period = fromSeconds(1.0 / options.rate_hz);
+  if (options.time_limit_s > 0) {
+    executor_options.time_limit = fromSeconds(options.time_limit_s);
+  }
+  bt::Executor executor(*tree, cell->clock(), executor_options);
+  executor.setBeforeTick([&cell] { cell->beforeTick(); });
+  g_running_executor.store(&executor);
+  auto* previous = std::signal(SIGINT, onInterrupt);
+  const auto wall_start = std::chrono::steady_clock::now();
+  const bt::RunResult result = executor.run();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  std::signal(SIGINT, previous);
+  g_running_executor.store(nullptr);
+
+  const char* clock_kind = cell->clock().simulated() ? "simulated" : "real";
+  const std::uint64_t node_ticks = tree->context().nodeTicks();
+  if (result.stopped) {
+    std::printf("%sSTOPPED%s by the user after %.3f s %s; running operations were cancelled\n", colors.red,
+                colors.reset, toSeconds(result.elapsed), clock_kind);
+    return kExitStopped;
+  }
+  if (result.status == bt::Status::kSuccess) {
+    std::printf("%sSUCCESS%s in %.3f s %s (%.3f s wall, %llu ticks, %llu node ticks)\n", colors.green, colors.reset,
+                toSeconds(result.elapsed), clock_kind, wall, static_cast<unsigned long long>(result.ticks),
+                static_cast<unsigned long long>(node_ticks));
+    return kExitSuccess;
+  }
+  std::printf("%sFAILURE%s at %s: %s\n  after %.3f s %s (%.3f s wall, %llu ticks)\n", colors.red, colors.reset,
+              result.failure_path.c_str(), result.failure_reason.c_str(), toSeconds(result.elapsed), clock_kind, wall,
+              static_cast<unsigned long long>(result.ticks));
+  return kExitFailure;
+}
+
+int validatePlan(const std::string& path, const std::string& workcell_name) {
+  try {
+    const auto cell = workcell::makeWorkcell(workcell_name);
+    const bt::Plan plan = bt::loadPlan(path);
+    const auto diagnostics = bt::validatePlan(plan, cell->nodes());
+    if (!diagnostics.empty()) {
+      printDiagnostics(bt::PlanError(diagnostics));
+      return kExitInvalid;
+    }
+    SimClock clock;
+    const bt::Tree tree = bt::buildTree(plan, cell->nodes(), clock);
+    std::printf("%s: valid for workcell '%s' (main tree '%s', %zu nodes with subtrees expanded, %zu file(s))\n",
+                path.c_str(), cell->name().c_str(), tree.mainTreeId().c_str(), tree.nodes().size(),
+                1 + plan.included.size());
+    return kExitSuccess;
+  } catch (const bt::PlanError& error) {
+    printDiagnostics(error);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+  }
+  return kExitInvalid;
+}
+
+nlohmann::json nodesJson(const bt::NodeRegistry& registry) {
+  nlohmann::json nodes = nlohmann::json::array();
+  for (const bt::NodeSpec* spec : registry.all()) {
+    nlohmann::json ports = nlohmann::json::array();
+    for (const auto& port : spec->ports) {
+      nlohmann::json item = {{"name", port.name}, {"type", port.type_name}, {"description", port.description}};
+      if (port.default_value) {
+        item["default"] = *port.default_value;
+      }
+      if (!port.choices.empty()) {
+        item["choices"] = port.choices;
+      }
+      ports.push_back(std::move(item));
+    }
+    nodes.push_back({{"id", spec->id},
+                     {"kind", bt::toString(spec->kind)},
+                     {"category", bt::toString(spec->category)},
+                     {"description", spec->description},
+                     {"asynchronous", spec->asynchronous},
+                     {"ports", std::move(ports)}});
+  }
+  return nodes;
+}
+
+int writeNodes(const std::string& workcell_name, const std::string& format, bool all, const std::string& out) {
+  std::unique_ptr<workcell::Workcell> cell;
+  try {
+    cell = workcell::makeWorkcell(workcell_name);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitInvalid;
+  }
+  const std::string text = format == "json" ? nodesJson(cell->nodes()).dump(2) + "\n"
+                                            : bt::treeNodesModelXml(cell->nodes(), {.include_btcpp_builtins = all});
+  if (out.empty()) {
+    std::cout << text;
+  } else {
+    std::ofstream(out) << text;
+    std::cerr << "wrote " << out << "\n";
+  }
+  return kExitSuccess;
+}
+
+}  // namespace
+
+void addPlanCommands(CLI::App& app, int& exit_code) {
+  auto options = std::make_shared<RunOptions>();
+  CLI::App* run = app.add_subcommand("run", "Run a task plan (BehaviorTree.CPP v4 XML) on a workcell");
+  run->add_option("plan", options->plan, "plan file")->required()->check(CLI::ExistingFile);
+  run->add_option("-w,--workcell", options->workcell, "workcell to run on (see `costar workcells`)")
+      ->capture_default_str();
+  run->add_option("--trace", options->trace, "write every status transition to FILE as JSON lines");
+  run->add_option("--rate", options->rate_hz, "ticks per second of clock time")
+      ->check(CLI::Range(0.1, 10000.0))
+      ->capture_default_str();
+  run->add_option("--time-limit", options->time_limit_s, "fail the run after this many clock seconds (0: none)")
+      ->check(CLI::NonNegativeNumber);
+  run->add_flag("-q,--quiet", options->quiet, "print only the result");
+  run->add_flag("--all-nodes", options->all_nodes, "status lines for internal nodes too");
+  run->footer(
+      "Exit code: 0 SUCCESS, 1 FAILURE (the failing node's path and reason are printed), 2 invalid plan,\n"
+      "130 stopped with Ctrl-C (running operations are cancelled).");
+  run->callback([options, &exit_code] { exit_code = runPlan(*options); });
+
+  auto validate_plan = std::make_shared<std::string>();
+  auto validate_workcell = std::make_shared<std::string>("test");
+  CLI::App* validate = app.add_subcommand("validate", "Check a plan without running it");
+  validate->add_option("plan", *validate_plan, "plan file")->required()->check(CLI::ExistingFile);
+  validate->add_option("-w,--workcell", *validate_workcell, "workcell whose operations the plan may use")
+      ->capture_default_str();
+  validate->footer("Exit code: 0 valid, 2 invalid (each problem is printed as file:line: message).");
+  validate->callback([=, &exit_code] { exit_code = validatePlan(*validate_plan, *validate_workcell); });
+
+  auto nodes_workcell = std::make_shared<std::string>("test");
+  auto nodes_format = std::make_shared<std::string>("xml");
+  auto nodes_all = std::make_shared<bool>(false);
+  auto nodes_out = std::make_shared<std::string>();
+  CLI::App* nodes = app.add_subcommand("nodes", "Write the TreeNodesModel of every node type (for Groot2)");
+  nodes->add_option("-w,--workcell", *nodes_workcell, "workcell whose operations to list")->capture_default_str();
+  nodes->add_option("--format", *nodes_format, "xml (TreeNodesModel) or json")
+      ->check(CLI::IsMember({"xml", "json"}))
+      ->capture_default_str();
+  nodes->add_flag("--all", *nodes_all, "also describe nodes that BehaviorTree.CPP has built in");
+  nodes->add_option("-o,--out", *nodes_out, "write to FILE instead of standard output");
+  nodes->callback([=, &exit_code] { exit_code = writeNodes(*nodes_workcell, *nodes_format, *nodes_all, *nodes_out); });
+
+  CLI::App* workcells = app.add_subcommand("workcells", "List the workcells this build knows");
+  workcells->callback([&exit_code] {
+    for (const auto& info : workcell::knownWorkcells()) {
+      std::printf("%-8s %s\n", info.name.c_str(), info.description.c_str());
+    }
+    exit_code = kExitSuccess;
+  });
+}
+
+}  // namespace costar::cli
