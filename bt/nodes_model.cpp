@@ -1,8 +1,7 @@
 #include "bt/nodes_model.h"
 
-#include <tinyxml2.h>
-
 #include "bt/registry.h"
+#include "bt/xml_writer.h"
 
 namespace costar::bt {
 
@@ -13,23 +12,23 @@ void collectNodeIds(const PlanNode& node, std::set<std::string>& ids) {
   }
 }
 
-void writeTreeNodesModel(tinyxml2::XMLPrinter& printer, const NodeRegistry& registry,
+void writeTreeNodesModel(XmlWriter& printer, const NodeRegistry& registry,
                          const std::set<std::string>& ids, const ModelOptions& options) {
-  printer.OpenElement("TreeNodesModel");
+  printer.open("TreeNodesModel");
   for (const NodeSpec* spec : registry.all()) {
     if ((!ids.empty() && !ids.contains(spec->id)) ||
         (spec->btcpp_builtin && !options.include_btcpp_builtins)) {
       continue;
     }
     const char* kind = spec->kind == NodeKind::kSubTree ? "SubTree" : toString(spec->kind);
-    printer.OpenElement(kind);
-    printer.PushAttribute("ID", spec->id.c_str());
+    printer.open(kind);
+    printer.attribute("ID", spec->id);
     for (const PortSpec& port : spec->ports) {
-      printer.OpenElement("input_port");
-      printer.PushAttribute("name", port.name.c_str());
-      printer.PushAttribute("type", port.type_name.c_str());
+      printer.open("input_port");
+      printer.attribute("name", port.name);
+      printer.attribute("type", port.type_name);
       if (port.default_value) {
-        printer.PushAttribute("default", port.default_value->c_str());
+        printer.attribute("default", *port.default_value);
       }
       std::string description = port.description;
       if (!port.choices.empty()) {
@@ -39,34 +38,33 @@ void writeTreeNodesModel(tinyxml2::XMLPrinter& printer, const NodeRegistry& regi
         }
         description += ")";
       }
-      printer.PushText(description.c_str());
-      printer.CloseElement();
+      printer.text(description);
+      printer.close();
     }
-    printer.OpenElement("MetadataFields");
+    printer.open("MetadataFields");
     const std::pair<const char*, std::string> metadata[] = {
         {"description", spec->description},
         {"category", toString(spec->category)},
         {"asynchronous", spec->asynchronous ? "true" : "false"}};
     for (const auto& [key, value] : metadata) {
-      printer.OpenElement("Metadata");
-      printer.PushAttribute("key", key);
-      printer.PushAttribute("value", value.c_str());
-      printer.CloseElement();
+      printer.open("Metadata");
+      printer.attribute("key", key);
+      printer.attribute("value", value);
+      printer.close();
     }
-    printer.CloseElement();
-    printer.CloseElement();
+    printer.close();
+    printer.close();
   }
-  printer.CloseElement();
+  printer.close();
 }
 
 std::string treeNodesModelXml(const NodeRegistry& registry, const ModelOptions& options) {
-  tinyxml2::XMLPrinter printer(nullptr, /*compact=*/false);
-  printer.PushHeader(false, true);
-  printer.OpenElement("root");
-  printer.PushAttribute("BTCPP_format", "4");
-  writeTreeNodesModel(printer, registry, {}, options);
-  printer.CloseElement();
-  return printer.CStr();
+  XmlWriter writer;
+  writer.open("root");
+  writer.attribute("BTCPP_format", "4");
+  writeTreeNodesModel(writer, registry, {}, options);
+  writer.close();
+  return writer.str();
 }
 
 }  // namespace costar::bt

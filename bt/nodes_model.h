@@ -7,13 +7,10 @@
 
 #include "bt/plan.h"
 
-namespace tinyxml2 {
-class XMLPrinter;
-}
-
 namespace costar::bt {
 
 class NodeRegistry;
+class XmlWriter;
 
 struct ModelOptions {
   /// Also describe node types that BehaviorTree.CPP has built in (Groot2 knows them).
@@ -25,7 +22,7 @@ std::string treeNodesModelXml(const NodeRegistry& registry, const ModelOptions& 
 
 /// Writes a <TreeNodesModel> element for the node types in `ids` (all if empty) that are
 /// not BehaviorTree.CPP built-ins.
-void writeTreeNodesModel(tinyxml2::XMLPrinter& printer, const NodeRegistry& registry,
+void writeTreeNodesModel(XmlWriter& writer, const NodeRegistry& registry,
                          const std::set<std::string>& ids, const ModelOptions& options = {});
 
 /// Adds the IDs of `node` and its descendants to `ids`.

@@ -9,6 +9,7 @@
 
 #include "bt/nodes_model.h"
 #include "bt/registry.h"
+#include "bt/xml_writer.h"
 #include "core/files.h"
 
 namespace costar::bt {
@@ -290,15 +291,15 @@ Plan finishLoad(PlanFile file, const std::filesystem::path& base_dir, const std:
   return plan;
 }
 
-void writeNode(tinyxml2::XMLPrinter& printer, const PlanNode& node) {
-  printer.OpenElement(node.id.c_str());
+void writeNode(XmlWriter& writer, const PlanNode& node) {
+  writer.open(node.id);
   for (const auto& [key, value] : node.attributes) {
-    printer.PushAttribute(key.c_str(), value.c_str());
+    writer.attribute(key, value);
   }
   for (const auto& child : node.children) {
-    writeNode(printer, child);
+    writeNode(writer, child);
   }
-  printer.CloseElement();
+  writer.close();
 }
 
 }  // namespace
@@ -321,33 +322,32 @@ Plan loadPlanText(std::string_view xml, const std::string& label, const LoadOpti
 }
 
 std::string writePlanFile(const PlanFile& file, const WriteOptions& options) {
-  tinyxml2::XMLPrinter printer(nullptr, /*compact=*/false);
-  printer.PushHeader(false, true);
-  printer.OpenElement("root");
-  printer.PushAttribute("BTCPP_format", "4");
+  XmlWriter writer;
+  writer.open("root");
+  writer.attribute("BTCPP_format", "4");
   if (!file.main_tree.empty()) {
-    printer.PushAttribute("main_tree_to_execute", file.main_tree.c_str());
+    writer.attribute("main_tree_to_execute", file.main_tree);
   }
   for (const auto& include : file.includes) {
-    printer.OpenElement("include");
-    printer.PushAttribute("path", include.path.c_str());
-    printer.CloseElement();
+    writer.open("include");
+    writer.attribute("path", include.path);
+    writer.close();
   }
   for (const auto& tree : file.trees) {
-    printer.OpenElement("BehaviorTree");
-    printer.PushAttribute("ID", tree.id.c_str());
-    writeNode(printer, tree.root);
-    printer.CloseElement();
+    writer.open("BehaviorTree");
+    writer.attribute("ID", tree.id);
+    writeNode(writer, tree.root);
+    writer.close();
   }
   if (options.model_from != nullptr) {
     std::set<std::string> used;
     for (const auto& tree : file.trees) {
       collectNodeIds(tree.root, used);
     }
-    writeTreeNodesModel(printer, *options.model_from, used);
+    writeTreeNodesModel(writer, *options.model_from, used);
   }
-  printer.CloseElement();
-  return printer.CStr();
+  writer.close();
+  return writer.str();
 }
 
 void savePlanFile(const PlanFile& file, const std::filesystem::path& path, const WriteOptions& options) {
