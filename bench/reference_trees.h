@@ -43,8 +43,7 @@ inline bt::Plan mixedTree1000() {
       leaves.push_back(node("AlwaysSuccess"));
     }
     bt::PlanNode sequence = node("Sequence", std::move(leaves));
-    groups.push_back(g % 3 == 0 ? std::move(sequence)
-                                : node("Repeat", {std::move(sequence)}, {{"num_cycles", "2"}}));
+    groups.push_back(g % 3 == 0 ? std::move(sequence) : node("Repeat", {std::move(sequence)}, {{"num_cycles", "2"}}));
   }
   return planOf(node("Sequence", std::move(groups)));
 }

@@ -12,13 +12,11 @@ namespace {
 
 // Attributes BehaviorTree.CPP evaluates as scripts: they need a blackboard, which CoSTAR
 // plans do not have (the paper: no user variables, no scope).
-constexpr std::string_view kScriptAttributes[] = {"_skipIf",    "_failureIf", "_successIf",
-                                                  "_while",     "_onSuccess", "_onFailure",
-                                                  "_onHalted",  "_post"};
+constexpr std::string_view kScriptAttributes[] = {"_skipIf",    "_failureIf", "_successIf", "_while",
+                                                  "_onSuccess", "_onFailure", "_onHalted",  "_post"};
 
 bool isScriptAttribute(std::string_view key) {
-  return std::find(std::begin(kScriptAttributes), std::end(kScriptAttributes), key) !=
-         std::end(kScriptAttributes);
+  return std::find(std::begin(kScriptAttributes), std::end(kScriptAttributes), key) != std::end(kScriptAttributes);
 }
 
 bool isBlackboardReference(std::string_view value) {
@@ -65,9 +63,7 @@ class Validator {
     return all;
   }
 
-  void error(const SourceLocation& where, std::string message) {
-    diagnostics_.push_back({where, std::move(message)});
-  }
+  void error(const SourceLocation& where, std::string message) { diagnostics_.push_back({where, std::move(message)}); }
 
   void checkDuplicateTrees() {
     std::map<std::string, SourceLocation> seen;
@@ -75,8 +71,7 @@ class Validator {
       for (const PlanTree& tree : file->trees) {
         const auto [it, inserted] = seen.emplace(tree.id, tree.location);
         if (!inserted && it->second.file != tree.location.file) {
-          error(tree.location,
-                "BehaviorTree '" + tree.id + "' is also defined at " + toString(it->second));
+          error(tree.location, "BehaviorTree '" + tree.id + "' is also defined at " + toString(it->second));
         }
       }
     }
@@ -92,8 +87,7 @@ class Validator {
     }
     const PlanTree* main = plan_.findTree(main_id);
     if (main == nullptr) {
-      error({plan_.file.path, 0}, "main_tree_to_execute names '" + main_id +
-                                      "', but no BehaviorTree has that ID");
+      error({plan_.file.path, 0}, "main_tree_to_execute names '" + main_id + "', but no BehaviorTree has that ID");
       return;
     }
     // Recursion, size and depth of the main tree once every SubTree is expanded.
@@ -217,8 +211,9 @@ class Validator {
         continue;
       }
       if (isScriptAttribute(key)) {
-        error(node.location, "'" + key + "' is a BehaviorTree.CPP script, which CoSTAR plans do not "
-                             "support (no variables): use a Condition node instead");
+        error(node.location, "'" + key +
+                                 "' is a BehaviorTree.CPP script, which CoSTAR plans do not "
+                                 "support (no variables): use a Condition node instead");
         ports_valid = false;
         continue;
       }
@@ -304,7 +299,8 @@ class Validator {
         error(node.children[i].location,
               node.children[i].id + " can be RUNNING, but " + node.id +
                   " re-ticks every child before its last one on each tick, which would restart it: "
-                  "only the last child of a " + node.id + " may take time (use conditions before it)");
+                  "only the last child of a " +
+                  node.id + " may take time (use conditions before it)");
       }
     }
   }
@@ -355,13 +351,12 @@ class Instantiator {
 
 }  // namespace
 
-std::vector<Diagnostic> validatePlan(const Plan& plan, const NodeRegistry& registry,
-                                     const BuildLimits& limits) {
+std::vector<Diagnostic> validatePlan(const Plan& plan, const NodeRegistry& registry, const BuildLimits& limits) {
   return Validator(plan, registry, limits).run();
 }
 
-Tree buildTree(const Plan& plan, const NodeRegistry& registry, const Clock& clock,
-               const std::string& tree_id, const BuildLimits& limits) {
+Tree buildTree(const Plan& plan, const NodeRegistry& registry, const Clock& clock, const std::string& tree_id,
+               const BuildLimits& limits) {
   auto diagnostics = validatePlan(plan, registry, limits);
   if (!diagnostics.empty()) {
     throw PlanError(std::move(diagnostics));

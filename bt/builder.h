@@ -21,12 +21,11 @@ struct BuildLimits {
 
 /// Every problem of the plan, in file order; empty when the plan is valid. Only the main
 /// tree and the trees it uses are checked for depth and size; every tree for the rest.
-std::vector<Diagnostic> validatePlan(const Plan& plan, const NodeRegistry& registry,
-                                     const BuildLimits& limits = {});
+std::vector<Diagnostic> validatePlan(const Plan& plan, const NodeRegistry& registry, const BuildLimits& limits = {});
 
 /// Validates and instantiates the main tree (or `tree_id` if given).
 /// @throws PlanError with every problem when the plan is invalid.
-Tree buildTree(const Plan& plan, const NodeRegistry& registry, const Clock& clock,
-               const std::string& tree_id = {}, const BuildLimits& limits = {});
+Tree buildTree(const Plan& plan, const NodeRegistry& registry, const Clock& clock, const std::string& tree_id = {},
+               const BuildLimits& limits = {});
 
 }  // namespace costar::bt

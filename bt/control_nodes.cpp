@@ -120,9 +120,7 @@ Status ReactiveFallback::onTick() {
 // --- Parallel ----------------------------------------------------------------------------------
 
 Parallel::Parallel(std::string id, std::string name, int success_count, int failure_count)
-    : ControlNode(std::move(id), std::move(name)),
-      success_count_(success_count),
-      failure_count_(failure_count) {}
+    : ControlNode(std::move(id), std::move(name)), success_count_(success_count), failure_count_(failure_count) {}
 
 int Parallel::threshold(int count) const {
   const int n = static_cast<int>(children_.size());

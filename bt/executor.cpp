@@ -2,8 +2,7 @@
 
 namespace costar::bt {
 
-Executor::Executor(Tree& tree, Clock& clock, ExecutorOptions options)
-    : tree_(tree), clock_(clock), options_(options) {}
+Executor::Executor(Tree& tree, Clock& clock, ExecutorOptions options) : tree_(tree), clock_(clock), options_(options) {}
 
 RunResult Executor::run() {
   RunResult result;
@@ -25,8 +24,8 @@ RunResult Executor::run() {
       tree_.halt();
       result.status = Status::kFailure;
       result.failure_path = tree_.mainTreeId();
-      result.failure_reason = "run exceeded its time limit of " +
-                              std::to_string(toSeconds(*options_.time_limit)) + " s";
+      result.failure_reason =
+          "run exceeded its time limit of " + std::to_string(toSeconds(*options_.time_limit)) + " s";
       break;
     }
     if (before_tick_) {

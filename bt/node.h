@@ -21,9 +21,7 @@ enum class Status : std::uint8_t { kIdle, kRunning, kSuccess, kFailure };
 
 /// "IDLE", "RUNNING", "SUCCESS", "FAILURE".
 const char* toString(Status status);
-inline bool isCompleted(Status status) {
-  return status == Status::kSuccess || status == Status::kFailure;
-}
+inline bool isCompleted(Status status) { return status == Status::kSuccess || status == Status::kFailure; }
 
 class TreeNode;
 

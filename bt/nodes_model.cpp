@@ -12,12 +12,11 @@ void collectNodeIds(const PlanNode& node, std::set<std::string>& ids) {
   }
 }
 
-void writeTreeNodesModel(XmlWriter& printer, const NodeRegistry& registry,
-                         const std::set<std::string>& ids, const ModelOptions& options) {
+void writeTreeNodesModel(XmlWriter& printer, const NodeRegistry& registry, const std::set<std::string>& ids,
+                         const ModelOptions& options) {
   printer.open("TreeNodesModel");
   for (const NodeSpec* spec : registry.all()) {
-    if ((!ids.empty() && !ids.contains(spec->id)) ||
-        (spec->btcpp_builtin && !options.include_btcpp_builtins)) {
+    if ((!ids.empty() && !ids.contains(spec->id)) || (spec->btcpp_builtin && !options.include_btcpp_builtins)) {
       continue;
     }
     const char* kind = spec->kind == NodeKind::kSubTree ? "SubTree" : toString(spec->kind);
@@ -42,10 +41,9 @@ void writeTreeNodesModel(XmlWriter& printer, const NodeRegistry& registry,
       printer.close();
     }
     printer.open("MetadataFields");
-    const std::pair<const char*, std::string> metadata[] = {
-        {"description", spec->description},
-        {"category", toString(spec->category)},
-        {"asynchronous", spec->asynchronous ? "true" : "false"}};
+    const std::pair<const char*, std::string> metadata[] = {{"description", spec->description},
+                                                            {"category", toString(spec->category)},
+                                                            {"asynchronous", spec->asynchronous ? "true" : "false"}};
     for (const auto& [key, value] : metadata) {
       printer.open("Metadata");
       printer.attribute("key", key);

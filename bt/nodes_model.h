@@ -22,8 +22,8 @@ std::string treeNodesModelXml(const NodeRegistry& registry, const ModelOptions& 
 
 /// Writes a <TreeNodesModel> element for the node types in `ids` (all if empty) that are
 /// not BehaviorTree.CPP built-ins.
-void writeTreeNodesModel(XmlWriter& writer, const NodeRegistry& registry,
-                         const std::set<std::string>& ids, const ModelOptions& options = {});
+void writeTreeNodesModel(XmlWriter& writer, const NodeRegistry& registry, const std::set<std::string>& ids,
+                         const ModelOptions& options = {});
 
 /// Adds the IDs of `node` and its descendants to `ids`.
 void collectNodeIds(const PlanNode& node, std::set<std::string>& ids);

@@ -78,9 +78,8 @@ std::string Plan::mainTreeId() const {
     return file.trees.front().id;
   }
   throw PlanError({{{file.path, 0},
-                    file.trees.empty()
-                        ? "the file defines no BehaviorTree"
-                        : "the file defines several BehaviorTrees but no main_tree_to_execute"}});
+                    file.trees.empty() ? "the file defines no BehaviorTree"
+                                       : "the file defines several BehaviorTrees but no main_tree_to_execute"}});
 }
 
 bool sameContent(const PlanNode& a, const PlanNode& b) {
@@ -96,8 +95,7 @@ bool sameContent(const PlanNode& a, const PlanNode& b) {
 }
 
 bool sameContent(const PlanFile& a, const PlanFile& b) {
-  if (a.main_tree != b.main_tree || a.includes.size() != b.includes.size() ||
-      a.trees.size() != b.trees.size()) {
+  if (a.main_tree != b.main_tree || a.includes.size() != b.includes.size() || a.trees.size() != b.trees.size()) {
     return false;
   }
   for (std::size_t i = 0; i < a.includes.size(); ++i) {

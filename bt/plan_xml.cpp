@@ -19,8 +19,7 @@ namespace {
 constexpr std::string_view kExplicitKinds[] = {"Action", "Condition", "Control", "Decorator"};
 
 bool isExplicitKind(std::string_view element) {
-  return std::find(std::begin(kExplicitKinds), std::end(kExplicitKinds), element) !=
-         std::end(kExplicitKinds);
+  return std::find(std::begin(kExplicitKinds), std::end(kExplicitKinds), element) != std::end(kExplicitKinds);
 }
 
 bool isBlank(const char* text) {
@@ -50,8 +49,8 @@ class FileParser {
     if (root == nullptr) {
       error(0, "no XML element found");
     } else if (std::string_view(root->Name()) != "root") {
-      error(root->GetLineNum(), "the top element must be <root BTCPP_format=\"4\">, found <" +
-                                    std::string(root->Name()) + ">");
+      error(root->GetLineNum(),
+            "the top element must be <root BTCPP_format=\"4\">, found <" + std::string(root->Name()) + ">");
     } else {
       if (root->NextSiblingElement() != nullptr) {
         error(root->NextSiblingElement()->GetLineNum(), "only one top-level <root> element is allowed");
@@ -65,13 +64,10 @@ class FileParser {
   }
 
  private:
-  void error(int line, std::string message) {
-    diagnostics_.push_back({{file_.path, line}, std::move(message)});
-  }
+  void error(int line, std::string message) { diagnostics_.push_back({{file_.path, line}, std::move(message)}); }
 
   void parseRoot(const tinyxml2::XMLElement& root) {
-    for (const auto* attribute = root.FirstAttribute(); attribute != nullptr;
-         attribute = attribute->Next()) {
+    for (const auto* attribute = root.FirstAttribute(); attribute != nullptr; attribute = attribute->Next()) {
       const std::string_view key = attribute->Name();
       if (key == "BTCPP_format") {
         if (std::string_view(attribute->Value()) != "4") {
@@ -85,8 +81,7 @@ class FileParser {
       }
     }
     std::set<std::string> tree_ids;
-    for (const auto* element = root.FirstChildElement(); element != nullptr;
-         element = element->NextSiblingElement()) {
+    for (const auto* element = root.FirstChildElement(); element != nullptr; element = element->NextSiblingElement()) {
       const std::string_view name = element->Name();
       if (name == "BehaviorTree") {
         parseBehaviorTree(*element, tree_ids);
@@ -122,8 +117,7 @@ class FileParser {
       return;
     }
     tree.id = id;
-    for (const auto* attribute = element.FirstAttribute(); attribute != nullptr;
-         attribute = attribute->Next()) {
+    for (const auto* attribute = element.FirstAttribute(); attribute != nullptr; attribute = attribute->Next()) {
       const std::string_view key = attribute->Name();
       if (key != "ID" && !key.starts_with("_")) {
         error(element.GetLineNum(),
@@ -158,8 +152,7 @@ class FileParser {
       node.id = element_name;
     }
     std::set<std::string_view> seen;
-    for (const auto* attribute = element.FirstAttribute(); attribute != nullptr;
-         attribute = attribute->Next()) {
+    for (const auto* attribute = element.FirstAttribute(); attribute != nullptr; attribute = attribute->Next()) {
       const std::string_view key = attribute->Name();
       if (!seen.insert(key).second) {
         error(element.GetLineNum(), "attribute '" + std::string(key) + "' is written twice");
@@ -178,8 +171,7 @@ class FileParser {
     if (!isBlank(element.GetText())) {
       error(element.GetLineNum(), "unexpected text inside <" + std::string(element_name) + ">");
     }
-    for (const auto* child = element.FirstChildElement(); child != nullptr;
-         child = child->NextSiblingElement()) {
+    for (const auto* child = element.FirstChildElement(); child != nullptr; child = child->NextSiblingElement()) {
       node.children.push_back(parseNode(*child));
     }
     return node;
@@ -190,18 +182,16 @@ class FileParser {
 };
 
 std::optional<std::string> readFile(const std::filesystem::path& path, std::size_t max_bytes,
-                                    const SourceLocation& referenced_from,
-                                    std::vector<Diagnostic>& diagnostics) {
+                                    const SourceLocation& referenced_from, std::vector<Diagnostic>& diagnostics) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
-    diagnostics.push_back({referenced_from, "cannot open plan file '" + path.string() +
-                                                "': no such regular file"});
+    diagnostics.push_back({referenced_from, "cannot open plan file '" + path.string() + "': no such regular file"});
     return std::nullopt;
   }
   const auto size = std::filesystem::file_size(path, ec);
   if (ec || size > max_bytes) {
-    diagnostics.push_back({referenced_from, "plan file '" + path.string() + "' is larger than " +
-                                                std::to_string(max_bytes) + " bytes"});
+    diagnostics.push_back(
+        {referenced_from, "plan file '" + path.string() + "' is larger than " + std::to_string(max_bytes) + " bytes"});
     return std::nullopt;
   }
   std::ifstream stream(path, std::ios::binary);
@@ -304,9 +294,7 @@ void writeNode(XmlWriter& writer, const PlanNode& node) {
 
 }  // namespace
 
-PlanFile parsePlanFile(std::string_view xml, const std::string& label) {
-  return FileParser(label).parse(xml);
-}
+PlanFile parsePlanFile(std::string_view xml, const std::string& label) { return FileParser(label).parse(xml); }
 
 Plan loadPlan(const std::filesystem::path& path, const LoadOptions& options) {
   std::vector<Diagnostic> diagnostics;

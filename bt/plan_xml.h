@@ -54,7 +54,6 @@ std::string writePlanFile(const PlanFile& file, const WriteOptions& options = {}
 
 /// Writes the file atomically (temporary file + rename), so a crash never leaves half a plan.
 /// @throws std::runtime_error when the file cannot be written.
-void savePlanFile(const PlanFile& file, const std::filesystem::path& path,
-                  const WriteOptions& options = {});
+void savePlanFile(const PlanFile& file, const std::filesystem::path& path, const WriteOptions& options = {});
 
 }  // namespace costar::bt

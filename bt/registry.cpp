@@ -75,8 +75,7 @@ std::optional<double> parseNumber(std::string_view text) {
   }
   double value = 0;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (text.empty() || error != std::errc() || end != text.data() + text.size() ||
-      !std::isfinite(value)) {
+  if (text.empty() || error != std::errc() || end != text.data() + text.size() || !std::isfinite(value)) {
     return std::nullopt;
   }
   return value;
@@ -98,8 +97,7 @@ std::optional<bool> parseBoolean(std::string_view text) {
 
 // --- PortSpec factories ---------------------------------------------------------------------
 
-PortSpec PortSpec::text(std::string name, std::string description,
-                        std::optional<std::string> default_value) {
+PortSpec PortSpec::text(std::string name, std::string description, std::optional<std::string> default_value) {
   PortSpec port;
   port.name = std::move(name);
   port.description = std::move(description);
@@ -108,9 +106,8 @@ PortSpec PortSpec::text(std::string name, std::string description,
   return port;
 }
 
-PortSpec PortSpec::integer(std::string name, std::string description,
-                           std::optional<std::string> default_value, long long min, long long max,
-                           std::optional<long long> special) {
+PortSpec PortSpec::integer(std::string name, std::string description, std::optional<std::string> default_value,
+                           long long min, long long max, std::optional<long long> special) {
   PortSpec port;
   port.name = std::move(name);
   port.type_name = "int";
@@ -133,8 +130,8 @@ PortSpec PortSpec::integer(std::string name, std::string description,
   return port;
 }
 
-PortSpec PortSpec::number(std::string name, std::string description,
-                          std::optional<std::string> default_value, double min, double max) {
+PortSpec PortSpec::number(std::string name, std::string description, std::optional<std::string> default_value,
+                          double min, double max) {
   PortSpec port;
   port.name = std::move(name);
   port.type_name = "double";
@@ -146,16 +143,14 @@ PortSpec PortSpec::number(std::string name, std::string description,
       return "'" + std::string(text) + "' is not a number";
     }
     if (*value < min || *value > max) {
-      return std::string(text) + " is out of range [" + std::to_string(min) + ", " +
-             std::to_string(max) + "]";
+      return std::string(text) + " is out of range [" + std::to_string(min) + ", " + std::to_string(max) + "]";
     }
     return {};
   };
   return port;
 }
 
-PortSpec PortSpec::boolean(std::string name, std::string description,
-                           std::optional<std::string> default_value) {
+PortSpec PortSpec::boolean(std::string name, std::string description, std::optional<std::string> default_value) {
   PortSpec port;
   port.name = std::move(name);
   port.type_name = "bool";
@@ -190,8 +185,7 @@ PortSpec PortSpec::choice(std::string name, std::string description, std::vector
 
 // --- NodeArgs / NodeSpec ---------------------------------------------------------------------
 
-NodeArgs::NodeArgs(const NodeSpec& spec,
-                   const std::vector<std::pair<std::string, std::string>>& attributes)
+NodeArgs::NodeArgs(const NodeSpec& spec, const std::vector<std::pair<std::string, std::string>>& attributes)
     : spec_(&spec) {
   for (const auto& port : spec.ports) {
     if (port.default_value) {
@@ -287,8 +281,8 @@ std::size_t editDistance(std::string_view a, std::string_view b) {
     row[0] = i;
     for (std::size_t j = 1; j <= b.size(); ++j) {
       const std::size_t above = row[j];
-      const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
-                        std::tolower(static_cast<unsigned char>(b[j - 1]));
+      const bool same =
+          std::tolower(static_cast<unsigned char>(a[i - 1])) == std::tolower(static_cast<unsigned char>(b[j - 1]));
       row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
       diagonal = above;
     }
@@ -329,8 +323,7 @@ NodeSpec control(std::string id, std::string description, NodeBuilder build) {
   return spec;
 }
 
-NodeSpec decorator(std::string id, std::string description, NodeBuilder build,
-                   std::vector<PortSpec> ports = {}) {
+NodeSpec decorator(std::string id, std::string description, NodeBuilder build, std::vector<PortSpec> ports = {}) {
   NodeSpec spec = control(std::move(id), std::move(description), std::move(build));
   spec.kind = NodeKind::kDecorator;
   spec.ports = std::move(ports);
@@ -351,58 +344,55 @@ int toInt(long long value) { return static_cast<int>(value); }
 void registerBuiltinNodes(NodeRegistry& registry) {
   // Nodes that BehaviorTree.CPP v4 has under the same ID and semantics.
   static const std::set<std::string, std::less<>> kBehaviorTreeCpp = {
-      "Sequence", "SequenceWithMemory", "ReactiveSequence", "Fallback", "ReactiveFallback",
-      "Parallel", "Inverter", "ForceSuccess", "ForceFailure", "Repeat", "Timeout",
-      "RetryUntilSuccessful", "SubTree", "AlwaysSuccess", "AlwaysFailure", "Sleep"};
+      "Sequence", "SequenceWithMemory", "ReactiveSequence", "Fallback", "ReactiveFallback", "Parallel",
+      "Inverter", "ForceSuccess",       "ForceFailure",     "Repeat",   "Timeout",          "RetryUntilSuccessful",
+      "SubTree",  "AlwaysSuccess",      "AlwaysFailure",    "Sleep"};
   const auto add = [&registry](NodeSpec spec) {
     spec.btcpp_builtin = kBehaviorTreeCpp.contains(spec.id);
     registry.add(std::move(spec));
   };
 
   add(control("Sequence",
-                       "Ticks children in order while they succeed; resumes at the RUNNING child; "
-                       "a FAILURE fails the sequence and restarts it next time.",
-                       plain<Sequence>()));
+              "Ticks children in order while they succeed; resumes at the RUNNING child; "
+              "a FAILURE fails the sequence and restarts it next time.",
+              plain<Sequence>()));
   add(control("SequenceWithMemory",
-                       "Sequence that keeps its place across a FAILURE or a halt: the next tick "
-                       "retries the same child. Reset clears it.",
-                       plain<SequenceWithMemory>()));
+              "Sequence that keeps its place across a FAILURE or a halt: the next tick "
+              "retries the same child. Reset clears it.",
+              plain<SequenceWithMemory>()));
   add(control("ReactiveSequence",
-                       "Re-ticks all children from the first on every tick; a child that fails "
-                       "halts the running one. Only the last child may be asynchronous.",
-                       plain<ReactiveSequence>()));
+              "Re-ticks all children from the first on every tick; a child that fails "
+              "halts the running one. Only the last child may be asynchronous.",
+              plain<ReactiveSequence>()));
   add(control("Fallback",
-                       "The paper's Selector (?): ticks children in order until one succeeds; "
-                       "resumes at the RUNNING child.",
-                       plain<Fallback>()));
+              "The paper's Selector (?): ticks children in order until one succeeds; "
+              "resumes at the RUNNING child.",
+              plain<Fallback>()));
   add(control("ReactiveFallback",
-                       "Fallback that re-ticks from the first child on every tick, so a "
-                       "higher-priority child preempts a lower one. Only the last child may be "
-                       "asynchronous.",
-                       plain<ReactiveFallback>()));
+              "Fallback that re-ticks from the first child on every tick, so a "
+              "higher-priority child preempts a lower one. Only the last child may be "
+              "asynchronous.",
+              plain<ReactiveFallback>()));
   {
-    NodeSpec spec = control(
-        "Parallel",
-        "Ticks all children together; SUCCESS when success_count succeeded, FAILURE when "
-        "failure_count failed. Negative counts are relative to the number of children (-1 = all).",
-        [](const NodeArgs& args) {
-          return std::make_unique<Parallel>(args.spec().id, args.name(),
-                                            toInt(args.getInt("success_count")),
-                                            toInt(args.getInt("failure_count")));
-        });
+    NodeSpec spec =
+        control("Parallel",
+                "Ticks all children together; SUCCESS when success_count succeeded, FAILURE when "
+                "failure_count failed. Negative counts are relative to the number of children (-1 = all).",
+                [](const NodeArgs& args) {
+                  return std::make_unique<Parallel>(args.spec().id, args.name(), toInt(args.getInt("success_count")),
+                                                    toInt(args.getInt("failure_count")));
+                });
     spec.ports = {
-        PortSpec::integer("success_count", "children that must succeed (-1 = all)", "-1", -kMaxCount,
-                          kMaxCount),
-        PortSpec::integer("failure_count", "children whose failure fails the node", "1", -kMaxCount,
-                          kMaxCount)};
+        PortSpec::integer("success_count", "children that must succeed (-1 = all)", "-1", -kMaxCount, kMaxCount),
+        PortSpec::integer("failure_count", "children whose failure fails the node", "1", -kMaxCount, kMaxCount)};
     spec.check_instance = [](const NodeArgs& args, std::size_t child_count) -> std::string {
       const long long n = static_cast<long long>(child_count);
       for (const char* port : {"success_count", "failure_count"}) {
         const long long count = args.getInt(port);
         const long long resolved = count < 0 ? n + count + 1 : count;
         if (resolved < 1 || resolved > n) {
-          return std::string(port) + "=" + std::to_string(count) + " does not fit " +
-                 std::to_string(n) + " children: it must name between 1 and " + std::to_string(n) +
+          return std::string(port) + "=" + std::to_string(count) + " does not fit " + std::to_string(n) +
+                 " children: it must name between 1 and " + std::to_string(n) +
                  " of them (negative counts from the end: -1 = all)";
         }
       }
@@ -411,59 +401,50 @@ void registerBuiltinNodes(NodeRegistry& registry) {
     add(std::move(spec));
   }
   add(control("Iterator",
-                       "CoSTAR's Iterator: runs each child once, in order, ignoring failures; "
-                       "SUCCESS after the last.",
-                       plain<Iterator>()));
+              "CoSTAR's Iterator: runs each child once, in order, ignoring failures; "
+              "SUCCESS after the last.",
+              plain<Iterator>()));
 
-  add(decorator("Inverter", "SUCCESS becomes FAILURE and FAILURE becomes SUCCESS.",
-                         plain<Inverter>()));
-  add(decorator("ForceSuccess", "Returns SUCCESS once the child completes.",
-                         plain<ForceSuccess>()));
-  add(decorator("ForceFailure", "Returns FAILURE once the child completes.",
-                         plain<ForceFailure>()));
+  add(decorator("Inverter", "SUCCESS becomes FAILURE and FAILURE becomes SUCCESS.", plain<Inverter>()));
+  add(decorator("ForceSuccess", "Returns SUCCESS once the child completes.", plain<ForceSuccess>()));
+  add(decorator("ForceFailure", "Returns FAILURE once the child completes.", plain<ForceFailure>()));
+  add(asynchronous(decorator("Repeat",
+                             "Re-runs the child until num_cycles successful runs (SUCCESS); a FAILURE stops the loop "
+                             "(FAILURE). -1 = forever.",
+                             [](const NodeArgs& args) {
+                               return std::make_unique<Repeat>(args.spec().id, args.name(),
+                                                               toInt(args.getInt("num_cycles")));
+                             },
+                             {PortSpec::integer("num_cycles", "successful runs to complete (-1 = forever)",
+                                                std::nullopt, 1, kMaxCount, -1)})));
+  add(asynchronous(decorator("RepeatRuns",
+                             "The paper's REPEAT N: runs the child num_runs times whatever each run returns, then "
+                             "SUCCESS. -1 = forever.",
+                             [](const NodeArgs& args) {
+                               return std::make_unique<RepeatRuns>(args.spec().id, args.name(),
+                                                                   toInt(args.getInt("num_runs")));
+                             },
+                             {PortSpec::integer("num_runs", "runs to complete, successful or not (-1 = forever)",
+                                                std::nullopt, 1, kMaxCount, -1)})));
+  add(decorator("Reset",
+                "CoSTAR's RESET N: returns the child's value; on FAILURE resets the child (clearing its "
+                "memory) up to num_resets times, then passes FAILURE on. -1 = always.",
+                [](const NodeArgs& args) {
+                  return std::make_unique<Reset>(args.spec().id, args.name(), toInt(args.getInt("num_resets")));
+                },
+                {PortSpec::integer("num_resets", "resets allowed (-1 = unlimited)", std::nullopt, 0, kMaxCount, -1)}));
+  add(decorator("Timeout", "Halts the child and fails if it has not completed msec after it started.",
+                [](const NodeArgs& args) {
+                  return std::make_unique<Timeout>(args.spec().id, args.name(),
+                                                   std::chrono::milliseconds(args.getInt("msec")));
+                },
+                {PortSpec::integer("msec", "time limit in milliseconds", std::nullopt, 0, kMaxCount)}));
   add(asynchronous(decorator(
-      "Repeat",
-      "Re-runs the child until num_cycles successful runs (SUCCESS); a FAILURE stops the loop "
-      "(FAILURE). -1 = forever.",
+      "RetryUntilSuccessful", "Re-runs a failing child, up to num_attempts runs in all (-1 = until it succeeds).",
       [](const NodeArgs& args) {
-        return std::make_unique<Repeat>(args.spec().id, args.name(), toInt(args.getInt("num_cycles")));
+        return std::make_unique<RetryUntilSuccessful>(args.spec().id, args.name(), toInt(args.getInt("num_attempts")));
       },
-      {PortSpec::integer("num_cycles", "successful runs to complete (-1 = forever)", std::nullopt, 1,
-                         kMaxCount, -1)})));
-  add(asynchronous(decorator(
-      "RepeatRuns",
-      "The paper's REPEAT N: runs the child num_runs times whatever each run returns, then "
-      "SUCCESS. -1 = forever.",
-      [](const NodeArgs& args) {
-        return std::make_unique<RepeatRuns>(args.spec().id, args.name(), toInt(args.getInt("num_runs")));
-      },
-      {PortSpec::integer("num_runs", "runs to complete, successful or not (-1 = forever)", std::nullopt,
-                         1, kMaxCount, -1)})));
-  add(decorator(
-      "Reset",
-      "CoSTAR's RESET N: returns the child's value; on FAILURE resets the child (clearing its "
-      "memory) up to num_resets times, then passes FAILURE on. -1 = always.",
-      [](const NodeArgs& args) {
-        return std::make_unique<Reset>(args.spec().id, args.name(), toInt(args.getInt("num_resets")));
-      },
-      {PortSpec::integer("num_resets", "resets allowed (-1 = unlimited)", std::nullopt, 0, kMaxCount,
-                         -1)}));
-  add(decorator(
-      "Timeout", "Halts the child and fails if it has not completed msec after it started.",
-      [](const NodeArgs& args) {
-        return std::make_unique<Timeout>(args.spec().id, args.name(),
-                                         std::chrono::milliseconds(args.getInt("msec")));
-      },
-      {PortSpec::integer("msec", "time limit in milliseconds", std::nullopt, 0, kMaxCount)}));
-  add(asynchronous(decorator(
-      "RetryUntilSuccessful",
-      "Re-runs a failing child, up to num_attempts runs in all (-1 = until it succeeds).",
-      [](const NodeArgs& args) {
-        return std::make_unique<RetryUntilSuccessful>(args.spec().id, args.name(),
-                                                      toInt(args.getInt("num_attempts")));
-      },
-      {PortSpec::integer("num_attempts", "runs allowed in all (-1 = unlimited)", std::nullopt, 1,
-                         kMaxCount, -1)})));
+      {PortSpec::integer("num_attempts", "runs allowed in all (-1 = unlimited)", std::nullopt, 1, kMaxCount, -1)})));
   {
     NodeSpec spec;
     spec.id = "SubTree";
@@ -498,8 +479,7 @@ void registerBuiltinNodes(NodeRegistry& registry) {
     spec.ports = {PortSpec::integer("msec", "how long to wait, in milliseconds", std::nullopt, 0, kMaxCount)};
     spec.asynchronous = true;
     spec.build = [](const NodeArgs& args) {
-      return std::make_unique<Sleep>(args.spec().id, args.name(),
-                                     std::chrono::milliseconds(args.getInt("msec")));
+      return std::make_unique<Sleep>(args.spec().id, args.name(), std::chrono::milliseconds(args.getInt("msec")));
     };
     add(std::move(spec));
   }

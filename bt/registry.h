@@ -40,13 +40,11 @@ struct PortSpec {
   static PortSpec text(std::string name, std::string description,
                        std::optional<std::string> default_value = std::nullopt);
   /// Integer within [min, max]; `special` is an extra allowed value (e.g. -1 = forever).
-  static PortSpec integer(std::string name, std::string description,
-                          std::optional<std::string> default_value, long long min, long long max,
-                          std::optional<long long> special = std::nullopt);
-  static PortSpec number(std::string name, std::string description,
-                         std::optional<std::string> default_value, double min, double max);
-  static PortSpec boolean(std::string name, std::string description,
-                          std::optional<std::string> default_value);
+  static PortSpec integer(std::string name, std::string description, std::optional<std::string> default_value,
+                          long long min, long long max, std::optional<long long> special = std::nullopt);
+  static PortSpec number(std::string name, std::string description, std::optional<std::string> default_value,
+                         double min, double max);
+  static PortSpec boolean(std::string name, std::string description, std::optional<std::string> default_value);
   static PortSpec choice(std::string name, std::string description, std::vector<std::string> choices,
                          std::optional<std::string> default_value);
 };

@@ -5,7 +5,7 @@
 namespace costar::bt {
 
 void JsonLinesTrace::onTransition(TimePoint time, const TreeNode& node, Status from, Status to) {
-  nlohmann::json line = {{"t", toSeconds(time)}, {"uid", node.uid()},     {"path", node.path()},
+  nlohmann::json line = {{"t", toSeconds(time)}, {"uid", node.uid()},      {"path", node.path()},
                          {"node", node.id()},    {"from", toString(from)}, {"to", toString(to)}};
   if (to == Status::kFailure) {
     line["reason"] = std::string(node.failureReason());

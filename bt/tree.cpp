@@ -5,8 +5,7 @@
 
 namespace costar::bt {
 
-Tree::Tree(std::string main_tree_id, std::vector<std::unique_ptr<TreeNode>> nodes, TreeNode* root,
-           const Clock& clock)
+Tree::Tree(std::string main_tree_id, std::vector<std::unique_ptr<TreeNode>> nodes, TreeNode* root, const Clock& clock)
     : main_tree_id_(std::move(main_tree_id)),
       context_(std::make_unique<TreeContext>(clock)),
       owned_(std::move(nodes)),

@@ -15,8 +15,7 @@ class Tree {
   /// Takes ownership of `nodes`, wired already (parents know their children); `root` is one
   /// of them. Paths start with `main_tree_id`.
   /// @throws std::invalid_argument if `root` is null or a reachable node is not in `nodes`.
-  Tree(std::string main_tree_id, std::vector<std::unique_ptr<TreeNode>> nodes, TreeNode* root,
-       const Clock& clock);
+  Tree(std::string main_tree_id, std::vector<std::unique_ptr<TreeNode>> nodes, TreeNode* root, const Clock& clock);
   Tree(Tree&&) noexcept = default;
   Tree& operator=(Tree&&) noexcept = default;
   ~Tree();

@@ -17,8 +17,11 @@ AbstractComponent abstractGripper() {
 }
 
 AbstractComponent abstractPowerTool() {
-  return {"PowerTool", "A tool that is switched on and off (a sander, a polisher).", {"ToolOn", "ToolOff"},
-          {}, {"tool_on"}};
+  return {"PowerTool",
+          "A tool that is switched on and off (a sander, a polisher).",
+          {"ToolOn", "ToolOff"},
+          {},
+          {"tool_on"}};
 }
 
 std::vector<std::string> missingRequirements(const AbstractComponent& abstract,

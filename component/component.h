@@ -76,9 +76,7 @@ struct OperationResult {
   nlohmann::json data;
 
   static OperationResult running() { return {}; }
-  static OperationResult success(nlohmann::json data = {}) {
-    return {OperationState::kSuccess, {}, std::move(data)};
-  }
+  static OperationResult success(nlohmann::json data = {}) { return {OperationState::kSuccess, {}, std::move(data)}; }
   static OperationResult failure(std::string reason, nlohmann::json data = {}) {
     return {OperationState::kFailure, std::move(reason), std::move(data)};
   }

@@ -119,8 +119,8 @@ void ComponentRegistry::registerNodes(bt::NodeRegistry& nodes) {
       bt::NodeSpec spec;
       spec.id = operation.name;
       spec.kind = bt::NodeKind::kAction;
-      spec.category = operation.kind == OperationKind::kKnowledge ? bt::NodeCategory::kKnowledge
-                                                                  : bt::NodeCategory::kRobotAction;
+      spec.category =
+          operation.kind == OperationKind::kKnowledge ? bt::NodeCategory::kKnowledge : bt::NodeCategory::kRobotAction;
       spec.description = operation.description + " [" + component->description().name + "]";
       spec.asynchronous = true;
       for (const ParamSpec& param : operation.params) {
@@ -172,14 +172,15 @@ void ComponentRegistry::refreshWorld() {
     const ComponentDescription& description = component->description();
     world::Report report = component->report();
     std::erase_if(report.predicates, [&](const world::Predicate& predicate) {
-      const bool declared = std::any_of(description.predicates.begin(), description.predicates.end(),
-                                        [&](const PredicateDecl& decl) {
-                                          return decl.name == predicate.name && decl.arity == predicate.args.size();
-                                        });
+      const bool declared =
+          std::any_of(description.predicates.begin(), description.predicates.end(), [&](const PredicateDecl& decl) {
+            return decl.name == predicate.name && decl.arity == predicate.args.size();
+          });
       if (!declared && warned_.insert(description.name + "/" + predicate.name).second) {
-        spdlog::warn("component '{}' reported predicate '{}' with {} argument(s), which it does not declare; "
-                     "ignored",
-                     description.name, predicate.name, predicate.args.size());
+        spdlog::warn(
+            "component '{}' reported predicate '{}' with {} argument(s), which it does not declare; "
+            "ignored",
+            description.name, predicate.name, predicate.args.size());
       }
       return !declared;
     });

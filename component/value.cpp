@@ -142,8 +142,7 @@ std::optional<Value> parseValue(ValueType type, std::string_view text, std::stri
     case ValueType::kDouble: {
       double value = 0;
       const auto [end, ec] = std::from_chars(trimmed.data(), trimmed.data() + trimmed.size(), value);
-      if (trimmed.empty() || ec != std::errc() || end != trimmed.data() + trimmed.size() ||
-          !std::isfinite(value)) {
+      if (trimmed.empty() || ec != std::errc() || end != trimmed.data() + trimmed.size() || !std::isfinite(value)) {
         return fail("'" + std::string(text) + "' is not a number");
       }
       return Value(value);

@@ -24,14 +24,14 @@ class Value {
   using List = std::vector<std::string>;
 
   Value() : data_(false) {}
-  Value(bool value) : data_(value) {}  // NOLINT(google-explicit-constructor)
-  Value(long long value) : data_(value) {}  // NOLINT
+  Value(bool value) : data_(value) {}                         // NOLINT(google-explicit-constructor)
+  Value(long long value) : data_(value) {}                    // NOLINT
   Value(int value) : data_(static_cast<long long>(value)) {}  // NOLINT
-  Value(double value) : data_(value) {}  // NOLINT
-  Value(std::string value) : data_(std::move(value)) {}  // NOLINT
-  Value(const char* value) : data_(std::string(value)) {}  // NOLINT
-  Value(const world::Pose& value) : data_(value) {}  // NOLINT
-  Value(List value) : data_(std::move(value)) {}  // NOLINT
+  Value(double value) : data_(value) {}                       // NOLINT
+  Value(std::string value) : data_(std::move(value)) {}       // NOLINT
+  Value(const char* value) : data_(std::string(value)) {}     // NOLINT
+  Value(const world::Pose& value) : data_(value) {}           // NOLINT
+  Value(List value) : data_(std::move(value)) {}              // NOLINT
 
   ValueType type() const { return static_cast<ValueType>(data_.index()); }
   /// Typed access. @throws std::invalid_argument naming both types on a mismatch

@@ -19,9 +19,7 @@ using TimePoint = std::chrono::time_point<ClockEpoch, Duration>;
 /// Seconds as a double, for printing and JSON.
 inline double toSeconds(Duration d) { return std::chrono::duration<double>(d).count(); }
 inline double toSeconds(TimePoint t) { return toSeconds(t.time_since_epoch()); }
-inline Duration fromSeconds(double s) {
-  return std::chrono::duration_cast<Duration>(std::chrono::duration<double>(s));
-}
+inline Duration fromSeconds(double s) { return std::chrono::duration_cast<Duration>(std::chrono::duration<double>(s)); }
 
 /// A source of time. Implementations are thread-safe for now(); sleepUntil() is called by
 /// one thread (the executor's).

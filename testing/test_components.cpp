@@ -16,9 +16,10 @@ using component::ValueType;
 TestLogger::TestLogger() {
   description_.name = "test_logger";
   description_.type = "TestLogger";
-  description_.operations = {
-      {"TestLog", "TEST ONLY: records a message.", {{"message", ValueType::kString, "text to record", {}}},
-       component::OperationKind::kKnowledge}};
+  description_.operations = {{"TestLog",
+                              "TEST ONLY: records a message.",
+                              {{"message", ValueType::kString, "text to record", {}}},
+                              component::OperationKind::kKnowledge}};
 }
 
 std::vector<std::string> TestLogger::messages() const {
@@ -67,7 +68,8 @@ class ThrowingOperation final : public RunningOperation {
 TestActions::TestActions() {
   description_.name = "test_actions";
   description_.type = "TestActions";
-  ParamSpec result{"result", ValueType::kString, "what the action returns", std::string("success"), {"success", "failure"}};
+  ParamSpec result{
+      "result", ValueType::kString, "what the action returns", std::string("success"), {"success", "failure"}};
   ParamSpec polls{"polls", ValueType::kInt, "polls spent RUNNING before the result", 0LL};
   polls.min = 0;
   ParamSpec reason{"reason", ValueType::kString, "failure reason", std::string("scripted failure")};
@@ -81,9 +83,8 @@ std::unique_ptr<RunningOperation> TestActions::begin(const std::string& operatio
   if (operation == "TestThrow") {
     return std::make_unique<ThrowingOperation>();
   }
-  return std::make_unique<ScriptedOperation>(*this, params.at("polls").asInt(),
-                                             params.at("result").asString() == "success",
-                                             params.at("reason").asString());
+  return std::make_unique<ScriptedOperation>(
+      *this, params.at("polls").asInt(), params.at("result").asString() == "success", params.at("reason").asString());
 }
 
 // --- TestCounter -----------------------------------------------------------------------
@@ -148,12 +149,14 @@ TestArm::TestArm() {
   description_.implements = {"Arm"};
   ParamSpec waypoint{"waypoint", ValueType::kString, "waypoint to move to", {}};
   waypoint.choices_from = "waypoint";
-  description_.operations = {
-      {"Move", "TEST ONLY: moves the endpoint to a waypoint (3 polls).", {waypoint}},
-      {"Teach", "TEST ONLY: saves the endpoint as a named waypoint.",
-       {{"waypoint", ValueType::kString, "name for the new waypoint", {}}}, component::OperationKind::kKnowledge},
-      {"SetEndpoint", "TEST ONLY: jogs the endpoint to a pose.",
-       {{"pose", ValueType::kPose, "x;y;z;roll;pitch;yaw (m, deg)", {}}}}};
+  description_.operations = {{"Move", "TEST ONLY: moves the endpoint to a waypoint (3 polls).", {waypoint}},
+                             {"Teach",
+                              "TEST ONLY: saves the endpoint as a named waypoint.",
+                              {{"waypoint", ValueType::kString, "name for the new waypoint", {}}},
+                              component::OperationKind::kKnowledge},
+                             {"SetEndpoint",
+                              "TEST ONLY: jogs the endpoint to a pose.",
+                              {{"pose", ValueType::kPose, "x;y;z;roll;pitch;yaw (m, deg)", {}}}}};
   description_.symbols = {{"endpoint", world::SymbolKind::kFrame, "the arm's tool frame"}};
   description_.predicates = {{"at_waypoint", 1, "at_waypoint(w): the endpoint is at waypoint w"}};
   waypoints_["home"] = world::Pose(Eigen::Translation3d(0.3, 0.0, 0.5));

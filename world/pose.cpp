@@ -9,10 +9,10 @@ namespace costar::world {
 Pose poseFromXyzRpy(double x, double y, double z, double roll, double pitch, double yaw) {
   Pose pose = Pose::Identity();
   pose.translation() = Eigen::Vector3d(x, y, z);
-  pose.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                   Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-                   Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-                      .toRotationMatrix();
+  pose.linear() =
+      (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   return pose;
 }
 
@@ -48,7 +48,8 @@ std::optional<Pose> parsePose(std::string_view text, std::string* error) {
     const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
     if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || !std::isfinite(value)) {
       if (error != nullptr) {
-        *error = "'" + std::string(text) + "' is not a pose: expected \"x;y;z\" or "
+        *error = "'" + std::string(text) +
+                 "' is not a pose: expected \"x;y;z\" or "
                  "\"x;y;z;roll;pitch;yaw\" (metres, degrees)";
       }
       return std::nullopt;
@@ -65,14 +66,13 @@ std::optional<Pose> parsePose(std::string_view text, std::string* error) {
   }
   values.resize(6, 0.0);
   constexpr double kDeg = M_PI / 180.0;
-  return poseFromXyzRpy(values[0], values[1], values[2], values[3] * kDeg, values[4] * kDeg,
-                        values[5] * kDeg);
+  return poseFromXyzRpy(values[0], values[1], values[2], values[3] * kDeg, values[4] * kDeg, values[5] * kDeg);
 }
 
 std::string formatPose(const Pose& pose) {
   const Eigen::Vector3d rpy = rpyOf(pose.linear()) * (180.0 / M_PI);
-  const double values[6] = {pose.translation().x(), pose.translation().y(), pose.translation().z(),
-                            rpy.x(), rpy.y(), rpy.z()};
+  const double values[6] = {
+      pose.translation().x(), pose.translation().y(), pose.translation().z(), rpy.x(), rpy.y(), rpy.z()};
   std::string text;
   for (double value : values) {
     char buffer[32];

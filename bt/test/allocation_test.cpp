@@ -37,10 +37,10 @@ TEST(Allocation, NoneInSteadyStateOnTheReferenceTrees) {
 
 TEST(Allocation, NoneWhenHaltingAndRestartingRunningLoops) {
   using bench::node;
-  const Plan plan = bench::planOf(node(
-      "Fallback", {node("Timeout", {node("Repeat", {node("Sleep", {}, {{"msec", "5"}})}, {{"num_cycles", "-1"}})},
-                        {{"msec", "30"}}),
-                   node("Reset", {node("Inverter", {node("AlwaysSuccess")})}, {{"num_resets", "-1"}})}));
+  const Plan plan = bench::planOf(
+      node("Fallback", {node("Timeout", {node("Repeat", {node("Sleep", {}, {{"msec", "5"}})}, {{"num_cycles", "-1"}})},
+                             {{"msec", "30"}}),
+                        node("Reset", {node("Inverter", {node("AlwaysSuccess")})}, {{"num_resets", "-1"}})}));
   // The Timeout fails (it composes its reason once, then reuses the string), Reset resets.
   EXPECT_EQ(allocationsForRuns(plan, 20, std::chrono::milliseconds(10)), 0u);
 }

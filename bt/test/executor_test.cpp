@@ -34,7 +34,8 @@ TEST(Executor, LoopsThatFinishARunEveryTickDoNotAdvanceTheClock) {
 }
 
 TEST(Executor, ReportsTheFailingNodesPathAndReason) {
-  testing::TestTree t(R"(<Sequence><TestLeaf name="grasp" results="failure" reason="no reachable candidate"/></Sequence>)");
+  testing::TestTree t(
+      R"(<Sequence><TestLeaf name="grasp" results="failure" reason="no reachable candidate"/></Sequence>)");
   Executor executor(t.tree, t.clock);
   const RunResult result = executor.run();
   EXPECT_EQ(result.status, Status::kFailure);
@@ -56,8 +57,8 @@ TEST(Executor, StopFromAnotherThreadHaltsAndCancelsTheRunningOperation) {
   testing::EventLog log;
   const NodeRegistry registry = testing::registryWithTestLeaf(log);
   RealClock clock;
-  Tree tree = buildTree(loadPlanText(testing::planXml(R"(<TestLeaf name="move" ticks="1000000"/>)"), "t"),
-                        registry, clock);
+  Tree tree =
+      buildTree(loadPlanText(testing::planXml(R"(<TestLeaf name="move" ticks="1000000"/>)"), "t"), registry, clock);
   Executor executor(tree, clock, {.tick_period = 1ms});
   std::thread stopper([&] {
     std::this_thread::sleep_for(50ms);

@@ -288,7 +288,7 @@ TEST(Reset, AfterNResetsPassesFailureOnWithoutTickingTheChild) {
     EXPECT_EQ(t.tree.root().failureReason(), "broken");
   }
   EXPECT_EQ(t.log.count("a:start"), 3);  // latched: child no longer ticked
-  t.tree.reset();                          // an ancestor's reset restores the budget
+  t.tree.reset();                        // an ancestor's reset restores the budget
   EXPECT_EQ(t.tree.tick(), Status::kFailure);
   EXPECT_EQ(t.log.count("a:start"), 4);
 }
@@ -329,13 +329,15 @@ TEST(Timeout, PassesOnTheResultOfAChildThatCompletesInTime) {
 // --- RetryUntilSuccessful -------------------------------------------------------------------
 
 TEST(RetryUntilSuccessful, RetriesUntilTheChildSucceeds) {
-  TestTree t(R"(<RetryUntilSuccessful num_attempts="5"><TestLeaf name="a" results="failure;failure;success"/></RetryUntilSuccessful>)");
+  TestTree t(
+      R"(<RetryUntilSuccessful num_attempts="5"><TestLeaf name="a" results="failure;failure;success"/></RetryUntilSuccessful>)");
   EXPECT_EQ(tickUntilDone(t), Status::kSuccess);
   EXPECT_EQ(t.log.count("a:start"), 3);
 }
 
 TEST(RetryUntilSuccessful, FailsWithTheLastReasonWhenAttemptsRunOut) {
-  TestTree t(R"(<RetryUntilSuccessful num_attempts="2"><TestLeaf name="a" results="failure" reason="slipped"/></RetryUntilSuccessful>)");
+  TestTree t(
+      R"(<RetryUntilSuccessful num_attempts="2"><TestLeaf name="a" results="failure" reason="slipped"/></RetryUntilSuccessful>)");
   EXPECT_EQ(tickUntilDone(t), Status::kFailure);
   EXPECT_EQ(t.log.count("a:start"), 2);
   EXPECT_EQ(t.tree.root().failureReason(), "slipped");
@@ -344,11 +346,11 @@ TEST(RetryUntilSuccessful, FailsWithTheLastReasonWhenAttemptsRunOut) {
 // --- SubTree, leaves ----------------------------------------------------------------------
 
 TEST(SubTree, IsTransparentAndNamedByItsIdInPaths) {
-  TestTree t(R"(<Sequence><SubTree ID="assemble"/></Sequence>)",
-             R"(<BehaviorTree ID="assemble"><Sequence><TestLeaf/><TestLeaf name="grasp link" results="failure" reason="no reachable candidate"/></Sequence></BehaviorTree>)");
+  TestTree t(
+      R"(<Sequence><SubTree ID="assemble"/></Sequence>)",
+      R"(<BehaviorTree ID="assemble"><Sequence><TestLeaf/><TestLeaf name="grasp link" results="failure" reason="no reachable candidate"/></Sequence></BehaviorTree>)");
   EXPECT_EQ(t.tree.tick(), Status::kFailure);
-  EXPECT_EQ(t.tree.root().failureOrigin().path(),
-            R"(main/Sequence[1]/assemble/Sequence[1]/TestLeaf "grasp link")");
+  EXPECT_EQ(t.tree.root().failureOrigin().path(), R"(main/Sequence[1]/assemble/Sequence[1]/TestLeaf "grasp link")");
 }
 
 TEST(Leaves, AlwaysSuccessAlwaysFailureAndSleepOnTheClock) {
@@ -374,13 +376,10 @@ TEST(Observer, ReportsEveryTransitionInOrder) {
   EXPECT_EQ(t.tree.tick(), Status::kRunning);
   EXPECT_EQ(t.tree.tick(), Status::kFailure);
   EXPECT_EQ(observer.transitions,
-            (Events{R"(main/Sequence[1]/TestLeaf "a":IDLE->RUNNING)",
-                    "main/Sequence[1]:IDLE->RUNNING",
+            (Events{R"(main/Sequence[1]/TestLeaf "a":IDLE->RUNNING)", "main/Sequence[1]:IDLE->RUNNING",
                     R"(main/Sequence[1]/TestLeaf "a":RUNNING->SUCCESS)",
-                    "main/Sequence[1]/AlwaysFailure[2]:IDLE->FAILURE",
-                    R"(main/Sequence[1]/TestLeaf "a":SUCCESS->IDLE)",
-                    "main/Sequence[1]/AlwaysFailure[2]:FAILURE->IDLE",
-                    "main/Sequence[1]:RUNNING->FAILURE"}));
+                    "main/Sequence[1]/AlwaysFailure[2]:IDLE->FAILURE", R"(main/Sequence[1]/TestLeaf "a":SUCCESS->IDLE)",
+                    "main/Sequence[1]/AlwaysFailure[2]:FAILURE->IDLE", "main/Sequence[1]:RUNNING->FAILURE"}));
   EXPECT_EQ(observer.reasons, (Events{"AlwaysFailure", "AlwaysFailure"}));
 }
 

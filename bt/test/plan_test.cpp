@@ -39,9 +39,11 @@ std::string problem(const std::string& xml) {
 // --- reading ------------------------------------------------------------------------------
 
 TEST(PlanXml, ReadsCompactAndExplicitFormsAlike) {
-  const PlanFile compact = parsePlanFile(planXml(R"(<Sequence name="s"><Repeat num_cycles="2"><AlwaysSuccess/></Repeat></Sequence>)"), "a");
+  const PlanFile compact =
+      parsePlanFile(planXml(R"(<Sequence name="s"><Repeat num_cycles="2"><AlwaysSuccess/></Repeat></Sequence>)"), "a");
   const PlanFile explicit_form = parsePlanFile(
-      planXml(R"(<Control ID="Sequence" name="s"><Decorator ID="Repeat" num_cycles="2"><Action ID="AlwaysSuccess"/></Decorator></Control>)"),
+      planXml(
+          R"(<Control ID="Sequence" name="s"><Decorator ID="Repeat" num_cycles="2"><Action ID="AlwaysSuccess"/></Decorator></Control>)"),
       "b");
   EXPECT_TRUE(sameContent(compact, explicit_form));
   EXPECT_EQ(compact.main_tree, "main");
@@ -120,7 +122,8 @@ TEST(NodesModel, ListsCostarNodesWithPortsTypesAndDefaults) {
 
 TEST(Validation, MalformedXmlNamesTheLine) {
   // The line of the element left open.
-  const auto unclosed = problems("<root BTCPP_format=\"4\">\n<BehaviorTree ID=\"m\">\n<Sequence>\n</BehaviorTree></root>");
+  const auto unclosed =
+      problems("<root BTCPP_format=\"4\">\n<BehaviorTree ID=\"m\">\n<Sequence>\n</BehaviorTree></root>");
   ASSERT_EQ(unclosed.size(), 1u);
   EXPECT_EQ(unclosed[0].where.line, 3);
   EXPECT_NE(unclosed[0].message.find("MISMATCHED_ELEMENT"), std::string::npos);
@@ -139,8 +142,7 @@ TEST(Validation, MissingIllTypedAndUnknownParameters) {
             "1: Repeat needs parameter 'num_cycles' (successful runs to complete (-1 = forever))");
   EXPECT_EQ(problem(planXml(R"(<Repeat num_cycles="three"><AlwaysSuccess/></Repeat>)")),
             "1: parameter 'num_cycles' of Repeat: 'three' is not an integer");
-  EXPECT_EQ(problem(planXml(R"(<Sleep msec="10" sec="1"/>)")),
-            "1: Sleep has no parameter 'sec' (it takes msec)");
+  EXPECT_EQ(problem(planXml(R"(<Sleep msec="10" sec="1"/>)")), "1: Sleep has no parameter 'sec' (it takes msec)");
   EXPECT_EQ(problem(planXml(R"(<TestLeaf ticks="1.5"/>)")),
             "1: parameter 'ticks' of TestLeaf: '1.5' is not an integer");
 }
@@ -166,8 +168,7 @@ TEST(Validation, ChildCounts) {
 }
 
 TEST(Validation, UnknownAndRecursiveSubtrees) {
-  EXPECT_EQ(problem(planXml(R"(<SubTree ID="grasp"/>)")),
-            "1: unknown subtree 'grasp' (the plan defines: main)");
+  EXPECT_EQ(problem(planXml(R"(<SubTree ID="grasp"/>)")), "1: unknown subtree 'grasp' (the plan defines: main)");
   const std::string recursive = planXml(R"(<SubTree ID="a"/>)",
                                         R"(<BehaviorTree ID="a"><Sequence><SubTree ID="b"/></Sequence></BehaviorTree>
                                            <BehaviorTree ID="b"><SubTree ID="a"/></BehaviorTree>)");
@@ -188,21 +189,32 @@ TEST(Validation, ReactiveNodesOnlyLetTheirLastChildRun) {
   EXPECT_NE(problem(planXml(R"(<ReactiveSequence><TestLeaf/><TestLeaf/></ReactiveSequence>)"))
                 .find("only the last child of a ReactiveSequence may take time"),
             std::string::npos);
-  EXPECT_NE(problem(planXml(R"(<ReactiveFallback><Repeat num_cycles="2"><TestCondition/></Repeat><TestLeaf/></ReactiveFallback>)"))
-                .find("Repeat can be RUNNING"),
-            std::string::npos);
-  EXPECT_TRUE(problems(planXml(R"(<ReactiveSequence><Inverter><TestCondition/></Inverter><TestLeaf/></ReactiveSequence>)")).empty());
+  EXPECT_NE(
+      problem(
+          planXml(
+              R"(<ReactiveFallback><Repeat num_cycles="2"><TestCondition/></Repeat><TestLeaf/></ReactiveFallback>)"))
+          .find("Repeat can be RUNNING"),
+      std::string::npos);
+  EXPECT_TRUE(
+      problems(planXml(R"(<ReactiveSequence><Inverter><TestCondition/></Inverter><TestLeaf/></ReactiveSequence>)"))
+          .empty());
 }
 
 TEST(Validation, StructureOfTheFile) {
   EXPECT_EQ(problem(R"(<root BTCPP_format="3"><BehaviorTree ID="m"><AlwaysSuccess/></BehaviorTree></root>)"),
             "1: BTCPP_format=\"3\" is not supported: plans use BehaviorTree.CPP's format 4");
-  EXPECT_EQ(problem("<root BTCPP_format=\"4\"><BehaviorTree ID=\"m\">\n<AlwaysSuccess/><AlwaysSuccess/></BehaviorTree></root>"),
-            "2: BehaviorTree 'm' has more than one root node: wrap them in a Sequence");
-  EXPECT_EQ(problem(R"(<root BTCPP_format="4" main_tree_to_execute="nope"><BehaviorTree ID="m"><AlwaysSuccess/></BehaviorTree></root>)"),
-            "0: main_tree_to_execute names 'nope', but no BehaviorTree has that ID");
-  EXPECT_EQ(problem(R"(<root BTCPP_format="4"><BehaviorTree ID="a"><AlwaysSuccess/></BehaviorTree><BehaviorTree ID="b"><AlwaysSuccess/></BehaviorTree></root>)"),
-            "0: the file defines several BehaviorTrees but no main_tree_to_execute");
+  EXPECT_EQ(
+      problem(
+          "<root BTCPP_format=\"4\"><BehaviorTree ID=\"m\">\n<AlwaysSuccess/><AlwaysSuccess/></BehaviorTree></root>"),
+      "2: BehaviorTree 'm' has more than one root node: wrap them in a Sequence");
+  EXPECT_EQ(
+      problem(
+          R"(<root BTCPP_format="4" main_tree_to_execute="nope"><BehaviorTree ID="m"><AlwaysSuccess/></BehaviorTree></root>)"),
+      "0: main_tree_to_execute names 'nope', but no BehaviorTree has that ID");
+  EXPECT_EQ(
+      problem(
+          R"(<root BTCPP_format="4"><BehaviorTree ID="a"><AlwaysSuccess/></BehaviorTree><BehaviorTree ID="b"><AlwaysSuccess/></BehaviorTree></root>)"),
+      "0: the file defines several BehaviorTrees but no main_tree_to_execute");
   EXPECT_EQ(problem(R"(<plan/>)"), "1: the top element must be <root BTCPP_format=\"4\">, found <plan>");
 }
 
@@ -216,8 +228,8 @@ TEST(Validation, ReportsEveryProblemNotJustTheFirst) {
 TEST(Validation, SizeLimitsStopExponentialSubtrees) {
   std::string trees;
   for (int i = 0; i < 30; ++i) {
-    trees += "<BehaviorTree ID=\"t" + std::to_string(i) + "\"><Sequence><SubTree ID=\"t" +
-             std::to_string(i + 1) + "\"/><SubTree ID=\"t" + std::to_string(i + 1) + "\"/></Sequence></BehaviorTree>";
+    trees += "<BehaviorTree ID=\"t" + std::to_string(i) + "\"><Sequence><SubTree ID=\"t" + std::to_string(i + 1) +
+             "\"/><SubTree ID=\"t" + std::to_string(i + 1) + "\"/></Sequence></BehaviorTree>";
   }
   trees += "<BehaviorTree ID=\"t30\"><AlwaysSuccess/></BehaviorTree>";
   EXPECT_NE(problem(planXml(R"(<SubTree ID="t0"/>)", trees)).find("expands to more than 1000000 nodes"),
@@ -243,7 +255,9 @@ class IncludeTest : public ::testing::Test {
 TEST_F(IncludeTest, IncludedTreesAreUsableAndRelativeToTheIncludingFile) {
   write("main.xml", R"(<root BTCPP_format="4" main_tree_to_execute="main"><include path="lib/a.xml"/>
     <BehaviorTree ID="main"><SubTree ID="a"/></BehaviorTree></root>)");
-  write("lib/a.xml", R"(<root BTCPP_format="4"><include path="b.xml"/><BehaviorTree ID="a"><SubTree ID="b"/></BehaviorTree></root>)");
+  write(
+      "lib/a.xml",
+      R"(<root BTCPP_format="4"><include path="b.xml"/><BehaviorTree ID="a"><SubTree ID="b"/></BehaviorTree></root>)");
   write("lib/b.xml", R"(<root BTCPP_format="4"><BehaviorTree ID="b"><AlwaysSuccess/></BehaviorTree></root>)");
   const Plan plan = loadPlan(dir_ / "main.xml");
   EXPECT_EQ(plan.included.size(), 2u);
@@ -253,7 +267,9 @@ TEST_F(IncludeTest, IncludedTreesAreUsableAndRelativeToTheIncludingFile) {
 }
 
 TEST_F(IncludeTest, ACycleOfIncludesIsAnErrorNamingTheCycle) {
-  write("main.xml", "<root BTCPP_format=\"4\">\n<include path=\"lib/a.xml\"/><BehaviorTree ID=\"m\"><AlwaysSuccess/></BehaviorTree></root>");
+  write("main.xml",
+        "<root BTCPP_format=\"4\">\n<include path=\"lib/a.xml\"/><BehaviorTree "
+        "ID=\"m\"><AlwaysSuccess/></BehaviorTree></root>");
   write("lib/a.xml", "<root BTCPP_format=\"4\">\n\n<include path=\"../main.xml\"/></root>");
   try {
     loadPlan(dir_ / "main.xml");
@@ -267,7 +283,9 @@ TEST_F(IncludeTest, ACycleOfIncludesIsAnErrorNamingTheCycle) {
 }
 
 TEST_F(IncludeTest, AMissingIncludeNamesTheIncludingLine) {
-  write("main.xml", "<root BTCPP_format=\"4\">\n<include path=\"nope.xml\"/><BehaviorTree ID=\"m\"><AlwaysSuccess/></BehaviorTree></root>");
+  write("main.xml",
+        "<root BTCPP_format=\"4\">\n<include path=\"nope.xml\"/><BehaviorTree "
+        "ID=\"m\"><AlwaysSuccess/></BehaviorTree></root>");
   try {
     loadPlan(dir_ / "main.xml");
     FAIL() << "expected a PlanError";

@@ -32,8 +32,7 @@ struct EventLog {
 /// "failure;failure;success"; the last one repeats.
 class TestLeaf final : public LeafNode {
  public:
-  TestLeaf(std::string id, std::string name, int ticks, std::vector<Status> results, std::string reason,
-           EventLog* log)
+  TestLeaf(std::string id, std::string name, int ticks, std::vector<Status> results, std::string reason, EventLog* log)
       : LeafNode(std::move(id), std::move(name)),
         ticks_(ticks),
         results_(std::move(results)),
@@ -87,8 +86,7 @@ inline NodeRegistry registryWithTestLeaf(EventLog& log) {
     std::size_t start = 0;
     while (start <= text.size()) {
       const std::size_t end = std::min(text.find(';', start), text.size());
-      results.push_back(text.substr(start, end - start) == "failure" ? Status::kFailure
-                                                                     : Status::kSuccess);
+      results.push_back(text.substr(start, end - start) == "failure" ? Status::kFailure : Status::kSuccess);
       start = end + 1;
     }
     return std::make_unique<TestLeaf>(args.spec().id, args.name(), static_cast<int>(args.getInt("ticks")),
@@ -120,8 +118,8 @@ class RecordingObserver final : public TreeObserver {
 
 /// Wraps a tree body in a plan document with main tree "main".
 inline std::string planXml(const std::string& body, const std::string& extra_trees = "") {
-  return R"(<root BTCPP_format="4" main_tree_to_execute="main"><BehaviorTree ID="main">)" + body +
-         "</BehaviorTree>" + extra_trees + "</root>";
+  return R"(<root BTCPP_format="4" main_tree_to_execute="main"><BehaviorTree ID="main">)" + body + "</BehaviorTree>" +
+         extra_trees + "</root>";
 }
 
 /// A tree built from `body`, with the TestLeaf registry and `clock`.

@@ -111,8 +111,7 @@ class RunsPlans : public ::testing::Test {
   }
 
   bt::RunResult run(const std::string& body) {
-    const std::string xml =
-        R"(<root BTCPP_format="4"><BehaviorTree ID="main">)" + body + "</BehaviorTree></root>";
+    const std::string xml = R"(<root BTCPP_format="4"><BehaviorTree ID="main">)" + body + "</BehaviorTree></root>";
     bt::Tree tree = bt::buildTree(bt::loadPlanText(xml, "plan.xml"), nodes, clock);
     bt::Executor executor(tree, clock);
     executor.setBeforeTick([this] { components.refreshWorld(); });
@@ -120,8 +119,7 @@ class RunsPlans : public ::testing::Test {
   }
 
   std::vector<bt::Diagnostic> problems(const std::string& body) {
-    const std::string xml =
-        R"(<root BTCPP_format="4"><BehaviorTree ID="main">)" + body + "</BehaviorTree></root>";
+    const std::string xml = R"(<root BTCPP_format="4"><BehaviorTree ID="main">)" + body + "</BehaviorTree></root>";
     return bt::validatePlan(bt::loadPlanText(xml, "plan.xml"), nodes);
   }
 
@@ -139,7 +137,8 @@ TEST_F(RunsPlans, OperationsBecomeNodeTypesWithTypedValidatedParameters) {
   ASSERT_NE(move, nullptr);
   EXPECT_EQ(move->category, bt::NodeCategory::kRobotAction);
   EXPECT_EQ(nodes.find("TestLog")->category, bt::NodeCategory::kKnowledge);
-  const auto bad = problems(R"(<Sequence><TestAction polls="soon"/><TestAction result="maybe"/><SetEndpoint pose="1;2"/></Sequence>)");
+  const auto bad = problems(
+      R"(<Sequence><TestAction polls="soon"/><TestAction result="maybe"/><SetEndpoint pose="1;2"/></Sequence>)");
   ASSERT_EQ(bad.size(), 3u);
   EXPECT_EQ(bad[0].message, "parameter 'polls' of TestAction: 'soon' is not an integer");
   EXPECT_EQ(bad[1].message, "parameter 'result' of TestAction: 'maybe' is not one of: success, failure");

@@ -8,10 +8,12 @@ namespace costar::component {
 namespace {
 
 TEST(Value, TextFormRoundTripsForEveryType) {
-  const std::vector<std::pair<ValueType, std::string>> cases = {
-      {ValueType::kBool, "true"},          {ValueType::kInt, "-42"},
-      {ValueType::kDouble, "0.125"},       {ValueType::kString, "grasp link"},
-      {ValueType::kPose, "0.1;0.2;0.3;10;-20;30"}, {ValueType::kStringList, "right_of;table_center"}};
+  const std::vector<std::pair<ValueType, std::string>> cases = {{ValueType::kBool, "true"},
+                                                                {ValueType::kInt, "-42"},
+                                                                {ValueType::kDouble, "0.125"},
+                                                                {ValueType::kString, "grasp link"},
+                                                                {ValueType::kPose, "0.1;0.2;0.3;10;-20;30"},
+                                                                {ValueType::kStringList, "right_of;table_center"}};
   for (const auto& [type, text] : cases) {
     std::string error;
     const auto value = parseValue(type, text, &error);

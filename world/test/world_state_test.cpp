@@ -12,9 +12,8 @@ Symbol frame(std::string name, std::string parent, Pose pose) {
 TEST(WorldState, IsTheUnionOfTheSourcesReports) {
   WorldState world;
   world.update("gripper", {{}, {{"gripper_open", {}, true, ""}}});
-  world.update("perception",
-               {{frame("node_1", "world", Pose(Eigen::Translation3d(1, 0, 0)))},
-                {{"is_a", {"node_1", "node"}, true, ""}}});
+  world.update("perception", {{frame("node_1", "world", Pose(Eigen::Translation3d(1, 0, 0)))},
+                              {{"is_a", {"node_1", "node"}, true, ""}}});
   EXPECT_TRUE(world.holds("gripper_open", {}));
   const std::vector<std::string> args{"node_1", "node"};
   EXPECT_TRUE(world.holds("is_a", args));
@@ -43,8 +42,7 @@ TEST(WorldState, WorldPoseComposesParentFrames) {
   WorldState world;
   world.update("cal", {{frame("table_center", "world", poseFromXyzRpy(0.5, 0, 0.1, 0, 0, M_PI / 2)),
                         frame("above_table", "table_center", Pose(Eigen::Translation3d(0.1, 0, 0.2))),
-                        frame("loop_a", "loop_b", Pose::Identity()),
-                        frame("loop_b", "loop_a", Pose::Identity())},
+                        frame("loop_a", "loop_b", Pose::Identity()), frame("loop_b", "loop_a", Pose::Identity())},
                        {}});
   const auto pose = world.worldPose("above_table");
   ASSERT_TRUE(pose.has_value());
