@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/plan_commands.h"
+#include "cli/sim_commands.h"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -12,6 +13,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   int exit_code = 0;
   costar::cli::addPlanCommands(app, exit_code);
+  costar::cli::addSimCommands(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

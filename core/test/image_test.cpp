@@ -1,0 +1,39 @@
+#include "core/image.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace costar {
+namespace {
+
+TEST(Png, WritesAndReadsBackTheSamePixels) {
+  RgbImage image(7, 3);
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 7; ++x) {
+      image.at(x, y)[0] = static_cast<std::uint8_t>(x * 30);
+      image.at(x, y)[1] = static_cast<std::uint8_t>(y * 80);
+      image.at(x, y)[2] = 200;
+    }
+  }
+  const auto path = std::filesystem::temp_directory_path() / "costar_image_test.png";
+  writePng(path, image);
+  const RgbImage back = readPng(path);
+  EXPECT_EQ(back.width, 7);
+  EXPECT_EQ(back.height, 3);
+  EXPECT_EQ(back.pixels, image.pixels);
+  std::filesystem::remove(path);
+}
+
+TEST(Png, ErrorsNameTheFile) {
+  try {
+    writePng("/nonexistent-dir/x.png", RgbImage(2, 2));
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent-dir/x.png"), std::string::npos);
+  }
+  EXPECT_THROW(readPng("/nonexistent.png"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace costar

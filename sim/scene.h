@@ -1,0 +1,75 @@
+#pragma once
+// Scene files: which parts lie on the table and where, fixed or at random in named regions
+// (any yaw), with a seed. Example (sim/scenes/assembly.json):
+//   {"description": "...", "seed": 1,
+//    "regions": {"right": {"x": [0.35, 0.7], "y": [-0.4, -0.1]}},
+//    "parts": [{"class": "node", "color": "red", "at": [0.5, -0.2, 30]},
+//              {"class": "node", "count": 2, "region": "right"},
+//              {"class": "link", "region": "right"}]}
+// "at" is x, y (m, world frame: the robot's base, table top z = 0) and yaw (degrees).
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "world/object_class.h"
+#include "world/pose.h"
+
+namespace costar::sim {
+
+struct Region {
+  Eigen::Vector2d min = Eigen::Vector2d::Zero();
+  Eigen::Vector2d max = Eigen::Vector2d::Zero();
+};
+
+struct PartRequest {
+  std::string object_class;
+  /// Colour name of the class; empty: the class's colours in turn.
+  std::string color;
+  int count = 1;
+  /// Fixed placement: x, y (m) and yaw (degrees).
+  std::optional<Eigen::Vector3d> at;
+  /// Random placement in this region (any yaw), when `at` is absent.
+  std::string region;
+};
+
+struct Scene {
+  std::string label;  // the file it came from
+  std::string description;
+  std::uint64_t seed = 0;
+  std::map<std::string, Region> regions;
+  std::vector<PartRequest> parts;
+  /// Smallest gap between the footprints of randomly placed parts (m).
+  double min_gap = 0.02;
+};
+
+/// The regions every scene knows: "table" (the reachable part of the table), "right" and
+/// "left" halves (y < 0 and y > 0, the robot's right and left).
+std::map<std::string, Region> defaultRegions();
+
+/// Reads a scene file. @throws std::runtime_error naming the file and the problem.
+Scene loadScene(const std::filesystem::path& file);
+Scene parseScene(const std::string& json_text, const std::string& label);
+
+/// A part as placed: its simulator name (node_0, link_1, ...), class, colour, and pose.
+struct PartPlacement {
+  std::string name;
+  std::string object_class;
+  std::string color;
+  world::Pose pose;
+};
+
+/// Places every requested part resting on the table: fixed ones where asked, random ones
+/// uniformly in their region with a uniform yaw, keeping `min_gap` between footprints.
+/// Deterministic for a given `seed` (the scene's seed unless overridden).
+/// @throws std::runtime_error for an unknown class, colour or region, or when the parts do
+/// not fit.
+std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<world::ObjectClass>& classes,
+                                      std::optional<std::uint64_t> seed = std::nullopt);
+
+}  // namespace costar::sim

@@ -1,0 +1,474 @@
+#include "sim/simulation.h"
+
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/paths.h"
+#include "sim/gl_context.h"
+
+namespace costar::sim {
+
+namespace {
+
+constexpr std::array<const char*, 6> kArmJoints = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
+                                                   "wrist_1_joint",      "wrist_2_joint",       "wrist_3_joint"};
+
+// Computed-torque gains: critically damped, 8 Hz bandwidth.
+constexpr double kArmOmega = 50.0;
+constexpr double kArmKp = kArmOmega * kArmOmega;
+constexpr double kArmKd = 2.0 * kArmOmega;
+
+std::string readText(const std::filesystem::path& file) {
+  std::ifstream stream(file);
+  if (!stream) {
+    throw std::runtime_error("cannot open '" + file.string() + "'");
+  }
+  std::stringstream text;
+  text << stream.rdbuf();
+  return text.str();
+}
+
+void replaceMarker(std::string& text, const std::string& marker, const std::string& content) {
+  const auto at = text.find(marker);
+  if (at == std::string::npos) {
+    throw std::runtime_error("the workcell model has no " + marker + " marker");
+  }
+  text.replace(at, marker.size(), content);
+}
+
+std::string format(double value) {
+  std::ostringstream out;
+  out.precision(9);
+  out << value;
+  return out.str();
+}
+
+std::string vec(const Eigen::Vector3d& v) { return format(v.x()) + " " + format(v.y()) + " " + format(v.z()); }
+
+/// MJCF for one part: a free body made of the class's boxes.
+std::string partBody(const PartPlacement& part, const world::ObjectClass& object) {
+  double volume = 0.0;
+  for (const auto& box : object.boxes) {
+    volume += 8.0 * box.half_size.prod();
+  }
+  const double density = object.mass / volume;
+  const Eigen::Quaterniond q(part.pose.linear());
+  std::string body = "<body name=\"" + part.name + "\" pos=\"" + vec(part.pose.translation()) + "\" quat=\"" +
+                     format(q.w()) + " " + format(q.x()) + " " + format(q.y()) + " " + format(q.z()) +
+                     "\"><freejoint/>";
+  for (std::size_t i = 0; i < object.boxes.size(); ++i) {
+    const auto& box = object.boxes[i];
+    body += "<geom class=\"part\" type=\"box\" pos=\"" + vec(box.center) + "\" size=\"" + vec(box.half_size) +
+            "\" density=\"" + format(density) + "\" material=\"" + object.name + "_" + part.color + "\"/>";
+  }
+  return body + "</body>\n";
+}
+
+}  // namespace
+
+const std::array<const char*, 6>& armJointNames() { return kArmJoints; }
+
+ArmJoints Simulation::homeConfiguration() { return {0.0, -2.3, 1.9, -M_PI / 2 + 0.4, -M_PI / 2, 0.0}; }
+
+// --- implementation ------------------------------------------------------------------------
+
+struct Simulation::Impl {
+  mjModel* model = nullptr;
+  mjData* data = nullptr;
+  std::vector<world::ObjectClass> classes;
+  std::vector<PartPlacement> placements;
+  std::vector<int> part_bodies;
+
+  std::array<int, 6> arm_qpos{};
+  std::array<int, 6> arm_dof{};
+  int finger_qpos = 0;
+  int finger_dof = 0;
+  int finger_actuator = 0;
+  int left_pad = 0;
+  int right_pad = 0;
+  int table_geom = 0;
+  int tcp_site = 0;
+  int rgbd_camera = 0;
+  int first_arm_body = 0;
+  int tool_body = 0;
+
+  std::int64_t steps = 0;         // physics steps since time 0
+  std::int64_t settle_steps = 0;  // steps taken before time 0
+  std::function<ArmSetpoint(TimePoint)> setpoint_source;
+  ArmSetpoint held;
+  std::vector<mjtNum> acceleration;  // nv, scratch
+  std::vector<mjtNum> torque;        // nv, scratch
+
+  double finger_target = kMaxOpening / 2;  // per side, m
+  double finger_command = kMaxOpening / 2;
+  double finger_speed = 0.05;
+  std::uint64_t arm_table_contact_steps = 0;
+
+  camera::Intrinsics intrinsics = camera::Intrinsics::fromHorizontalFov(640, 480, 58.0 * M_PI / 180.0);
+  DepthNoiseOptions noise;
+  std::unique_ptr<GlRenderer> renderer;
+
+  SimClock* clock = nullptr;
+  int listener = 0;
+
+  ~Impl() {
+    if (clock != nullptr) {
+      clock->removeStepListener(listener);
+    }
+    renderer.reset();
+    if (data != nullptr) {
+      mj_deleteData(data);
+    }
+    if (model != nullptr) {
+      mj_deleteModel(model);
+    }
+  }
+
+  int id(mjtObj type, const char* name) const {
+    const int found = mj_name2id(model, type, name);
+    if (found < 0) {
+      throw std::runtime_error(std::string("the workcell model lacks '") + name + "'");
+    }
+    return found;
+  }
+
+  TimePoint now() const {
+    return TimePoint(Duration(static_cast<std::int64_t>(std::llround(steps * model->opt.timestep * 1e9))));
+  }
+
+  bool isArmBody(int body) const {
+    // Every body from shoulder_link down the chain (the gripper included) belongs to the arm.
+    for (int b = body; b > 0; b = model->body_parentid[b]) {
+      if (b == first_arm_body) {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  void control() {
+    // Arm: computed torque, tau = M (qdd_d + Kp e + Kd de) + bias, clamped by the actuators.
+    const TimePoint t = now();
+    const ArmSetpoint setpoint = setpoint_source ? setpoint_source(t) : held;
+    if (setpoint_source) {
+      held = {setpoint.position, {}, {}};
+    }
+    std::fill(acceleration.begin(), acceleration.end(), 0.0);
+    for (int i = 0; i < 6; ++i) {
+      const double error = setpoint.position[i] - data->qpos[arm_qpos[i]];
+      const double rate_error = setpoint.velocity[i] - data->qvel[arm_dof[i]];
+      acceleration[arm_dof[i]] = setpoint.acceleration[i] + kArmKp * error + kArmKd * rate_error;
+    }
+    mj_mulM(model, data, torque.data(), acceleration.data());
+    for (int i = 0; i < 6; ++i) {
+      data->ctrl[i] = torque[arm_dof[i]] + data->qfrc_bias[arm_dof[i]];
+    }
+    // Gripper: the servo setpoint moves toward the target at the commanded speed.
+    const double step = finger_speed * model->opt.timestep;
+    finger_command += std::clamp(finger_target - finger_command, -step, step);
+    data->ctrl[finger_actuator] = finger_command;
+  }
+
+  void countTableContacts() {
+    for (int i = 0; i < data->ncon; ++i) {
+      const mjContact& contact = data->contact[i];
+      const int other = contact.geom1 == table_geom ? contact.geom2 : contact.geom2 == table_geom ? contact.geom1 : -1;
+      if (other >= 0 && isArmBody(model->geom_bodyid[other])) {
+        ++arm_table_contact_steps;
+        return;
+      }
+    }
+  }
+
+  void step() {
+    mj_step1(model, data);
+    control();
+    mj_step2(model, data);
+    countTableContacts();
+    ++steps;
+  }
+
+  std::string bodyLabel(int body) const {
+    if (body == 0) {
+      return "world";
+    }
+    for (std::size_t i = 0; i < part_bodies.size(); ++i) {
+      if (part_bodies[i] == body) {
+        return placements[i].name;
+      }
+    }
+    const char* name = mj_id2name(model, mjOBJ_BODY, body);
+    const std::string label = name != nullptr ? name : "body";
+    if (label == "left_finger" || label == "right_finger") {
+      return label;
+    }
+    return isArmBody(body) ? "arm" : label;
+  }
+};
+
+Simulation::Simulation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Simulation::~Simulation() = default;
+
+std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const SimulationOptions& options) {
+  auto impl = std::make_unique<Impl>();
+  const std::filesystem::path root = options.data_root.empty() ? dataRoot() : options.data_root;
+  impl->classes = world::loadObjectClasses(root / "data" / "objects");
+  impl->placements = placeParts(scene, impl->classes, options.placement_seed);
+  impl->noise = options.depth_noise;
+
+  // Model: the workcell template plus a material per class colour and a body per part.
+  std::string xml = readText(root / "sim" / "models" / "ur5_workcell.xml");
+  std::string assets;
+  for (const auto& object : impl->classes) {
+    for (const auto& [color_name, rgb] : object.colors) {
+      assets += "<material name=\"" + object.name + "_" + color_name + "\" rgba=\"" + vec(rgb) +
+                " 1\" specular=\"0.2\" shininess=\"0.3\"/>\n";
+    }
+  }
+  std::string bodies;
+  for (const auto& part : impl->placements) {
+    const auto object = std::find_if(impl->classes.begin(), impl->classes.end(),
+                                     [&](const world::ObjectClass& c) { return c.name == part.object_class; });
+    bodies += partBody(part, *object);
+  }
+  replaceMarker(xml, "<!--PART_ASSETS-->", assets);
+  replaceMarker(xml, "<!--PARTS-->", bodies);
+
+  mjVFS vfs;
+  mj_defaultVFS(&vfs);
+  const char* kModelName = "workcell.xml";
+  if (mj_makeEmptyFileVFS(&vfs, kModelName, static_cast<int>(xml.size())) != 0) {
+    throw std::runtime_error("MuJoCo: cannot allocate the model in memory");
+  }
+  const int file = mj_findFileVFS(&vfs, kModelName);
+  std::memcpy(vfs.filedata[file], xml.data(), xml.size());
+  char error[1024] = "";
+  impl->model = mj_loadXML(kModelName, &vfs, error, sizeof error);
+  mj_deleteVFS(&vfs);
+  if (impl->model == nullptr) {
+    throw std::runtime_error(std::string("MuJoCo cannot load the workcell for scene '") + scene.label + "': " + error);
+  }
+  impl->data = mj_makeData(impl->model);
+  mjModel* m = impl->model;
+
+  for (int i = 0; i < 6; ++i) {
+    const int joint = impl->id(mjOBJ_JOINT, kArmJoints[i]);
+    impl->arm_qpos[i] = m->jnt_qposadr[joint];
+    impl->arm_dof[i] = m->jnt_dofadr[joint];
+  }
+  const int finger_joint = impl->id(mjOBJ_JOINT, "left_finger_joint");
+  impl->finger_qpos = m->jnt_qposadr[finger_joint];
+  impl->finger_dof = m->jnt_dofadr[finger_joint];
+  impl->finger_actuator = impl->id(mjOBJ_ACTUATOR, "fingers");
+  impl->left_pad = impl->id(mjOBJ_GEOM, "left_pad");
+  impl->right_pad = impl->id(mjOBJ_GEOM, "right_pad");
+  impl->table_geom = impl->id(mjOBJ_GEOM, "table");
+  impl->tcp_site = impl->id(mjOBJ_SITE, "tcp");
+  impl->rgbd_camera = impl->id(mjOBJ_CAMERA, "rgbd");
+  impl->first_arm_body = impl->id(mjOBJ_BODY, "shoulder_link");
+  impl->tool_body = impl->id(mjOBJ_BODY, "tool0");
+  for (const auto& part : impl->placements) {
+    impl->part_bodies.push_back(impl->id(mjOBJ_BODY, part.name.c_str()));
+  }
+  // Square pixels, principal point at the centre, focal length from the model's fovy.
+  const double fovy = m->cam_fovy[impl->rgbd_camera] * M_PI / 180.0;
+  impl->intrinsics.fy = impl->intrinsics.height / (2.0 * std::tan(fovy / 2.0));
+  impl->intrinsics.fx = impl->intrinsics.fy;
+  impl->acceleration.assign(m->nv, 0.0);
+  impl->torque.assign(m->nv, 0.0);
+
+  // Start at the initial configuration, fingers open, and let the parts settle.
+  const ArmJoints initial = options.initial_arm.value_or(homeConfiguration());
+  for (int i = 0; i < 6; ++i) {
+    impl->data->qpos[impl->arm_qpos[i]] = initial[i];
+  }
+  impl->held.position = initial;
+  impl->data->qpos[impl->finger_qpos] = kMaxOpening / 2;
+  impl->data->qpos[m->jnt_qposadr[impl->id(mjOBJ_JOINT, "right_finger_joint")]] = kMaxOpening / 2;
+  mj_forward(m, impl->data);
+  const auto settle = static_cast<std::int64_t>(std::ceil(options.settle_seconds / m->opt.timestep));
+  for (std::int64_t i = 0; i < settle; ++i) {
+    impl->step();
+  }
+  impl->settle_steps = settle;
+  impl->steps = 0;
+  impl->arm_table_contact_steps = 0;
+  return std::unique_ptr<Simulation>(new Simulation(std::move(impl)));
+}
+
+TimePoint Simulation::time() const { return impl_->now(); }
+
+Duration Simulation::timestep() const {
+  return Duration(static_cast<std::int64_t>(std::llround(impl_->model->opt.timestep * 1e9)));
+}
+
+void Simulation::stepTo(TimePoint t) {
+  const double dt = impl_->model->opt.timestep;
+  const auto target = static_cast<std::int64_t>(std::floor(toSeconds(t) / dt + 1e-9));
+  while (impl_->steps < target) {
+    impl_->step();
+  }
+}
+
+void Simulation::attach(SimClock& clock) {
+  detach();
+  impl_->clock = &clock;
+  impl_->listener = clock.addStepListener([this](TimePoint, TimePoint to) { stepTo(to); });
+}
+
+void Simulation::detach() {
+  if (impl_->clock != nullptr) {
+    impl_->clock->removeStepListener(impl_->listener);
+    impl_->clock = nullptr;
+  }
+}
+
+ArmJoints Simulation::armPositions() const {
+  ArmJoints q{};
+  for (int i = 0; i < 6; ++i) {
+    q[i] = impl_->data->qpos[impl_->arm_qpos[i]];
+  }
+  return q;
+}
+
+ArmJoints Simulation::armVelocities() const {
+  ArmJoints v{};
+  for (int i = 0; i < 6; ++i) {
+    v[i] = impl_->data->qvel[impl_->arm_dof[i]];
+  }
+  return v;
+}
+
+void Simulation::setArmSetpointSource(std::function<ArmSetpoint(TimePoint)> source) {
+  impl_->setpoint_source = std::move(source);
+}
+
+world::Pose Simulation::tcpPose() const {
+  const mjData* d = impl_->data;
+  world::Pose pose = world::Pose::Identity();
+  const mjtNum* r = d->site_xmat + 9 * impl_->tcp_site;
+  pose.linear() << r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8];
+  pose.translation() = Eigen::Map<const Eigen::Vector3d>(d->site_xpos + 3 * impl_->tcp_site);
+  return pose;
+}
+
+std::uint64_t Simulation::armTableContactSteps() const { return impl_->arm_table_contact_steps; }
+
+FingerState Simulation::fingers() const {
+  const mjData* d = impl_->data;
+  FingerState state;
+  state.opening = 2.0 * d->qpos[impl_->finger_qpos];
+  state.opening_speed = 2.0 * d->qvel[impl_->finger_dof];
+  state.force = -d->actuator_force[impl_->finger_actuator];
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& contact = d->contact[i];
+    for (const int pad : {impl_->left_pad, impl_->right_pad}) {
+      if (contact.geom1 == pad || contact.geom2 == pad) {
+        const int other = contact.geom1 == pad ? contact.geom2 : contact.geom1;
+        if (other != impl_->left_pad && other != impl_->right_pad) {
+          state.pads_in_contact = true;
+        }
+      }
+    }
+  }
+  return state;
+}
+
+void Simulation::commandFingers(double opening, double speed, double force) {
+  impl_->finger_target = std::clamp(opening, 0.0, kMaxOpening) / 2.0;
+  impl_->finger_speed = std::max(speed, 1e-3) / 2.0;
+  const double limit = std::clamp(force, 1.0, 200.0);
+  impl_->model->actuator_forcerange[2 * impl_->finger_actuator] = -limit;
+  impl_->model->actuator_forcerange[2 * impl_->finger_actuator + 1] = limit;
+}
+
+const camera::Intrinsics& Simulation::rgbdIntrinsics() const { return impl_->intrinsics; }
+
+world::Pose Simulation::rgbdPose() const {
+  const mjData* d = impl_->data;
+  const int cam = impl_->rgbd_camera;
+  world::Pose mujoco_camera = world::Pose::Identity();
+  const mjtNum* r = d->cam_xmat + 9 * cam;
+  mujoco_camera.linear() << r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8];
+  mujoco_camera.translation() = Eigen::Map<const Eigen::Vector3d>(d->cam_xpos + 3 * cam);
+  // MuJoCo's camera looks along -z with y up; the optical frame looks along +z with y down.
+  world::Pose optical = world::Pose::Identity();
+  optical.linear() = Eigen::Vector3d(1, -1, -1).asDiagonal();
+  return mujoco_camera * optical;
+}
+
+camera::RgbdFrame Simulation::captureRgbd(std::uint64_t noise_seed) {
+  if (!impl_->renderer) {
+    impl_->renderer = std::make_unique<GlRenderer>(impl_->model);
+  }
+  const camera::Intrinsics& in = impl_->intrinsics;
+  camera::RgbdFrame frame;
+  frame.intrinsics = in;
+  frame.stamp = time();
+  frame.camera_pose = rgbdPose();
+  std::vector<float> depth;
+  impl_->renderer->render(impl_->model, impl_->data, impl_->rgbd_camera, in.width, in.height, frame.rgb, &depth);
+  noisyPointCloud(depth, in, impl_->noise, noise_seed, frame.points);
+  return frame;
+}
+
+RgbImage Simulation::renderImage(const std::string& camera, int width, int height) {
+  if (!impl_->renderer) {
+    impl_->renderer = std::make_unique<GlRenderer>(impl_->model);
+  }
+  const int id = impl_->id(mjOBJ_CAMERA, camera.c_str());
+  RgbImage image;
+  impl_->renderer->render(impl_->model, impl_->data, id, width, height, image, nullptr);
+  return image;
+}
+
+std::vector<PartState> Simulation::parts() const {
+  std::vector<PartState> states;
+  const mjData* d = impl_->data;
+  for (std::size_t i = 0; i < impl_->placements.size(); ++i) {
+    const int body = impl_->part_bodies[i];
+    PartState state;
+    state.name = impl_->placements[i].name;
+    state.object_class = impl_->placements[i].object_class;
+    state.color = impl_->placements[i].color;
+    const mjtNum* q = d->xquat + 4 * body;
+    state.pose = world::Pose::Identity();
+    state.pose.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
+    state.pose.translation() = Eigen::Map<const Eigen::Vector3d>(d->xpos + 3 * body);
+    const int dof = impl_->model->jnt_dofadr[impl_->model->body_jntadr[body]];
+    state.linear_velocity = Eigen::Map<const Eigen::Vector3d>(d->qvel + dof);
+    states.push_back(std::move(state));
+  }
+  return states;
+}
+
+std::vector<std::pair<std::string, std::string>> Simulation::contacts() const {
+  std::vector<std::pair<std::string, std::string>> pairs;
+  const mjData* d = impl_->data;
+  const mjModel* m = impl_->model;
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& contact = d->contact[i];
+    std::string a = contact.geom1 == impl_->table_geom ? "table" : impl_->bodyLabel(m->geom_bodyid[contact.geom1]);
+    std::string b = contact.geom2 == impl_->table_geom ? "table" : impl_->bodyLabel(m->geom_bodyid[contact.geom2]);
+    if (a > b) {
+      std::swap(a, b);
+    }
+    const std::pair<std::string, std::string> pair{a, b};
+    if (std::find(pairs.begin(), pairs.end(), pair) == pairs.end()) {
+      pairs.push_back(pair);
+    }
+  }
+  return pairs;
+}
+
+const std::vector<world::ObjectClass>& Simulation::objectClasses() const { return impl_->classes; }
+
+}  // namespace costar::sim

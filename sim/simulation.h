@@ -1,0 +1,134 @@
+#pragma once
+// The embedded default robot: a MuJoCo simulation of the UR5 workcell (arm, 2-finger gripper,
+// table, parts, RGB-D camera). No MuJoCo type appears here; MuJoCo stays in sim/*.cpp.
+//
+// Physics advances in lockstep with a SimClock (attach()): each tick's interval is
+// simulated in fixed steps of the model's timestep (2 ms). The arm follows joint setpoints
+// with computed-torque control within the UR5's torque limits; the gripper's fingers close by
+// a force-limited servo, so parts are held only by contact and friction.
+//
+// Ground truth (parts(), contacts) is for tests and the trial judge only: components that a
+// plan uses must get their knowledge from the arm's joint states, the gripper's finger state
+// and camera frames.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "camera/rgbd.h"
+#include "core/clock.h"
+#include "core/image.h"
+#include "sim/depth_noise.h"
+#include "sim/scene.h"
+#include "world/object_class.h"
+
+namespace costar::sim {
+
+using ArmJoints = std::array<double, 6>;
+
+/// Where the arm should be at a given time.
+struct ArmSetpoint {
+  ArmJoints position{};
+  ArmJoints velocity{};
+  ArmJoints acceleration{};
+};
+
+struct SimulationOptions {
+  /// Folder with data/objects and sim/models (default: the repository, see core/paths.h).
+  std::filesystem::path data_root;
+  /// Arm configuration at the start (radians). Default: the "home" pose, tool pointing down.
+  std::optional<ArmJoints> initial_arm;
+  /// Seed of the random part placement (default: the scene's seed).
+  std::optional<std::uint64_t> placement_seed;
+  DepthNoiseOptions depth_noise;
+  /// Physics time to let parts settle before time 0.
+  double settle_seconds = 0.3;
+};
+
+/// A part's true state, for tests and the trial judge.
+struct PartState {
+  std::string name;
+  std::string object_class;
+  std::string color;
+  world::Pose pose;
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();
+};
+
+/// The gripper as its sensors see it.
+struct FingerState {
+  double opening = 0.0;        // distance between the pads, m (0 .. 0.085)
+  double opening_speed = 0.0;  // m/s, negative while closing
+  double force = 0.0;          // servo force, N (positive squeezes)
+  bool pads_in_contact = false;
+};
+
+class Simulation {
+ public:
+  /// Builds the workcell with the scene's parts and lets them settle.
+  /// @throws std::runtime_error naming what is missing or wrong (files, classes, model).
+  static std::unique_ptr<Simulation> create(const Scene& scene, const SimulationOptions& options = {});
+  ~Simulation();
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  // --- time ------------------------------------------------------------------------------
+  /// Simulated time (0 after settling).
+  TimePoint time() const;
+  /// Simulates up to `t` in whole physics steps.
+  void stepTo(TimePoint t);
+  /// Steps whenever `clock` advances, until detach() or destruction. The clock must outlive
+  /// the attachment.
+  void attach(SimClock& clock);
+  void detach();
+  Duration timestep() const;
+
+  // --- arm -------------------------------------------------------------------------------
+  ArmJoints armPositions() const;
+  ArmJoints armVelocities() const;
+  /// The controller asks `source` for a setpoint at every physics step. Without a source
+  /// (nullptr) the arm holds the last setpoint.
+  void setArmSetpointSource(std::function<ArmSetpoint(TimePoint)> source);
+  /// Pose of the gripper's tool centre point in the world (true value).
+  world::Pose tcpPose() const;
+  /// Number of physics steps in which an arm or gripper geom touched the table so far.
+  std::uint64_t armTableContactSteps() const;
+
+  // --- gripper ---------------------------------------------------------------------------
+  FingerState fingers() const;
+  /// Moves the fingers toward `opening` (m) at `speed` (m/s), squeezing with at most `force` (N).
+  void commandFingers(double opening, double speed, double force);
+  static constexpr double kMaxOpening = 0.085;
+
+  // --- camera ----------------------------------------------------------------------------
+  const camera::Intrinsics& rgbdIntrinsics() const;
+  /// Pose of the RGB-D camera's optical frame (x right, y down, z forward) in the world.
+  world::Pose rgbdPose() const;
+  /// Renders the RGB-D camera now and applies the depth noise model with `noise_seed`.
+  camera::RgbdFrame captureRgbd(std::uint64_t noise_seed);
+  /// Renders a named camera ("rgbd", "overview") at any size up to 1280 x 960.
+  RgbImage renderImage(const std::string& camera, int width, int height);
+
+  // --- ground truth (tests and the trial judge only) ----------------------------------------
+  std::vector<PartState> parts() const;
+  /// Pairs of bodies in contact: part names, "table", "left_finger", "right_finger", "arm".
+  std::vector<std::pair<std::string, std::string>> contacts() const;
+  const std::vector<world::ObjectClass>& objectClasses() const;
+
+  /// The arm's "home" configuration: tool pointing down above the table.
+  static ArmJoints homeConfiguration();
+
+ private:
+  struct Impl;
+  explicit Simulation(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The UR5's joint names in the simulator and the URDF, in order.
+const std::array<const char*, 6>& armJointNames();
+
+}  // namespace costar::sim
