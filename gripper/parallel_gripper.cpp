@@ -1,0 +1,139 @@
+#include "gripper/parallel_gripper.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace costar::gripper {
+
+using component::OperationResult;
+using component::ParamSpec;
+using component::ValueType;
+
+namespace {
+
+std::string millimetres(double metres) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f mm", metres * 1000.0);
+  return text;
+}
+
+/// Moves the fingers and waits until they settle: at the target, or stopped on something.
+class FingerMotion final : public component::RunningOperation {
+ public:
+  FingerMotion(GripperDriver& driver, const Clock& clock, double target, double speed, double force, Duration timeout,
+               bool closing)
+      : driver_(driver),
+        clock_(clock),
+        target_(target),
+        closing_(closing),
+        start_(clock.now()),
+        deadline_(start_ + timeout) {
+    driver_.command(target, speed, force);
+  }
+
+  OperationResult poll() override {
+    const FingerReading reading = driver_.read();
+    const TimePoint now = clock_.now();
+    const bool still = std::abs(reading.opening_speed) < 0.002;
+    // Settled once still for 50 ms, and not before the fingers had time to start moving.
+    if (still && now - start_ > std::chrono::milliseconds(60)) {
+      if (!still_since_) {
+        still_since_ = now;
+      }
+    } else {
+      still_since_.reset();
+    }
+    const bool settled = still_since_ && now - *still_since_ >= std::chrono::milliseconds(50);
+    if (settled || std::abs(reading.opening - target_) < 0.0005) {
+      if (!closing_ && reading.opening < driver_.maxOpening() - ParallelGripper::kOpenMargin) {
+        return OperationResult::failure("the fingers are blocked at " + millimetres(reading.opening) +
+                                        ": they could not open fully");
+      }
+      const bool holding = closing_ && reading.opening > ParallelGripper::kClosedBelow;
+      return OperationResult::success({{"opening", reading.opening}, {"holding", holding}});
+    }
+    if (now >= deadline_) {
+      return OperationResult::failure(std::string("the fingers did not settle within the time limit (at ") +
+                                      millimetres(reading.opening) + ")");
+    }
+    return OperationResult::running();
+  }
+
+  void cancel() override {
+    // Stop where the fingers are.
+    const FingerReading reading = driver_.read();
+    driver_.command(reading.opening, 0.1, reading.force > 0 ? reading.force : 10.0);
+  }
+
+ private:
+  GripperDriver& driver_;
+  const Clock& clock_;
+  double target_;
+  bool closing_;
+  TimePoint start_;
+  TimePoint deadline_;
+  std::optional<TimePoint> still_since_;
+};
+
+}  // namespace
+
+ParallelGripper::ParallelGripper(GripperDriver& driver, const Clock& clock, ParallelGripperOptions options)
+    : driver_(driver), clock_(clock), options_(std::move(options)) {
+  description_.name = options_.name;
+  description_.type = "ParallelGripper2F";
+  description_.implements = {"Gripper"};
+  description_.inputs = {"finger_state"};
+  description_.outputs = {"finger_command"};
+  ParamSpec speed{"speed", ValueType::kDouble, "finger speed (m/s)", options_.speed};
+  speed.min = 0.01;
+  speed.max = 0.15;
+  ParamSpec force{"force", ValueType::kDouble, "grip force (N)", options_.force};
+  force.min = 5.0;
+  force.max = 120.0;
+  description_.operations = {{"Open", "Opens the fingers fully.", {speed}},
+                             {"Close", "Closes the fingers until they stop on a part or close fully.", {speed, force}},
+                             {"BasicMode", "Selects Basic mode (3-finger grippers only).", {}},
+                             {"PinchMode", "Selects Pinch mode, the only mode of a parallel gripper.", {}},
+                             {"WideMode", "Selects Wide mode (3-finger grippers only).", {}},
+                             {"ScissorMode", "Selects Scissor mode (3-finger grippers only).", {}}};
+  description_.predicates = {{"gripper_open", 0, "the fingers are fully open"},
+                             {"gripper_closed", 0, "the fingers are fully closed, nothing between them"},
+                             {"gripper_holding", 0, "the fingers stopped on something and squeeze it"},
+                             {"gripper_mode", 1, "gripper_mode(m): the gripper is in mode m"}};
+}
+
+world::Report ParallelGripper::report() const {
+  const FingerReading reading = driver_.read();
+  world::Report report;
+  const bool still = std::abs(reading.opening_speed) < 0.002;
+  if (reading.opening >= driver_.maxOpening() - kOpenMargin) {
+    report.predicates.push_back({"gripper_open", {}, true, ""});
+  }
+  if (reading.opening <= kClosedBelow) {
+    report.predicates.push_back({"gripper_closed", {}, true, ""});
+  }
+  if (still && reading.contact && reading.force > kHoldingForce && reading.opening > kClosedBelow) {
+    report.predicates.push_back({"gripper_holding", {}, true, ""});
+  }
+  report.predicates.push_back({"gripper_mode", {"pinch"}, true, ""});
+  return report;
+}
+
+std::unique_ptr<component::RunningOperation> ParallelGripper::begin(const std::string& operation,
+                                                                    const component::ParamMap& params) {
+  if (operation == "Open") {
+    return std::make_unique<FingerMotion>(driver_, clock_, driver_.maxOpening(), params.at("speed").asDouble(),
+                                          options_.force, options_.timeout, false);
+  }
+  if (operation == "Close") {
+    return std::make_unique<FingerMotion>(driver_, clock_, 0.0, params.at("speed").asDouble(),
+                                          params.at("force").asDouble(), options_.timeout, true);
+  }
+  if (operation == "PinchMode") {
+    return std::make_unique<component::FinishedOperation>(OperationResult::success());
+  }
+  return std::make_unique<component::FinishedOperation>(OperationResult::failure(
+      operation + ": mode not supported by this gripper (a parallel 2-finger gripper has only Pinch mode)"));
+}
+
+}  // namespace costar::gripper

@@ -1,0 +1,48 @@
+#pragma once
+// A parallel 2-finger gripper (e.g. a Robotiq 2F-85) as a CoSTAR component implementing the
+// abstract Gripper. It has one mode, Pinch: BasicMode, WideMode and ScissorMode fail with a
+// reason. Its predicates come from the fingers' readings, never from the last command:
+//   gripper_open      the fingers are (nearly) fully open
+//   gripper_closed    the fingers are (nearly) fully closed: nothing between them
+//   gripper_holding   the fingers stopped on something and squeeze it
+//   gripper_mode(m)   m = pinch
+
+#include <memory>
+
+#include "component/component.h"
+#include "core/clock.h"
+#include "gripper/gripper_driver.h"
+
+namespace costar::gripper {
+
+struct ParallelGripperOptions {
+  std::string name = "gripper";
+  double speed = 0.1;   // m/s, default for Open and Close
+  double force = 40.0;  // N, default grip force
+  /// Close and Open fail when the fingers have not settled after this long.
+  Duration timeout = std::chrono::seconds(3);
+};
+
+class ParallelGripper final : public component::LocalComponent {
+ public:
+  /// The driver and clock must outlive the component.
+  ParallelGripper(GripperDriver& driver, const Clock& clock, ParallelGripperOptions options = {});
+  const component::ComponentDescription& description() const override { return description_; }
+  world::Report report() const override;
+
+  /// Thresholds of the predicates: within 2 mm of fully open / closed; holding when the
+  /// still fingers touch something and squeeze it with more than 2 N.
+  static constexpr double kOpenMargin = 0.002;
+  static constexpr double kClosedBelow = 0.002;
+  static constexpr double kHoldingForce = 2.0;
+
+ private:
+  std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
+                                                     const component::ParamMap& params) override;
+  component::ComponentDescription description_;
+  GripperDriver& driver_;
+  const Clock& clock_;
+  ParallelGripperOptions options_;
+};
+
+}  // namespace costar::gripper
