@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/perception_commands.h"
 #include "cli/plan_commands.h"
 #include "cli/sim_commands.h"
 
@@ -14,6 +15,7 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   costar::cli::addPlanCommands(app, exit_code);
   costar::cli::addSimCommands(app, exit_code);
+  costar::cli::addPerceptionCommands(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
