@@ -239,6 +239,11 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
                                      [&](const world::ObjectClass& c) { return c.name == part.object_class; });
     bodies += partBody(part, *object);
   }
+  // Textures and meshes named in the model are files in sim/models.
+  const std::string models = (root / "sim" / "models").string();
+  replaceMarker(xml, "<compiler angle=\"radian\" autolimits=\"true\"/>",
+                "<compiler angle=\"radian\" autolimits=\"true\" texturedir=\"" + models + "\" meshdir=\"" + models +
+                    "\"/>");
   replaceMarker(xml, "<!--PART_ASSETS-->", assets);
   replaceMarker(xml, "<!--PARTS-->", bodies);
 
