@@ -18,6 +18,8 @@ PACKAGES=(
   libtinyxml2-dev nlohmann-json3-dev libspdlog-dev libcli11-dev libeigen3-dev libboost-dev libpng-dev
   # the simulated workcell: MuJoCo physics, headless rendering with Mesa's EGL
   libmujoco-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
+  # arm kinematics from URDF (Orocos KDL), collision checking (FCL), motion planning (OMPL)
+  liborocos-kdl-dev libkdl-parser-dev liburdfdom-dev libfcl-dev libompl-dev
 )
 
 SUDO=""

@@ -33,7 +33,7 @@ JOINTS = [  # name, parent, child, xyz = (a_{i-1}, 0, d_{i-1}), rpy = (alpha_{i-
 
 
 def f(values):
-    return " ".join(f"{x:.9g}" for x in values)
+    return " ".join(f"{x:.17g}" for x in values)
 
 
 def main():

@@ -1,0 +1,72 @@
+#pragma once
+// Collision checking of a robot arm (RobotModel) against itself and named obstacles (the
+// table, known parts), with FCL. Used to check every motion along its whole path before it
+// runs, and by the planner.
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "planning/robot_model.h"
+#include "world/pose.h"
+
+namespace costar::planning {
+
+/// What touches what, for a reason a user can read.
+struct Contact {
+  std::string robot_link;
+  std::string other;  // an obstacle's name, or another robot link
+  std::string str() const { return robot_link + " would touch " + other; }
+};
+
+struct CollisionOptions {
+  /// Robot shapes are inflated by this much (m) so that tracking errors keep a margin.
+  double padding = 0.01;
+  /// Largest joint step (rad) between the configurations checked along a segment.
+  double resolution = 0.01;
+};
+
+class CollisionWorld {
+ public:
+  /// `base_in_world`: where the robot's base frame is. The robot model must outlive this.
+  /// Self-collision pairs that touch at `reference` configurations (e.g. home) or are
+  /// adjacent in the chain are not checked, like MoveIt's set-up assistant does.
+  CollisionWorld(const RobotModel& robot, const world::Pose& base_in_world, CollisionOptions options = {},
+                 const std::vector<Eigen::VectorXd>& reference = {});
+  ~CollisionWorld();
+  CollisionWorld(const CollisionWorld&) = delete;
+  CollisionWorld& operator=(const CollisionWorld&) = delete;
+
+  /// Adds or replaces a box obstacle (full side lengths) at a pose in the world.
+  void setBox(const std::string& name, const world::Pose& pose, const Eigen::Vector3d& size);
+  void remove(const std::string& name);
+  /// Removes every obstacle whose name starts with `prefix`.
+  void removeAll(const std::string& prefix = "");
+  std::vector<std::string> obstacleNames() const;
+
+  /// Lets `robot_link` touch `obstacle` (e.g. the fingers and the part being grasped).
+  void allow(const std::string& robot_link, const std::string& obstacle);
+  void disallowAll();
+
+  /// The first contact of the robot at `q`, or nullopt when it is free.
+  std::optional<Contact> check(const Eigen::VectorXd& q) const;
+  /// Checks the straight joint-space segment from `from` to `to` at `options.resolution`.
+  std::optional<Contact> checkSegment(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
+
+  const RobotModel& robot() const { return robot_; }
+  const CollisionOptions& options() const { return options_; }
+  /// Number of configurations checked so far (for benchmarks).
+  std::uint64_t checks() const { return checks_; }
+
+ private:
+  struct Impl;
+  const RobotModel& robot_;
+  CollisionOptions options_;
+  std::unique_ptr<Impl> impl_;
+  mutable std::uint64_t checks_ = 0;
+};
+
+}  // namespace costar::planning

@@ -1,0 +1,108 @@
+#include "planning/planner.h"
+
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/geometric/PathSimplifier.h>
+#include <ompl/geometric/SimpleSetup.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/util/Console.h>
+#include <ompl/util/RandomNumbers.h>
+
+#include <chrono>
+#include <mutex>
+
+namespace costar::planning {
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+namespace {
+
+std::mutex g_ompl_mutex;  // OMPL's seed is global
+
+}  // namespace
+
+PlanResult planPath(const CollisionWorld& world, const Eigen::VectorXd& start, const Eigen::VectorXd& goal,
+                    const PlannerOptions& options) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  PlanResult result;
+  const auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  };
+  if (const auto contact = world.check(start)) {
+    result.failure = "the arm is in collision where it starts: " + contact->str();
+    return result;
+  }
+  if (const auto contact = world.check(goal)) {
+    result.failure = "the goal is in collision: " + contact->str();
+    return result;
+  }
+  if (!world.checkSegment(start, goal)) {
+    result.path = {start, goal};
+    result.planning_seconds = elapsed();
+    return result;
+  }
+
+  std::lock_guard lock(g_ompl_mutex);
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  ompl::RNG::setSeed(options.seed == 0 ? 1 : options.seed);
+  const auto dof = static_cast<unsigned>(start.size());
+  auto space = std::make_shared<ob::RealVectorStateSpace>(dof);
+  ob::RealVectorBounds bounds(dof);
+  const RobotModel& robot = world.robot();
+  for (unsigned j = 0; j < dof; ++j) {
+    bounds.setLow(j, std::max(robot.lowerLimits()[j], std::min(start[j], goal[j]) - options.joint_range));
+    bounds.setHigh(j, std::min(robot.upperLimits()[j], std::max(start[j], goal[j]) + options.joint_range));
+  }
+  space->setBounds(bounds);
+  og::SimpleSetup setup(space);
+  Eigen::VectorXd q(dof);
+  setup.setStateValidityChecker([&world, &q, dof](const ob::State* state) {
+    const auto* values = state->as<ob::RealVectorStateSpace::StateType>()->values;
+    for (unsigned j = 0; j < dof; ++j) {
+      q[j] = values[j];
+    }
+    return !world.check(q).has_value();
+  });
+  // Check motions at the collision world's joint resolution.
+  setup.getSpaceInformation()->setStateValidityCheckingResolution(world.options().resolution /
+                                                                  space->getMaximumExtent());
+  ob::ScopedState<> from(space);
+  ob::ScopedState<> to(space);
+  for (unsigned j = 0; j < dof; ++j) {
+    from[j] = start[j];
+    to[j] = goal[j];
+  }
+  setup.setStartAndGoalStates(from, to);
+  setup.setPlanner(std::make_shared<og::RRTConnect>(setup.getSpaceInformation()));
+  const ob::PlannerStatus status = setup.solve(options.time_limit_s);
+  if (status != ob::PlannerStatus::EXACT_SOLUTION) {
+    result.failure = "no collision-free path found within " + std::to_string(options.time_limit_s) +
+                     " s (the straight motion would hit: " + world.checkSegment(start, goal)->str() + ")";
+    result.planning_seconds = elapsed();
+    return result;
+  }
+  og::PathGeometric& path = setup.getSolutionPath();
+  og::PathSimplifier simplifier(setup.getSpaceInformation());
+  simplifier.shortcutPath(path);
+  simplifier.reduceVertices(path);
+  for (std::size_t i = 0; i < path.getStateCount(); ++i) {
+    const auto* values = path.getState(i)->as<ob::RealVectorStateSpace::StateType>()->values;
+    Eigen::VectorXd waypoint(dof);
+    for (unsigned j = 0; j < dof; ++j) {
+      waypoint[j] = values[j];
+    }
+    result.path.push_back(waypoint);
+  }
+  // OMPL checks motions discretely; confirm every segment at our resolution.
+  for (std::size_t i = 1; i < result.path.size(); ++i) {
+    if (const auto contact = world.checkSegment(result.path[i - 1], result.path[i])) {
+      result.path.clear();
+      result.failure = "the planned path failed its final check: " + contact->str();
+      break;
+    }
+  }
+  result.planning_seconds = elapsed();
+  return result;
+}
+
+}  // namespace costar::planning

@@ -1,0 +1,217 @@
+#include "planning/robot_model.h"
+
+#include <urdf_parser/urdf_parser.h>
+#include <kdl/chain.hpp>
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainiksolverpos_lma.hpp>
+#include <kdl/tree.hpp>
+#include <kdl_parser/kdl_parser.hpp>
+
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+namespace costar::planning {
+
+namespace {
+
+world::Pose toPose(const KDL::Frame& frame) {
+  world::Pose pose = world::Pose::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      pose.linear()(r, c) = frame.M(r, c);
+    }
+    pose.translation()[r] = frame.p[r];
+  }
+  return pose;
+}
+
+KDL::Frame toFrame(const world::Pose& pose) {
+  const auto& r = pose.linear();
+  const auto& t = pose.translation();
+  return KDL::Frame(KDL::Rotation(r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2)),
+                    KDL::Vector(t.x(), t.y(), t.z()));
+}
+
+world::Pose toPose(const urdf::Pose& origin) {
+  world::Pose pose = world::Pose::Identity();
+  pose.translation() = Eigen::Vector3d(origin.position.x, origin.position.y, origin.position.z);
+  pose.linear() = Eigen::Quaterniond(origin.rotation.w, origin.rotation.x, origin.rotation.y, origin.rotation.z)
+                      .normalized()
+                      .toRotationMatrix();
+  return pose;
+}
+
+}  // namespace
+
+struct RobotModel::Impl {
+  KDL::Chain chain;
+  std::unique_ptr<KDL::ChainFkSolverPos_recursive> fk;
+  std::unique_ptr<KDL::ChainIkSolverPos_LMA> ik;
+  std::vector<std::string> joint_names;
+  Eigen::VectorXd lower, upper, velocity;
+  std::vector<LinkGeometry> links;
+  std::vector<int> link_segment;  // KDL segment index whose tip is the link (-1: the base)
+  std::vector<int> link_parent;   // index in links of the parent link with geometry, or -1
+  mutable KDL::JntArray scratch;
+  mutable KDL::Frame scratch_frame;
+};
+
+RobotModel::RobotModel(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+RobotModel::RobotModel(RobotModel&&) noexcept = default;
+RobotModel& RobotModel::operator=(RobotModel&&) noexcept = default;
+RobotModel::~RobotModel() = default;
+
+RobotModel RobotModel::fromUrdf(const std::filesystem::path& path, const std::string& base_link,
+                                const std::string& tip_link) {
+  std::ifstream stream(path);
+  if (!stream) {
+    throw std::runtime_error("cannot open URDF '" + path.string() + "'");
+  }
+  std::stringstream text;
+  text << stream.rdbuf();
+  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(text.str());
+  if (!model) {
+    throw std::runtime_error("URDF '" + path.string() + "' cannot be parsed");
+  }
+  KDL::Tree tree;
+  if (!kdl_parser::treeFromString(text.str(), tree)) {
+    throw std::runtime_error("kdl_parser cannot build a tree from '" + path.string() + "'");
+  }
+  auto impl = std::make_unique<Impl>();
+  if (!tree.getChain(base_link, tip_link, impl->chain)) {
+    throw std::runtime_error("URDF '" + path.string() + "' has no chain from '" + base_link + "' to '" + tip_link +
+                             "'");
+  }
+  const unsigned joints = impl->chain.getNrOfJoints();
+  impl->lower.resize(joints);
+  impl->upper.resize(joints);
+  impl->velocity.resize(joints);
+  // Links along the chain, base first, with their collision shapes and joint limits.
+  std::vector<std::pair<std::string, int>> chain_links{{base_link, -1}};
+  for (unsigned i = 0; i < impl->chain.getNrOfSegments(); ++i) {
+    const KDL::Segment& segment = impl->chain.getSegment(i);
+    chain_links.emplace_back(segment.getName(), static_cast<int>(i));
+    if (segment.getJoint().getType() != KDL::Joint::None) {
+      const auto joint = model->getJoint(segment.getJoint().getName());
+      const std::size_t index = impl->joint_names.size();
+      impl->joint_names.push_back(segment.getJoint().getName());
+      if (!joint || !joint->limits) {
+        throw std::runtime_error("URDF '" + path.string() + "': joint '" + segment.getJoint().getName() +
+                                 "' has no limits");
+      }
+      impl->lower[index] = joint->limits->lower;
+      impl->upper[index] = joint->limits->upper;
+      impl->velocity[index] = joint->limits->velocity;
+    }
+  }
+  int previous = -1;
+  for (const auto& [link_name, segment] : chain_links) {
+    const auto link = model->getLink(link_name);
+    if (!link) {
+      continue;
+    }
+    LinkGeometry geometry{link_name, {}};
+    for (const auto& collision : link->collision_array) {
+      if (!collision || !collision->geometry) {
+        continue;
+      }
+      CollisionShape shape;
+      shape.origin = toPose(collision->origin);
+      switch (collision->geometry->type) {
+        case urdf::Geometry::BOX: {
+          const auto* box = static_cast<const urdf::Box*>(collision->geometry.get());
+          shape.kind = CollisionShape::Kind::kBox;
+          shape.size = Eigen::Vector3d(box->dim.x, box->dim.y, box->dim.z);
+          break;
+        }
+        case urdf::Geometry::CYLINDER: {
+          const auto* cylinder = static_cast<const urdf::Cylinder*>(collision->geometry.get());
+          shape.kind = CollisionShape::Kind::kCylinder;
+          shape.size = Eigen::Vector3d(cylinder->radius, cylinder->length, 0);
+          break;
+        }
+        case urdf::Geometry::SPHERE: {
+          const auto* sphere = static_cast<const urdf::Sphere*>(collision->geometry.get());
+          shape.kind = CollisionShape::Kind::kSphere;
+          shape.size = Eigen::Vector3d(sphere->radius, 0, 0);
+          break;
+        }
+        default:
+          throw std::runtime_error("URDF '" + path.string() + "': link '" + link_name +
+                                   "' has a collision mesh; only boxes, cylinders and spheres are supported");
+      }
+      geometry.shapes.push_back(shape);
+    }
+    if (!geometry.shapes.empty()) {
+      impl->links.push_back(std::move(geometry));
+      impl->link_segment.push_back(segment);
+      impl->link_parent.push_back(previous);
+      previous = static_cast<int>(impl->links.size()) - 1;
+    }
+  }
+  impl->fk = std::make_unique<KDL::ChainFkSolverPos_recursive>(impl->chain);
+  impl->ik = std::make_unique<KDL::ChainIkSolverPos_LMA>(impl->chain, 1e-6, 500);
+  impl->scratch.resize(joints);
+  return RobotModel(std::move(impl));
+}
+
+std::size_t RobotModel::dof() const { return impl_->joint_names.size(); }
+const std::vector<std::string>& RobotModel::jointNames() const { return impl_->joint_names; }
+const Eigen::VectorXd& RobotModel::lowerLimits() const { return impl_->lower; }
+const Eigen::VectorXd& RobotModel::upperLimits() const { return impl_->upper; }
+const Eigen::VectorXd& RobotModel::velocityLimits() const { return impl_->velocity; }
+const std::vector<LinkGeometry>& RobotModel::links() const { return impl_->links; }
+
+world::Pose RobotModel::forward(const Eigen::VectorXd& q) const {
+  impl_->scratch.data = q;
+  impl_->fk->JntToCart(impl_->scratch, impl_->scratch_frame);
+  return toPose(impl_->scratch_frame);
+}
+
+void RobotModel::linkPoses(const Eigen::VectorXd& q, std::vector<world::Pose>& poses) const {
+  impl_->scratch.data = q;
+  poses.resize(impl_->links.size());
+  for (std::size_t i = 0; i < impl_->links.size(); ++i) {
+    const int segment = impl_->link_segment[i];
+    if (segment < 0) {
+      poses[i] = world::Pose::Identity();
+    } else {
+      impl_->fk->JntToCart(impl_->scratch, impl_->scratch_frame, segment + 1);
+      poses[i] = toPose(impl_->scratch_frame);
+    }
+  }
+}
+
+bool RobotModel::adjacent(std::size_t a, std::size_t b) const {
+  return impl_->link_parent[a] == static_cast<int>(b) || impl_->link_parent[b] == static_cast<int>(a);
+}
+
+std::optional<Eigen::VectorXd> RobotModel::inverse(const world::Pose& target, const Eigen::VectorXd& seed, int restarts,
+                                                   std::uint64_t random_seed) const {
+  const KDL::Frame goal = toFrame(target);
+  std::mt19937_64 random(random_seed);
+  KDL::JntArray start(static_cast<unsigned>(dof()));
+  KDL::JntArray result(static_cast<unsigned>(dof()));
+  for (int attempt = 0; attempt <= restarts; ++attempt) {
+    if (attempt == 0) {
+      start.data = seed;
+    } else {
+      for (std::size_t j = 0; j < dof(); ++j) {
+        std::uniform_real_distribution<double> angle(std::max(impl_->lower[j], -M_PI), std::min(impl_->upper[j], M_PI));
+        start(j) = angle(random);
+      }
+    }
+    if (impl_->ik->CartToJnt(start, goal, result) >= 0) {
+      const Eigen::VectorXd q = result.data;
+      if ((q.array() >= impl_->lower.array()).all() && (q.array() <= impl_->upper.array()).all()) {
+        return q;
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace costar::planning

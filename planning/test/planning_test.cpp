@@ -1,0 +1,173 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/paths.h"
+#include "planning/collision_world.h"
+#include "planning/planner.h"
+#include "planning/robot_model.h"
+
+namespace costar::planning {
+namespace {
+
+RobotModel ur5() { return RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp"); }
+
+/// Independent standard-DH model of the UR5 with the 0.14 m tool centre point.
+world::Pose dhForward(const Eigen::VectorXd& q) {
+  const double d[6] = {0.089159, 0, 0, 0.10915, 0.09465, 0.0823};
+  const double a[6] = {0, -0.425, -0.39225, 0, 0, 0};
+  const double alpha[6] = {M_PI / 2, 0, 0, M_PI / 2, -M_PI / 2, 0};
+  world::Pose pose = world::Pose::Identity();
+  for (int i = 0; i < 6; ++i) {
+    pose = pose * Eigen::AngleAxisd(q[i], Eigen::Vector3d::UnitZ()) * Eigen::Translation3d(a[i], 0, d[i]) *
+           Eigen::AngleAxisd(alpha[i], Eigen::Vector3d::UnitX());
+  }
+  return pose * Eigen::Translation3d(0, 0, 0.14);
+}
+
+Eigen::VectorXd joints(std::initializer_list<double> values) {
+  Eigen::VectorXd q(static_cast<Eigen::Index>(values.size()));
+  std::copy(values.begin(), values.end(), q.data());
+  return q;
+}
+
+const Eigen::VectorXd kHome = joints({0.0, -2.3, 1.9, -M_PI / 2 + 0.4, -M_PI / 2, 0.0});
+// The robot's base is turned 180 degrees about z in the workcell.
+const world::Pose kBaseInWorld(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
+
+TEST(RobotModel, TheUrdfChainMatchesTheDhModel) {
+  const RobotModel robot = ur5();
+  ASSERT_EQ(robot.dof(), 6u);
+  EXPECT_EQ(robot.jointNames().front(), "shoulder_pan_joint");
+  EXPECT_NEAR(robot.upperLimits()[0], 2 * M_PI, 1e-6);
+  EXPECT_NEAR(robot.velocityLimits()[5], M_PI, 1e-6);
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI);
+  for (int trial = 0; trial < 1000; ++trial) {
+    Eigen::VectorXd q(6);
+    for (int j = 0; j < 6; ++j) {
+      q[j] = angle(random);
+    }
+    const world::Pose expected = dhForward(q);
+    const world::Pose actual = robot.forward(q);
+    EXPECT_LT((actual.translation() - expected.translation()).norm(), 1e-9);
+    EXPECT_LT(world::rotationAngle(actual, expected), 1e-9);
+  }
+  EXPECT_EQ(robot.links().size(), 8u);  // base, shoulder, upper arm, forearm, 3 wrists, tool
+}
+
+TEST(RobotModel, NumericInverseKinematicsReachesReachablePoses) {
+  const RobotModel robot = ur5();
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI);
+  int solved = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    Eigen::VectorXd q(6);
+    for (int j = 0; j < 6; ++j) {
+      q[j] = angle(random);
+    }
+    const world::Pose target = robot.forward(q);
+    if (const auto solution = robot.inverse(target, Eigen::VectorXd::Zero(6), 10, trial)) {
+      ++solved;
+      EXPECT_LT((robot.forward(*solution).translation() - target.translation()).norm(), 1e-5);
+    }
+  }
+  EXPECT_GE(solved, 48);
+}
+
+class Collisions : public ::testing::Test {
+ protected:
+  Collisions() : robot(ur5()), world(robot, kBaseInWorld, {}, {kHome}) {
+    // The table: top at z = 0.
+    world.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
+    world.allow("base_link", "table");  // the robot stands on it
+  }
+  RobotModel robot;
+  CollisionWorld world;
+};
+
+TEST_F(Collisions, HomeIsFreeAndTheTableIsHitBelowIt) {
+  EXPECT_FALSE(world.check(kHome).has_value());
+  // Shoulder lowered until the tool reaches into the table.
+  Eigen::VectorXd down = kHome;
+  down[1] = -1.2;
+  const auto contact = world.check(down);
+  ASSERT_TRUE(contact.has_value());
+  EXPECT_EQ(contact->other, "table");
+  EXPECT_NE(contact->str().find("would touch table"), std::string::npos);
+}
+
+TEST_F(Collisions, SelfCollisionsAreFound) {
+  // Elbow folded in: the tool comes down onto the shoulder.
+  Eigen::VectorXd folded = kHome;
+  folded[2] = 2.4;
+  const auto contact = world.check(folded);
+  ASSERT_TRUE(contact.has_value());
+  EXPECT_EQ(contact->str(), "shoulder_link would touch tool0");
+}
+
+TEST_F(Collisions, AllowedContactsAreIgnoredAndObstaclesCanBeRemoved) {
+  const world::Pose tcp = kBaseInWorld * robot.forward(kHome);
+  world.setBox("part_1", tcp, {0.05, 0.05, 0.05});
+  ASSERT_TRUE(world.check(kHome).has_value());
+  EXPECT_EQ(world.check(kHome)->other, "part_1");
+  world.allow("tool0", "part_1");
+  EXPECT_FALSE(world.check(kHome).has_value());
+  world.disallowAll();
+  world.allow("base_link", "table");
+  world.removeAll("part_");
+  EXPECT_FALSE(world.check(kHome).has_value());
+}
+
+/// The tool over the table at 25 cm, swung to the left or right by the shoulder pan.
+Eigen::VectorXd swung(double pan) { return joints({pan, -2.0, 2.0, -M_PI / 2, -M_PI / 2, 0.0}); }
+
+/// A 24 cm post that the tool passes over at pan 0 (its TCP at (0.31, 0.109, 0.25)).
+void addPost(CollisionWorld& world) {
+  world.setBox("post", world::Pose(Eigen::Translation3d(0.31, 0.11, 0.12)), {0.04, 0.04, 0.24});
+}
+
+TEST_F(Collisions, SegmentsAreCheckedAlongTheirWholeLength) {
+  const Eigen::VectorXd left = swung(1.2);
+  const Eigen::VectorXd right = swung(-1.2);
+  EXPECT_FALSE(world.checkSegment(left, right).has_value());
+  addPost(world);
+  EXPECT_FALSE(world.check(left).has_value());
+  EXPECT_FALSE(world.check(right).has_value());
+  const auto contact = world.checkSegment(left, right);
+  ASSERT_TRUE(contact.has_value());
+  EXPECT_EQ(contact->other, "post");
+}
+
+TEST_F(Collisions, ThePlannerFindsAWayAroundAnObstacleThatBlocksTheStraightMotion) {
+  const Eigen::VectorXd left = swung(1.2);
+  const Eigen::VectorXd right = swung(-1.2);
+  addPost(world);
+  const PlanResult plan = planPath(world, left, right, {.time_limit_s = 5.0, .seed = 7});
+  ASSERT_TRUE(plan.ok()) << plan.failure;
+  EXPECT_GT(plan.path.size(), 2u);
+  EXPECT_TRUE(plan.path.front().isApprox(left));
+  EXPECT_TRUE(plan.path.back().isApprox(right));
+  for (std::size_t i = 1; i < plan.path.size(); ++i) {
+    EXPECT_FALSE(world.checkSegment(plan.path[i - 1], plan.path[i]).has_value());
+  }
+  // The same seed gives the same plan.
+  const PlanResult again = planPath(world, left, right, {.time_limit_s = 5.0, .seed = 7});
+  ASSERT_EQ(again.path.size(), plan.path.size());
+  for (std::size_t i = 0; i < plan.path.size(); ++i) {
+    EXPECT_TRUE(again.path[i].isApprox(plan.path[i], 1e-12));
+  }
+}
+
+TEST_F(Collisions, ThePlannerSaysWhyWhenTheGoalIsInCollision) {
+  Eigen::VectorXd down = kHome;
+  down[1] = -1.2;
+  const PlanResult plan = planPath(world, kHome, down);
+  EXPECT_FALSE(plan.ok());
+  EXPECT_NE(plan.failure.find("the goal is in collision"), std::string::npos) << plan.failure;
+  EXPECT_NE(plan.failure.find("table"), std::string::npos);
+  EXPECT_EQ(planPath(world, kHome, kHome).path.size(), 2u);  // nothing to plan
+}
+
+}  // namespace
+}  // namespace costar::planning
