@@ -1,0 +1,52 @@
+// The hot paths allocate nothing: the array overload of the inverse kinematics,
+// inverseNearest(), and sampling a trajectory. Counted, not timed.
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "arm/trajectory.h"
+#include "arm/ur5_kinematics.h"
+#include "bench/alloc_counter.h"
+
+namespace costar::arm {
+namespace {
+
+TEST(ArmAllocation, NoneInInverseKinematics) {
+  const Ur5Kinematics kinematics;
+  std::mt19937_64 random(21);
+  std::uniform_real_distribution<double> angle(-3.0, 3.0);
+  std::vector<world::Pose> poses;
+  for (int k = 0; k < 100; ++k) {
+    JointVector q;
+    for (double& value : q) {
+      value = angle(random);
+    }
+    poses.push_back(kinematics.forward(q));
+  }
+  std::array<JointVector, Ur5Kinematics::kMaxSolutions> solutions;
+  int total = 0;
+  const JointLimits limits = JointLimits::ur5();
+  const std::uint64_t before = bench::allocations();
+  for (const world::Pose& pose : poses) {
+    total += kinematics.inverse(pose, solutions);
+    total += kinematics.inverseNearest(pose, JointVector{}, &limits).has_value();
+  }
+  EXPECT_EQ(bench::allocations() - before, 0u);
+  EXPECT_GT(total, 100);
+}
+
+TEST(ArmAllocation, NoneWhenSampling) {
+  const JointTrajectory trajectory = JointTrajectory::alongPath(
+      {{0, 0, 0, 0, 0, 0}, {1, 0.5, 0, 0, 0, 0}, {1, 1, 1, 0, 0, 0}}, JointLimits::ur5(), 0.8);
+  double sum = 0.0;
+  const std::uint64_t before = bench::allocations();
+  for (Duration t(0); t <= trajectory.duration(); t += std::chrono::microseconds(100)) {
+    sum += trajectory.sample(t).position[0];
+  }
+  EXPECT_EQ(bench::allocations() - before, 0u);
+  EXPECT_GT(sum, 0.0);
+}
+
+}  // namespace
+}  // namespace costar::arm
