@@ -84,9 +84,32 @@ void printDiagnostics(const bt::PlanError& error) {
   std::cerr << error.diagnostics().size() << " problem(s); nothing was run.\n";
 }
 
+/// Options that choose and set up the workcell, shared by the plan commands.
+void addWorkcellOptions(CLI::App* command, workcell::WorkcellOptions& options) {
+  std::string known;
+  for (const auto& info : workcell::knownWorkcells()) {
+    known += (known.empty() ? "" : ", ") + info.name;
+  }
+  command->add_option("-w,--workcell", options.name, "workcell to run on: " + known)->capture_default_str();
+  command->add_option("--scene", options.scene, "simulated workcells: scene file (default sim/scenes/assembly.json)")
+      ->check(CLI::ExistingFile);
+  command->add_option("--seed", options.seed, "simulated workcells: seed of part placement and sensor noise");
+  command->add_option("--waypoints", options.waypoints,
+                      "waypoint file (default " + workcell::defaultWaypointFile("<workcell>").string() + ")");
+}
+
+std::unique_ptr<workcell::Workcell> openWorkcell(const workcell::WorkcellOptions& options) {
+  try {
+    return workcell::makeWorkcell(options);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return nullptr;
+  }
+}
+
 struct RunOptions {
   std::string plan;
-  std::string workcell = "test";
+  workcell::WorkcellOptions workcell;
   std::string trace;
   double rate_hz = 100.0;
   double time_limit_s = 0.0;
@@ -95,11 +118,8 @@ struct RunOptions {
 };
 
 int runPlan(const RunOptions& options) {
-  std::unique_ptr<workcell::Workcell> cell;
-  try {
-    cell = workcell::makeWorkcell(options.workcell);
-  } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
+  const std::unique_ptr<workcell::Workcell> cell = openWorkcell(options.workcell);
+  if (!cell) {
     return kExitInvalid;
   }
   std::optional<bt::Tree> tree;
@@ -126,8 +146,8 @@ int runPlan(const RunOptions& options) {
   if (!options.quiet) {
     console.emplace(*tree, cell->nodes(), options.all_nodes, colors);
     tree->addObserver(&*console);
-    std::printf("costar: running %s (tree '%s', %zu nodes) on workcell '%s' at %.0f Hz\n", options.plan.c_str(),
-                tree->mainTreeId().c_str(), tree->nodes().size(), cell->name().c_str(), options.rate_hz);
+    std::printf("costar: running %s (tree '%s', %zu nodes) at %.0f Hz on %s\n", options.plan.c_str(),
+                tree->mainTreeId().c_str(), tree->nodes().size(), options.rate_hz, cell->description().c_str());
   }
 
   bt::ExecutorOptions executor_options;
@@ -164,9 +184,9 @@ int runPlan(const RunOptions& options) {
   return kExitFailure;
 }
 
-int validatePlan(const std::string& path, const std::string& workcell_name) {
+int validatePlan(const std::string& path, const workcell::WorkcellOptions& workcell_options) {
   try {
-    const auto cell = workcell::makeWorkcell(workcell_name);
+    const auto cell = workcell::makeWorkcell(workcell_options);
     const bt::Plan plan = bt::loadPlan(path);
     const auto diagnostics = bt::validatePlan(plan, cell->nodes());
     if (!diagnostics.empty()) {
@@ -211,12 +231,10 @@ nlohmann::json nodesJson(const bt::NodeRegistry& registry) {
   return nodes;
 }
 
-int writeNodes(const std::string& workcell_name, const std::string& format, bool all, const std::string& out) {
-  std::unique_ptr<workcell::Workcell> cell;
-  try {
-    cell = workcell::makeWorkcell(workcell_name);
-  } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
+int writeNodes(const workcell::WorkcellOptions& workcell_options, const std::string& format, bool all,
+               const std::string& out) {
+  const std::unique_ptr<workcell::Workcell> cell = openWorkcell(workcell_options);
+  if (!cell) {
     return kExitInvalid;
   }
   const std::string text = format == "json" ? nodesJson(cell->nodes()).dump(2) + "\n"
@@ -236,8 +254,7 @@ void addPlanCommands(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<RunOptions>();
   CLI::App* run = app.add_subcommand("run", "Run a task plan (BehaviorTree.CPP v4 XML) on a workcell");
   run->add_option("plan", options->plan, "plan file")->required()->check(CLI::ExistingFile);
-  run->add_option("-w,--workcell", options->workcell, "workcell to run on (see `costar workcells`)")
-      ->capture_default_str();
+  addWorkcellOptions(run, options->workcell);
   run->add_option("--trace", options->trace, "write every status transition to FILE as JSON lines");
   run->add_option("--rate", options->rate_hz, "ticks per second of clock time")
       ->check(CLI::Range(0.1, 10000.0))
@@ -252,20 +269,19 @@ void addPlanCommands(CLI::App& app, int& exit_code) {
   run->callback([options, &exit_code] { exit_code = runPlan(*options); });
 
   auto validate_plan = std::make_shared<std::string>();
-  auto validate_workcell = std::make_shared<std::string>("test");
+  auto validate_workcell = std::make_shared<workcell::WorkcellOptions>();
   CLI::App* validate = app.add_subcommand("validate", "Check a plan without running it");
   validate->add_option("plan", *validate_plan, "plan file")->required()->check(CLI::ExistingFile);
-  validate->add_option("-w,--workcell", *validate_workcell, "workcell whose operations the plan may use")
-      ->capture_default_str();
+  addWorkcellOptions(validate, *validate_workcell);
   validate->footer("Exit code: 0 valid, 2 invalid (each problem is printed as file:line: message).");
   validate->callback([=, &exit_code] { exit_code = validatePlan(*validate_plan, *validate_workcell); });
 
-  auto nodes_workcell = std::make_shared<std::string>("test");
+  auto nodes_workcell = std::make_shared<workcell::WorkcellOptions>();
   auto nodes_format = std::make_shared<std::string>("xml");
   auto nodes_all = std::make_shared<bool>(false);
   auto nodes_out = std::make_shared<std::string>();
   CLI::App* nodes = app.add_subcommand("nodes", "Write the TreeNodesModel of every node type (for Groot2)");
-  nodes->add_option("-w,--workcell", *nodes_workcell, "workcell whose operations to list")->capture_default_str();
+  addWorkcellOptions(nodes, *nodes_workcell);
   nodes->add_option("--format", *nodes_format, "xml (TreeNodesModel) or json")
       ->check(CLI::IsMember({"xml", "json"}))
       ->capture_default_str();

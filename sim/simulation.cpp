@@ -241,9 +241,9 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   }
   // Textures and meshes named in the model are files in sim/models.
   const std::string models = (root / "sim" / "models").string();
-  replaceMarker(xml, "<compiler angle=\"radian\" autolimits=\"true\"/>",
-                "<compiler angle=\"radian\" autolimits=\"true\" texturedir=\"" + models + "\" meshdir=\"" + models +
-                    "\"/>");
+  replaceMarker(
+      xml, "<compiler angle=\"radian\" autolimits=\"true\"/>",
+      "<compiler angle=\"radian\" autolimits=\"true\" texturedir=\"" + models + "\" meshdir=\"" + models + "\"/>");
   replaceMarker(xml, "<!--PART_ASSETS-->", assets);
   replaceMarker(xml, "<!--PARTS-->", bodies);
 
@@ -388,6 +388,8 @@ FingerState Simulation::fingers() const {
 }
 
 void Simulation::commandFingers(double opening, double speed, double force) {
+  // A new command starts from where the fingers are (not from the previous setpoint).
+  impl_->finger_command = impl_->data->qpos[impl_->finger_qpos];
   impl_->finger_target = std::clamp(opening, 0.0, kMaxOpening) / 2.0;
   impl_->finger_speed = std::max(speed, 1e-3) / 2.0;
   const double limit = std::clamp(force, 1.0, 200.0);

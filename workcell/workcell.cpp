@@ -2,13 +2,31 @@
 
 #include <stdexcept>
 
+#include <cstdlib>
+
 #include "testing/test_components.h"
+#include "workcell/ur5_sim_workcell.h"
 
 namespace costar::workcell {
 
 Workcell::Workcell(std::unique_ptr<Clock> clock) : clock_(std::move(clock)), nodes_(bt::builtinRegistry()) {}
 
-void Workcell::registerNodes() { components_.registerNodes(nodes_); }
+void Workcell::registerNodes() {
+  components_.registerNodes(nodes_);
+  components_.refreshWorld();
+}
+
+std::filesystem::path defaultWaypointFile(const std::string& workcell) {
+  std::filesystem::path state;
+  if (const char* xdg = std::getenv("XDG_STATE_HOME"); xdg != nullptr && *xdg != '\0') {
+    state = xdg;
+  } else if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0') {
+    state = std::filesystem::path(home) / ".local" / "state";
+  } else {
+    state = ".";
+  }
+  return state / "costar" / workcell / "waypoints.json";
+}
 
 namespace {
 
@@ -40,10 +58,16 @@ class TestWorkcell final : public Workcell {
 }  // namespace
 
 std::vector<WorkcellInfo> knownWorkcells() {
-  return {{"test", TestWorkcell().description()}, {"none", BareWorkcell().description()}};
+  return {{"ur5-sim", "simulated UR5 with a 2-finger gripper and an RGB-D camera (MuJoCo); the default"},
+          {"test", TestWorkcell().description()},
+          {"none", BareWorkcell().description()}};
 }
 
-std::unique_ptr<Workcell> makeWorkcell(const std::string& name) {
+std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& options) {
+  const std::string& name = options.name;
+  if (name == "ur5-sim") {
+    return makeUr5SimWorkcell(options);
+  }
   if (name == "test") {
     return std::make_unique<TestWorkcell>();
   }

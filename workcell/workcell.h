@@ -1,8 +1,12 @@
 #pragma once
 // A workcell: the clock, the components and the node types a plan runs against. The CLI
-// and the server pick one by name ("test" today; the simulated UR5 cell comes with sim/).
+// and the server pick one by name: "ur5-sim" (the simulated UR5 cell, the default robot),
+// "test" (test components without a robot), "none" (built-in nodes only).
 
+#include <cstdint>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,7 +14,24 @@
 #include "component/registry.h"
 #include "core/clock.h"
 
+namespace costar::sim {
+class Simulation;
+}
+
 namespace costar::workcell {
+
+struct WorkcellOptions {
+  std::string name = "ur5-sim";
+  /// Simulated cells: the scene file (default: sim/scenes/assembly.json).
+  std::filesystem::path scene;
+  /// Simulated cells: seed of the part placement and of the sensor noise (default: the scene's).
+  std::optional<std::uint64_t> seed;
+  /// Where taught waypoints are kept (default: $XDG_STATE_HOME or ~/.local/state, then
+  /// costar/<workcell>/waypoints.json). Empty string in `memory_only` mode.
+  std::filesystem::path waypoints;
+  /// Keep waypoints in memory only (tests).
+  bool memory_only = false;
+};
 
 class Workcell {
  public:
@@ -28,10 +49,13 @@ class Workcell {
 
   /// Called by the executor before every tick: refreshes the world state.
   virtual void beforeTick() { components_.refreshWorld(); }
+  /// The simulation behind a simulated cell (for tests, pictures and the trial judge, never
+  /// for plans), or nullptr.
+  virtual sim::Simulation* simulation() { return nullptr; }
 
  protected:
   explicit Workcell(std::unique_ptr<Clock> clock);
-  /// Call once the components are added: registers their node types.
+  /// Call once the components are added: registers their node types and reads their state.
   void registerNodes();
 
  private:
@@ -48,7 +72,11 @@ struct WorkcellInfo {
 /// The workcells this build knows.
 std::vector<WorkcellInfo> knownWorkcells();
 
-/// Creates a workcell by name. @throws std::invalid_argument naming the known ones.
-std::unique_ptr<Workcell> makeWorkcell(const std::string& name);
+/// Creates a workcell. @throws std::invalid_argument naming the known ones for an unknown
+/// name; std::runtime_error when its files cannot be read.
+std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& options);
+
+/// Where waypoints of `workcell` are kept by default.
+std::filesystem::path defaultWaypointFile(const std::string& workcell);
 
 }  // namespace costar::workcell

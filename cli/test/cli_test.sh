@@ -28,16 +28,16 @@ check "invalid plan"        2 'cli/test/fixtures/invalid.xml:6: parameter .num_c
   -- "$costar" run cli/test/fixtures/invalid.xml -w test
 check "invalid: every problem" 2 'invalid.xml:8: unknown node .Mvoe. \(did you mean .Move.\?\)' \
   -- "$costar" validate cli/test/fixtures/invalid.xml -w test
-check "validate ok"         0 'valid for workcell .test.' -- "$costar" validate examples/test_workcell/demo.xml
+check "validate ok"         0 'valid for workcell .test.' -- "$costar" validate examples/test_workcell/demo.xml -w test
 check "unknown workcell"    2 "unknown workcell 'moon'" -- "$costar" run examples/test_workcell/demo.xml -w moon
 check "missing file"        2 'File does not exist' -- "$costar" run nope.xml
 check "nodes model"         0 '<Action ID="Move">' -- "$costar" nodes -w test
 check "nodes json"          0 '"category": "knowledge"' -- "$costar" nodes -w test --format json
 check "help"                0 'Exit code: 0 SUCCESS' -- "$costar" run --help
-check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml --time-limit 0.1
+check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit 0.1
 
 # The trace has one JSON object per transition, with reasons on failures.
-"$costar" run examples/test_workcell/fails.xml -q --trace "$tmp/trace.jsonl" >/dev/null
+"$costar" run examples/test_workcell/fails.xml -w test -q --trace "$tmp/trace.jsonl" >/dev/null
 if python3 - "$tmp/trace.jsonl" <<'PY'
 import json, sys
 lines = [json.loads(l) for l in open(sys.argv[1])]

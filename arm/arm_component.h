@@ -1,0 +1,113 @@
+#pragma once
+// The UR5 as a CoSTAR component implementing the abstract Arm (Teach, Move, `endpoint`).
+//
+// Every motion is planned before it runs: the goal is solved with the closed-form IK (the
+// nearest solution within the joint limits whose configuration is collision-free), the
+// straight joint-space motion is collision-checked along its whole length against the table,
+// known parts and the arm itself, and when it would collide OMPL plans a way around. The
+// motion is then time-parameterized within the joint velocity and acceleration limits
+// (scaled by the operation's speed) and handed to the driver. Cancelling decelerates along
+// the path within the acceleration limits and stops.
+//
+// Operations: Move(waypoint), Home, MoveToPose(pose, frame), MoveRelative(offset, frame)
+// (a straight Cartesian line), Teach(waypoint, kind, frame), JogJoint(joint, degrees),
+// JogCartesian(axis, amount, frame).
+// Symbols: endpoint (the tool centre point in the world), arm_joints, and every waypoint
+// (pose waypoints as frames relative to their frame, joint waypoints as configurations).
+// Predicates: arm_moving, at_waypoint(w).
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "arm/arm_driver.h"
+#include "arm/trajectory.h"
+#include "arm/ur5_kinematics.h"
+#include "arm/waypoints.h"
+#include "component/component.h"
+#include "planning/collision_world.h"
+#include "planning/planner.h"
+
+namespace costar::arm {
+
+struct ArmConfig {
+  std::string name = "arm";
+  std::string type = "UR5";
+  /// Where the robot's base frame is in the world.
+  world::Pose base_in_world = world::Pose::Identity();
+  /// The tool centre point in the flange frame (between the gripper's finger pads).
+  world::Pose tcp_in_flange = world::Pose(Eigen::Translation3d(0, 0, 0.14));
+  JointLimits limits = JointLimits::ur5();
+  JointVector home{};
+  /// Default speed of motions: a fraction of the joint velocity and acceleration limits.
+  double default_speed = 0.5;
+  /// at_waypoint tolerances.
+  double at_waypoint_distance = 0.005;            // m
+  double at_waypoint_angle = 2.0 * M_PI / 180.0;  // rad
+  double at_waypoint_joints = 0.01;               // rad
+  /// A motion fails if the arm is not within this of its goal this long after the end.
+  double arrival_tolerance = 0.005;  // rad
+  Duration settle_time = std::chrono::seconds(1);
+  /// Cartesian straight lines are followed through IK points this far apart.
+  double line_step = 0.005;  // m
+  planning::PlannerOptions planner;
+};
+
+/// A motion ready to run, or why there is none.
+struct MotionPlan {
+  std::shared_ptr<const JointTrajectory> trajectory;
+  JointVector goal{};
+  std::string failure;
+  bool ok() const { return trajectory != nullptr; }
+};
+
+class ArmComponent final : public component::LocalComponent {
+ public:
+  /// Pose in the world of a frame symbol ("table_center", a part...), or nullopt if unknown.
+  using FrameLookup = std::function<std::optional<world::Pose>(const std::string&)>;
+
+  /// Everything passed by reference must outlive the component. `collisions` holds the
+  /// table and known parts; the component adds nothing to it.
+  ArmComponent(ArmDriver& driver, const Clock& clock, planning::CollisionWorld& collisions, WaypointStore& waypoints,
+               FrameLookup frames, ArmConfig config);
+
+  const component::ComponentDescription& description() const override { return description_; }
+  world::Report report() const override;
+
+  // --- planning, for other components (SmartMove) and the operations -------------------
+  /// The tool centre point's pose in the world now (from the joint encoders).
+  world::Pose endpoint() const;
+  /// Every IK solution for a TCP pose in the world, each expressed nearest to `seed` within
+  /// the joint limits, nearest first.
+  std::vector<JointVector> solutions(const world::Pose& tcp_in_world, const JointVector& seed) const;
+  /// A collision-free motion from the current configuration to the TCP pose.
+  MotionPlan planToPose(const world::Pose& tcp_in_world, double speed) const;
+  MotionPlan planToJoints(const JointVector& goal, double speed) const;
+  /// A straight Cartesian line of the TCP from where it is to `tcp_in_world`.
+  MotionPlan planLine(const world::Pose& tcp_in_world, double speed) const;
+
+  const ArmConfig& config() const { return config_; }
+  const Ur5Kinematics& kinematics() const { return kinematics_; }
+
+ private:
+  std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
+                                                     const component::ParamMap& params) override;
+  std::unique_ptr<component::RunningOperation> run(MotionPlan plan, const std::string& what);
+  std::optional<world::Pose> waypointPose(const Waypoint& waypoint) const;
+  world::Pose flangeInBase(const world::Pose& tcp_in_world) const;
+  MotionPlan timed(std::vector<JointVector> path, double speed) const;
+  Eigen::VectorXd toEigen(const JointVector& q) const;
+
+  component::ComponentDescription description_;
+  ArmDriver& driver_;
+  const Clock& clock_;
+  planning::CollisionWorld& collisions_;
+  WaypointStore& waypoints_;
+  FrameLookup frames_;
+  ArmConfig config_;
+  Ur5Kinematics kinematics_;
+  std::shared_ptr<std::uint64_t> motion_counter_ = std::make_shared<std::uint64_t>(0);
+};
+
+}  // namespace costar::arm

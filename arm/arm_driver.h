@@ -1,0 +1,27 @@
+#pragma once
+// What an arm's controller (a UR's RTDE interface, or the simulator) offers the Arm
+// component: the joint state from its encoders, and execution of timed joint trajectories.
+
+#include <memory>
+
+#include "arm/joints.h"
+#include "arm/trajectory.h"
+#include "core/clock.h"
+
+namespace costar::arm {
+
+struct ArmState {
+  JointVector position{};
+  JointVector velocity{};
+};
+
+class ArmDriver {
+ public:
+  virtual ~ArmDriver() = default;
+  virtual ArmState read() const = 0;
+  /// Follows `trajectory` from clock time `start` (its sample at t - start), replacing any
+  /// trajectory being followed; after its end, holds its final position.
+  virtual void execute(std::shared_ptr<const JointTrajectory> trajectory, TimePoint start) = 0;
+};
+
+}  // namespace costar::arm

@@ -1,0 +1,246 @@
+// The Arm component against an ideal driver (it follows trajectories exactly): what it plans,
+// what it refuses and why, cancelling, teaching, waypoints and predicates.
+
+#include "arm/arm_component.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "component/registry.h"
+#include "core/paths.h"
+
+namespace costar::arm {
+namespace {
+
+using component::OperationResult;
+using component::OperationState;
+
+/// Follows the trajectory exactly; records every trajectory it is given.
+class IdealDriver final : public ArmDriver {
+ public:
+  IdealDriver(const SimClock& clock, JointVector start) : clock_(clock), hold_(start) {}
+  ArmState read() const override {
+    if (!trajectory_) {
+      return {hold_, {}};
+    }
+    const TrajectoryPoint point = trajectory_->sample(clock_.now() - start_);
+    return {point.position, point.velocity};
+  }
+  void execute(std::shared_ptr<const JointTrajectory> trajectory, TimePoint start) override {
+    trajectory_ = std::move(trajectory);
+    start_ = start;
+    executed.push_back(trajectory_);
+  }
+  std::vector<std::shared_ptr<const JointTrajectory>> executed;
+
+ private:
+  const SimClock& clock_;
+  JointVector hold_;
+  std::shared_ptr<const JointTrajectory> trajectory_;
+  TimePoint start_{};
+};
+
+const JointVector kHome = {0.0, -2.3, 1.9, -M_PI / 2 + 0.4, -M_PI / 2, 0.0};
+const world::Pose kBase(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
+
+/// A TCP pose in the world, pointing straight down.
+world::Pose toolDown(double x, double y, double z, double yaw = 0.0) {
+  return world::poseFromXyzRpy(x, y, z, M_PI, 0, yaw);
+}
+
+class ArmTest : public ::testing::Test {
+ protected:
+  ArmTest()
+      : robot(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp")),
+        collisions(robot, kBase, {.padding = 0.005}, {Eigen::Map<const Eigen::VectorXd>(kHome.data(), 6)}),
+        driver(clock, kHome),
+        arm(
+            driver, clock, collisions, waypoints, [this](const std::string& frame) { return frame_lookup(frame); },
+            config()) {
+    collisions.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
+    collisions.allow("base_link", "table");
+  }
+
+  static ArmConfig config() {
+    ArmConfig c;
+    c.base_in_world = kBase;
+    c.home = kHome;
+    return c;
+  }
+
+  std::optional<world::Pose> frame_lookup(const std::string& frame) {
+    if (frame == "table_center") {
+      return world::Pose(Eigen::Translation3d(0.5, 0, 0));
+    }
+    return std::nullopt;
+  }
+
+  OperationResult run(const std::string& operation, component::ParamMap params = {}) {
+    for (const auto& spec : arm.description().operation(operation)->params) {
+      if (spec.default_value) {
+        params.try_emplace(spec.name, *spec.default_value);
+      }
+    }
+    const auto id = arm.start(operation, params);
+    for (int tick = 0; tick < 3000; ++tick) {
+      const OperationResult result = arm.poll(id);
+      if (result.state != OperationState::kRunning) {
+        return result;
+      }
+      clock.advanceBy(std::chrono::milliseconds(10));
+    }
+    return OperationResult::failure("test: did not finish");
+  }
+
+  bool holds(const std::string& predicate, std::vector<std::string> args = {}) {
+    world::WorldState state;
+    state.update("arm", arm.report());
+    return state.holds(predicate, args);
+  }
+
+  SimClock clock;
+  planning::RobotModel robot;
+  planning::CollisionWorld collisions;
+  WaypointStore waypoints;
+  IdealDriver driver;
+  ArmComponent arm;
+};
+
+TEST_F(ArmTest, ImplementsTheAbstractArmAndReportsItsEndpoint) {
+  component::ComponentRegistry registry;
+  EXPECT_NO_THROW(registry.add(std::shared_ptr<component::Component>(&arm, [](auto*) {})));
+  world::WorldState state;
+  state.update("arm", arm.report());
+  ASSERT_NE(state.symbol("endpoint"), nullptr);
+  EXPECT_LT((state.symbol("endpoint")->frame()->pose.translation() - Eigen::Vector3d(0.1728, 0.1092, 0.3365)).norm(),
+            1e-3);
+  EXPECT_FALSE(holds("arm_moving"));
+}
+
+TEST_F(ArmTest, MovesToATaughtPoseWaypointWithinTheLimitsAndSaysWhereItIs) {
+  waypoints.put({"above_part", Waypoint::Kind::kPose, {}, toolDown(0.5, -0.2, 0.15), "world"});
+  const OperationResult result = run("Move", {{"waypoint", "above_part"}, {"speed", 0.5}});
+  ASSERT_EQ(result.state, OperationState::kSuccess) << result.reason;
+  EXPECT_TRUE(arm.endpoint().isApprox(toolDown(0.5, -0.2, 0.15), 1e-6));
+  EXPECT_TRUE(holds("at_waypoint", {"above_part"}));
+  ASSERT_EQ(driver.executed.size(), 1u);
+  EXPECT_NO_THROW(driver.executed[0]->validate(JointLimits::ur5()));
+  // Moving took time on the clock, within the speed-scaled limits.
+  EXPECT_GT(toSeconds(driver.executed[0]->duration()), 0.5);
+}
+
+TEST_F(ArmTest, WaypointsRelativeToAFrameFollowTheFrame) {
+  waypoints.put({"over_center", Waypoint::Kind::kPose, {}, toolDown(0.0, 0.0, 0.2), "table_center"});
+  ASSERT_EQ(run("Move", {{"waypoint", "over_center"}}).state, OperationState::kSuccess);
+  EXPECT_TRUE(arm.endpoint().translation().isApprox(Eigen::Vector3d(0.5, 0, 0.2), 1e-6));
+  waypoints.put({"on_the_moon", Waypoint::Kind::kPose, {}, toolDown(0, 0, 0.2), "moon"});
+  EXPECT_EQ(run("Move", {{"waypoint", "on_the_moon"}}).reason,
+            "waypoint 'on_the_moon' is relative to 'moon', which is not known now");
+}
+
+TEST_F(ArmTest, UnknownUnreachableAndCollidingGoalsFailWithAReason) {
+  EXPECT_EQ(run("Move", {{"waypoint", "nowhere"}}).reason, "unknown waypoint 'nowhere' (none taught yet)");
+  waypoints.put({"far", Waypoint::Kind::kPose, {}, toolDown(1.5, 0, 0.2), "world"});
+  EXPECT_EQ(run("Move", {{"waypoint", "far"}}).reason,
+            "Move to 'far': the pose is out of reach (no inverse kinematics solution within the joint limits)");
+  waypoints.put({"in_table", Waypoint::Kind::kPose, {}, toolDown(0.5, 0, -0.05), "world"});
+  const OperationResult in_table = run("Move", {{"waypoint", "in_table"}});
+  EXPECT_EQ(in_table.state, OperationState::kFailure);
+  EXPECT_NE(in_table.reason.find("would touch table"), std::string::npos) << in_table.reason;
+  EXPECT_TRUE(driver.executed.empty());  // nothing moved
+}
+
+TEST_F(ArmTest, ABlockedStraightMotionIsPlannedAroundTheObstacle) {
+  const JointVector left = {1.2, -2.0, 2.0, -M_PI / 2, -M_PI / 2, 0.0};
+  const JointVector right = {-1.2, -2.0, 2.0, -M_PI / 2, -M_PI / 2, 0.0};
+  waypoints.put({"left", Waypoint::Kind::kJoints, left, {}, "world"});
+  waypoints.put({"right", Waypoint::Kind::kJoints, right, {}, "world"});
+  ASSERT_EQ(run("Move", {{"waypoint", "left"}}).state, OperationState::kSuccess);
+  collisions.setBox("post", world::Pose(Eigen::Translation3d(0.31, 0.11, 0.12)), {0.04, 0.04, 0.24});
+  const OperationResult result = run("Move", {{"waypoint", "right"}});
+  ASSERT_EQ(result.state, OperationState::kSuccess) << result.reason;
+  EXPECT_TRUE(holds("at_waypoint", {"right"}));
+  // The executed motion never touched the post: sample it finely.
+  const auto& trajectory = *driver.executed.back();
+  for (Duration t{}; t <= trajectory.duration(); t += std::chrono::milliseconds(5)) {
+    const JointVector q = trajectory.sample(t).position;
+    EXPECT_FALSE(collisions.check(Eigen::Map<const Eigen::VectorXd>(q.data(), 6)).has_value());
+  }
+}
+
+TEST_F(ArmTest, MoveRelativeFollowsAStraightLine) {
+  waypoints.put({"start", Waypoint::Kind::kPose, {}, toolDown(0.45, 0.1, 0.1), "world"});
+  ASSERT_EQ(run("Move", {{"waypoint", "start"}}).state, OperationState::kSuccess);
+  const OperationResult result =
+      run("MoveRelative", {{"offset", *component::parseValue(component::ValueType::kPose, "0;0;0.15")}});
+  ASSERT_EQ(result.state, OperationState::kSuccess) << result.reason;
+  EXPECT_TRUE(arm.endpoint().isApprox(toolDown(0.45, 0.1, 0.25), 1e-6));
+  // Every sample of the motion is on the vertical line through the start.
+  const auto& trajectory = *driver.executed.back();
+  Ur5Kinematics kinematics;
+  for (Duration t{}; t <= trajectory.duration(); t += std::chrono::milliseconds(10)) {
+    const world::Pose tcp = kBase * kinematics.forward(trajectory.sample(t).position) * ArmConfig{}.tcp_in_flange;
+    EXPECT_LT((tcp.translation().head<2>() - Eigen::Vector2d(0.45, 0.1)).norm(), 1e-3);
+  }
+  const OperationResult into_table =
+      run("MoveRelative", {{"offset", *component::parseValue(component::ValueType::kPose, "0;0;-0.3")}});
+  EXPECT_NE(into_table.reason.find("the straight line is blocked"), std::string::npos) << into_table.reason;
+}
+
+TEST_F(ArmTest, CancellingDeceleratesAlongThePathAndStops) {
+  const auto id = arm.start("Home", {{"speed", 1.0}});
+  waypoints.put({"far_side", Waypoint::Kind::kJoints, {2.5, -2.0, 2.0, -M_PI / 2, -M_PI / 2, 0.0}, {}, "world"});
+  const auto move = arm.start("Move", {{"waypoint", "far_side"}, {"speed", 1.0}});
+  EXPECT_EQ(arm.poll(id).state, OperationState::kFailure);  // the second motion took over
+  clock.advanceBy(std::chrono::milliseconds(500));
+  EXPECT_TRUE(holds("arm_moving"));
+  arm.cancel(move);
+  ASSERT_EQ(driver.executed.size(), 3u);
+  const auto& stop = *driver.executed.back();
+  EXPECT_LT(toSeconds(stop.duration()), 1.0);
+  clock.advanceBy(stop.duration() + std::chrono::milliseconds(10));
+  EXPECT_FALSE(holds("arm_moving"));
+}
+
+TEST_F(ArmTest, TeachSavesWhereTheArmIsAndJoggingMovesIt) {
+  ASSERT_EQ(run("JogJoint", {{"joint", 1}, {"degrees", 20.0}}).state, OperationState::kSuccess);
+  EXPECT_NEAR(driver.read().position[0], 20.0 * M_PI / 180.0, 1e-9);
+  ASSERT_EQ(run("Teach", {{"waypoint", "taught"}, {"kind", "pose"}, {"frame", "table_center"}}).state,
+            OperationState::kSuccess);
+  ASSERT_EQ(run("Teach", {{"waypoint", "taught_joints"}, {"kind", "joints"}, {"frame", "world"}}).state,
+            OperationState::kSuccess);
+  EXPECT_TRUE(holds("at_waypoint", {"taught"}));
+  EXPECT_TRUE(holds("at_waypoint", {"taught_joints"}));
+  ASSERT_EQ(run("JogCartesian", {{"axis", "z"}, {"amount", 0.05}, {"frame", "world"}}).state, OperationState::kSuccess);
+  EXPECT_FALSE(holds("at_waypoint", {"taught"}));
+  ASSERT_EQ(run("Move", {{"waypoint", "taught"}}).state, OperationState::kSuccess);
+  EXPECT_TRUE(holds("at_waypoint", {"taught"}));
+  EXPECT_EQ(run("Teach", {{"waypoint", "bad name!"}, {"kind", "pose"}, {"frame", "world"}}).reason,
+            "cannot save the waypoint: waypoint name 'bad name!' may contain only letters, digits, '_' and '-'");
+}
+
+TEST(WaypointStore, PersistsAtomicallyAndReloads) {
+  const auto file = std::filesystem::temp_directory_path() / "costar_waypoints_test" / "waypoints.json";
+  std::filesystem::remove_all(file.parent_path());
+  {
+    WaypointStore store(file);
+    store.put({"a", Waypoint::Kind::kJoints, {1, 2, 3, 4, 5, 6}, {}, "world"});
+    store.put({"b", Waypoint::Kind::kPose, {}, world::poseFromXyzRpy(0.1, 0.2, 0.3, 0.4, 0.5, 0.6), "table_center"});
+    store.rename("a", "c");
+    EXPECT_THROW(store.rename("zzz", "d"), std::invalid_argument);
+    EXPECT_THROW(store.rename("b", "c"), std::invalid_argument);
+  }
+  WaypointStore reloaded(file);
+  ASSERT_EQ(reloaded.all().size(), 2u);
+  EXPECT_EQ(reloaded.find("c")->joints[5], 6.0);
+  EXPECT_EQ(reloaded.find("b")->frame, "table_center");
+  EXPECT_TRUE(reloaded.find("b")->pose.isApprox(world::poseFromXyzRpy(0.1, 0.2, 0.3, 0.4, 0.5, 0.6), 1e-12));
+  EXPECT_TRUE(reloaded.remove("c"));
+  EXPECT_FALSE(reloaded.remove("c"));
+  EXPECT_EQ(WaypointStore(file).all().size(), 1u);
+  std::filesystem::remove_all(file.parent_path());
+}
+
+}  // namespace
+}  // namespace costar::arm

@@ -1,0 +1,141 @@
+// The simulated UR5 workcell end to end: the MuJoCo model and the URDF agree, the blind
+// pick-and-place example really moves the part (judged from the simulator's true state), and
+// random motions never leave the joint limits or touch the table.
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "bt/builder.h"
+#include "bt/executor.h"
+#include "bt/plan_xml.h"
+#include "core/paths.h"
+#include "planning/robot_model.h"
+#include "sim/simulation.h"
+#include "workcell/workcell.h"
+
+namespace costar::workcell {
+namespace {
+
+const world::Pose kBaseInWorld(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
+
+TEST(Ur5SimWorkcell, TheMujocoModelAndTheUrdfAgreeToATenthOfAMillimetre) {
+  const auto robot = planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp");
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI);
+  const sim::Scene empty = sim::parseScene(R"({"parts": []})", "empty");
+  for (int trial = 0; trial < 10; ++trial) {
+    sim::ArmJoints q{};
+    for (double& joint : q) {
+      joint = angle(random);
+    }
+    sim::SimulationOptions options;
+    options.initial_arm = q;
+    options.settle_seconds = 0.0;
+    const auto simulation = sim::Simulation::create(empty, options);
+    const world::Pose urdf = kBaseInWorld * robot.forward(Eigen::Map<const Eigen::VectorXd>(q.data(), 6));
+    const world::Pose mujoco = simulation->tcpPose();
+    EXPECT_LT((urdf.translation() - mujoco.translation()).norm(), 1e-4) << "trial " << trial;
+    EXPECT_LT(world::rotationAngle(urdf, mujoco), 1e-5);
+  }
+}
+
+bt::RunResult runPlan(Workcell& cell, const std::filesystem::path& plan) {
+  bt::Tree tree = bt::buildTree(bt::loadPlan(plan), cell.nodes(), cell.clock());
+  bt::Executor executor(tree, cell.clock(), {.time_limit = std::chrono::seconds(120)});
+  executor.setBeforeTick([&cell] { cell.beforeTick(); });
+  return executor.run();
+}
+
+TEST(Ur5SimWorkcell, TheBlindPickAndPlaceMovesThePartWhereTheWaypointsSay) {
+  const auto waypoints = std::filesystem::temp_directory_path() / "costar_blind_waypoints.json";
+  std::filesystem::copy_file(dataRoot() / "examples/ur5/blind_waypoints.json", waypoints,
+                             std::filesystem::copy_options::overwrite_existing);
+  const auto cell =
+      makeWorkcell({.name = "ur5-sim", .scene = dataRoot() / "sim/scenes/one_node.json", .waypoints = waypoints});
+  const Eigen::Vector3d start = cell->simulation()->parts()[0].pose.translation();
+  ASSERT_LT((start - Eigen::Vector3d(0.45, -0.25, 0.025)).norm(), 0.002);
+
+  const bt::RunResult result = runPlan(*cell, dataRoot() / "examples/ur5/blind_pick_place.xml");
+  ASSERT_EQ(result.status, bt::Status::kSuccess) << result.failure_path << ": " << result.failure_reason;
+
+  // Judged from the simulator's true state: the node rests on the table at the place spot.
+  const sim::PartState node = cell->simulation()->parts()[0];
+  EXPECT_LT((node.pose.translation() - Eigen::Vector3d(0.45, 0.25, 0.025)).norm(), 0.01)
+      << node.pose.translation().transpose();
+  EXPECT_LT(node.linear_velocity.norm(), 0.01);
+  EXPECT_EQ(cell->simulation()->armTableContactSteps(), 0u);
+  std::filesystem::remove(waypoints);
+}
+
+TEST(Ur5SimWorkcell, RandomMotionsStayWithinTheLimitsAndNeverTouchTheTable) {
+  const auto cell =
+      makeWorkcell({.name = "ur5-sim", .scene = dataRoot() / "sim/scenes/one_node.json", .memory_only = true});
+  sim::Simulation& simulation = *cell->simulation();
+  std::mt19937 random(21);
+  std::uniform_real_distribution<double> x(0.0, 0.8);
+  std::uniform_real_distribution<double> y(-0.6, 0.6);
+  std::uniform_real_distribution<double> z(-0.1, 0.6);  // some goals are inside the table
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI);
+  int refused = 0;
+  int moved = 0;
+  double fastest = 0.0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const world::Pose goal =
+        world::poseFromXyzRpy(x(random), y(random), z(random), angle(random), angle(random) / 2, angle(random));
+    const std::string body = R"(<MoveToPose pose=")" + world::formatPose(goal) + R"(" speed="1.0"/>)";
+    const auto plan = bt::loadPlanText(
+        R"(<root BTCPP_format="4"><BehaviorTree ID="m">)" + body + "</BehaviorTree></root>", "random.xml");
+    bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
+    bt::Executor executor(tree, cell->clock());
+    executor.setBeforeTick([&] {
+      cell->beforeTick();
+      for (const double v : simulation.armVelocities()) {
+        fastest = std::max(fastest, std::abs(v));
+      }
+      for (const double q : simulation.armPositions()) {
+        EXPECT_LE(std::abs(q), 2 * M_PI + 1e-3);
+      }
+    });
+    const bt::RunResult result = executor.run();
+    if (result.status == bt::Status::kSuccess) {
+      ++moved;
+      EXPECT_LT((simulation.tcpPose().translation() - goal.translation()).norm(), 0.002);
+    } else {
+      ++refused;
+      EXPECT_FALSE(result.failure_reason.empty());
+    }
+  }
+  EXPECT_GT(moved, 5);
+  EXPECT_GT(refused, 5);
+  EXPECT_LE(fastest, M_PI * 1.02);  // joint speed limit (a little tracking overshoot allowed)
+  EXPECT_EQ(simulation.armTableContactSteps(), 0u);
+}
+
+TEST(Ur5SimWorkcell, StoppingARunDeceleratesTheArmToRest) {
+  const auto cell =
+      makeWorkcell({.name = "ur5-sim", .scene = dataRoot() / "sim/scenes/one_node.json", .memory_only = true});
+  const auto plan = bt::loadPlanText(
+      R"(<root BTCPP_format="4"><BehaviorTree ID="m"><Timeout msec="700"><MoveToPose pose="0.5;0.3;0.2;180;0;0" speed="1.0"/></Timeout></BehaviorTree></root>)",
+      "stop.xml");
+  bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
+  bt::Executor executor(tree, cell->clock());
+  executor.setBeforeTick([&] { cell->beforeTick(); });
+  const bt::RunResult result = executor.run();
+  ASSERT_EQ(result.status, bt::Status::kFailure);  // the Timeout halted the Move mid-motion
+  sim::Simulation& simulation = *cell->simulation();
+  double speed = 0;
+  for (const double v : simulation.armVelocities()) {
+    speed = std::max(speed, std::abs(v));
+  }
+  EXPECT_GT(speed, 0.05);  // still moving when halted ...
+  simulation.stepTo(simulation.time() + std::chrono::milliseconds(1500));
+  speed = 0;
+  for (const double v : simulation.armVelocities()) {
+    speed = std::max(speed, std::abs(v));
+  }
+  EXPECT_LT(speed, 0.01);  // ... and at rest soon after
+}
+
+}  // namespace
+}  // namespace costar::workcell

@@ -1,0 +1,107 @@
+#include "workcell/ur5_sim_workcell.h"
+
+#include "arm/arm_component.h"
+#include "core/paths.h"
+#include "gripper/parallel_gripper.h"
+#include "planning/collision_world.h"
+#include "sim/arm_driver.h"
+#include "sim/drivers.h"
+#include "sim/simulation.h"
+
+namespace costar::workcell {
+
+namespace {
+
+/// The workcell's fixed frames, as symbols: table_center (the workspace centre, on the table
+/// top; found from the ArUco marker when perception is set up) and the robot's base.
+class FixedFrames final : public component::LocalComponent {
+ public:
+  explicit FixedFrames(std::vector<std::pair<std::string, world::Pose>> frames) : frames_(std::move(frames)) {
+    description_.name = "workcell";
+    description_.type = "FixedFrames";
+    for (const auto& [name, pose] : frames_) {
+      description_.symbols.push_back({name, world::SymbolKind::kFrame, "a fixed frame of the workcell"});
+    }
+  }
+  const component::ComponentDescription& description() const override { return description_; }
+  world::Report report() const override {
+    world::Report report;
+    for (const auto& [name, pose] : frames_) {
+      report.symbols.push_back({name, "", {}, world::FrameValue{"world", pose}});
+    }
+    return report;
+  }
+
+ private:
+  std::unique_ptr<component::RunningOperation> begin(const std::string&, const component::ParamMap&) override {
+    return nullptr;  // no operations
+  }
+  component::ComponentDescription description_;
+  std::vector<std::pair<std::string, world::Pose>> frames_;
+};
+
+const world::Pose kBaseInWorld(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
+const world::Pose kTableCenter(Eigen::Translation3d(0.5, 0.0, 0.0));
+
+class Ur5SimWorkcell final : public Workcell {
+ public:
+  explicit Ur5SimWorkcell(const WorkcellOptions& options)
+      : Workcell(std::make_unique<SimClock>()),
+        scene_(sim::loadScene(options.scene.empty() ? dataRoot() / "sim/scenes/assembly.json" : options.scene)),
+        simulation_(sim::Simulation::create(scene_, simOptions(options))),
+        arm_driver_(*simulation_),
+        gripper_driver_(*simulation_),
+        camera_(*simulation_, options.seed.value_or(scene_.seed)),
+        robot_(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp")),
+        collisions_(robot_, kBaseInWorld, {.padding = 0.005, .resolution = 0.01},
+                    {toEigen(sim::Simulation::homeConfiguration())}),
+        waypoints_(options.memory_only
+                       ? std::filesystem::path()
+                       : (options.waypoints.empty() ? defaultWaypointFile("ur5-sim") : options.waypoints)) {
+    simulation_->attach(static_cast<SimClock&>(clock()));
+    collisions_.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
+    collisions_.allow("base_link", "table");  // the robot stands on it
+
+    arm::ArmConfig arm_config;
+    arm_config.base_in_world = kBaseInWorld;
+    arm_config.home = sim::Simulation::homeConfiguration();
+    components().add(std::make_shared<arm::ArmComponent>(
+        arm_driver_, clock(), collisions_, waypoints_,
+        [this](const std::string& frame) { return components().world().worldPose(frame); }, arm_config));
+    components().add(std::make_shared<gripper::ParallelGripper>(gripper_driver_, clock()));
+    components().add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
+        {"table_center", kTableCenter}, {"robot_base", kBaseInWorld}}));
+    registerNodes();
+  }
+
+  std::string name() const override { return "ur5-sim"; }
+  std::string description() const override {
+    return "simulated UR5 with a 2-finger gripper and an RGB-D camera (MuJoCo), scene '" + scene_.label + "'";
+  }
+  sim::Simulation* simulation() override { return simulation_.get(); }
+
+ private:
+  static sim::SimulationOptions simOptions(const WorkcellOptions& options) {
+    sim::SimulationOptions sim_options;
+    sim_options.placement_seed = options.seed;
+    return sim_options;
+  }
+  static Eigen::VectorXd toEigen(const sim::ArmJoints& q) { return Eigen::Map<const Eigen::VectorXd>(q.data(), 6); }
+
+  sim::Scene scene_;
+  std::unique_ptr<sim::Simulation> simulation_;
+  sim::SimArmDriver arm_driver_;
+  sim::SimGripperDriver gripper_driver_;
+  sim::SimRgbdCamera camera_;
+  planning::RobotModel robot_;
+  planning::CollisionWorld collisions_;
+  arm::WaypointStore waypoints_;
+};
+
+}  // namespace
+
+std::unique_ptr<Workcell> makeUr5SimWorkcell(const WorkcellOptions& options) {
+  return std::make_unique<Ur5SimWorkcell>(options);
+}
+
+}  // namespace costar::workcell
