@@ -148,6 +148,11 @@ ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::Coll
        "Saves where the arm is as a named waypoint.",
        {{"waypoint", ValueType::kString, "name for the waypoint", {}}, kind, frame},
        component::OperationKind::kKnowledge},
+      {"RenameWaypoint",
+       "Renames a taught waypoint.",
+       {waypoint, {"new_name", ValueType::kString, "the waypoint's new name", {}}},
+       component::OperationKind::kKnowledge},
+      {"DeleteWaypoint", "Forgets a taught waypoint.", {waypoint}, component::OperationKind::kKnowledge},
       {"JogJoint", "Turns one joint by a few degrees.", {joint, degrees, speed}},
       {"JogCartesian",
        "Moves the tool a little along or about one axis, in a straight line.",
@@ -413,6 +418,19 @@ std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::stri
       return finished(OperationResult::failure(std::string("cannot save the waypoint: ") + e.what()));
     }
     return finished(OperationResult::success({{"waypoint", waypoint.name}}));
+  }
+  if (operation == "RenameWaypoint" || operation == "DeleteWaypoint") {
+    const std::string name = params.at("waypoint").asString();
+    try {
+      if (operation == "RenameWaypoint") {
+        waypoints_.rename(name, params.at("new_name").asString());
+      } else if (!waypoints_.remove(name)) {
+        return finished(OperationResult::failure("unknown waypoint '" + name + "'"));
+      }
+    } catch (const std::exception& e) {
+      return finished(OperationResult::failure(e.what()));
+    }
+    return finished(OperationResult::success());
   }
   return finished(OperationResult::failure("unknown operation " + operation));
 }

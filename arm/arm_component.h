@@ -10,8 +10,8 @@
 // the path within the acceleration limits and stops.
 //
 // Operations: Move(waypoint), Home, MoveToPose(pose, frame), MoveRelative(offset, frame)
-// (a straight Cartesian line), Teach(waypoint, kind, frame), JogJoint(joint, degrees),
-// JogCartesian(axis, amount, frame).
+// (a straight Cartesian line), Teach(waypoint, kind, frame), RenameWaypoint, DeleteWaypoint,
+// JogJoint(joint, degrees), JogCartesian(axis, amount, frame).
 // Symbols: endpoint (the tool centre point in the world), arm_joints, and every waypoint
 // (pose waypoints as frames relative to their frame, joint waypoints as configurations).
 // Predicates: arm_moving, at_waypoint(w).

@@ -5,6 +5,7 @@
 #include "cli/perception_commands.h"
 #include "cli/plan_commands.h"
 #include "cli/sim_commands.h"
+#include "cli/teach_command.h"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
   costar::cli::addPlanCommands(app, exit_code);
   costar::cli::addSimCommands(app, exit_code);
   costar::cli::addPerceptionCommands(app, exit_code);
+  costar::cli::addTeachCommand(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

@@ -53,21 +53,22 @@ std::string format(double value) {
 
 std::string vec(const Eigen::Vector3d& v) { return format(v.x()) + " " + format(v.y()) + " " + format(v.z()); }
 
-/// MJCF for one part: a free body made of the class's boxes.
+/// MJCF for one part: a free body. Cameras see the class's boxes (visual geoms, massless, no
+/// contacts); contacts and mass come from one box around them (geom group 3, which renderers
+/// hide). The sockets matter to what a camera sees, not to how a part rests or is gripped.
 std::string partBody(const PartPlacement& part, const world::ObjectClass& object) {
-  double volume = 0.0;
-  for (const auto& box : object.boxes) {
-    volume += 8.0 * box.half_size.prod();
-  }
-  const double density = object.mass / volume;
+  const Eigen::AlignedBox3d bounds = object.bounds();
+  const Eigen::Vector3d half = bounds.sizes() / 2;
+  const double density = object.mass / (8.0 * half.prod());
   const Eigen::Quaterniond q(part.pose.linear());
   std::string body = "<body name=\"" + part.name + "\" pos=\"" + vec(part.pose.translation()) + "\" quat=\"" +
                      format(q.w()) + " " + format(q.x()) + " " + format(q.y()) + " " + format(q.z()) +
                      "\"><freejoint/>";
-  for (std::size_t i = 0; i < object.boxes.size(); ++i) {
-    const auto& box = object.boxes[i];
-    body += "<geom class=\"part\" type=\"box\" pos=\"" + vec(box.center) + "\" size=\"" + vec(box.half_size) +
-            "\" density=\"" + format(density) + "\" material=\"" + object.name + "_" + part.color + "\"/>";
+  body += "<geom class=\"part\" type=\"box\" group=\"3\" pos=\"" + vec(bounds.center()) + "\" size=\"" + vec(half) +
+          "\" density=\"" + format(density) + "\" rgba=\"0.5 0.5 0.5 0.3\"/>";
+  for (const auto& box : object.boxes) {
+    body += "<geom type=\"box\" contype=\"0\" conaffinity=\"0\" density=\"0\" pos=\"" + vec(box.center) + "\" size=\"" +
+            vec(box.half_size) + "\" material=\"" + object.name + "_" + part.color + "\"/>";
   }
   return body + "</body>\n";
 }

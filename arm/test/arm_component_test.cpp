@@ -216,6 +216,11 @@ TEST_F(ArmTest, TeachSavesWhereTheArmIsAndJoggingMovesIt) {
   EXPECT_FALSE(holds("at_waypoint", {"taught"}));
   ASSERT_EQ(run("Move", {{"waypoint", "taught"}}).state, OperationState::kSuccess);
   EXPECT_TRUE(holds("at_waypoint", {"taught"}));
+  ASSERT_EQ(run("RenameWaypoint", {{"waypoint", "taught"}, {"new_name", "renamed"}}).state, OperationState::kSuccess);
+  EXPECT_TRUE(holds("at_waypoint", {"renamed"}));
+  EXPECT_EQ(run("DeleteWaypoint", {{"waypoint", "taught"}}).reason, "unknown waypoint 'taught'");
+  ASSERT_EQ(run("DeleteWaypoint", {{"waypoint", "renamed"}}).state, OperationState::kSuccess);
+  EXPECT_FALSE(waypoints.find("renamed").has_value());
   EXPECT_EQ(run("Teach", {{"waypoint", "bad name!"}, {"kind", "pose"}, {"frame", "world"}}).reason,
             "cannot save the waypoint: waypoint name 'bad name!' may contain only letters, digits, '_' and '-'");
 }

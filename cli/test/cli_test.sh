@@ -36,6 +36,20 @@ check "nodes json"          0 '"category": "knowledge"' -- "$costar" nodes -w te
 check "help"                0 'Exit code: 0 SUCCESS' -- "$costar" run --help
 check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit 0.1
 
+# Teaching: jog, teach, move back, rename; waypoints persist in the file.
+printf 'jog z 0.05\nteach up\nhome\nmove up\nrename up lifted\nmove nowhere\nquit\n' |
+  "$costar" teach --scene sim/scenes/one_node.json --waypoints "$tmp/waypoints.json" >"$tmp/teach.out" 2>&1
+if [[ $(grep -c '^ok' "$tmp/teach.out") -eq 5 ]] && grep -q "failed: unknown waypoint 'nowhere' (known: lifted)" "$tmp/teach.out" &&
+   grep -q '"name": "lifted"' "$tmp/waypoints.json"; then
+  echo "ok   teach"
+else
+  echo "FAIL teach"; cat "$tmp/teach.out"; failures=$((failures + 1))
+fi
+
+# The blind pick-and-place on the simulated UR5.
+check "blind pick and place" 0 '^SUCCESS in' -- "$costar" run examples/ur5/blind_pick_place.xml -q \
+  --scene sim/scenes/one_node.json --waypoints examples/ur5/blind_waypoints.json
+
 # The trace has one JSON object per transition, with reasons on failures.
 "$costar" run examples/test_workcell/fails.xml -w test -q --trace "$tmp/trace.jsonl" >/dev/null
 if python3 - "$tmp/trace.jsonl" <<'PY'

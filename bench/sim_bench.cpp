@@ -1,0 +1,74 @@
+// How fast the simulated workcell runs: real-time factor of the physics (parts settled, arm
+// holding or moving), and the cost of one RGB-D frame (render + noise). Target: >= 20x real
+// time headless, camera frames included when asked. Figures: docs/BENCHMARKS.md.
+
+#include <benchmark/benchmark.h>
+
+#include "arm/trajectory.h"
+#include "core/paths.h"
+#include "sim/simulation.h"
+
+namespace costar::bench {
+namespace {
+
+std::unique_ptr<sim::Simulation> assembly() {
+  return sim::Simulation::create(sim::loadScene(dataRoot() / "sim/scenes/assembly.json"));
+}
+
+/// One simulated second per iteration; reports the real-time factor.
+void simulateSeconds(benchmark::State& state, sim::Simulation& simulation) {
+  for (auto _ : state) {
+    simulation.stepTo(simulation.time() + std::chrono::seconds(1));
+  }
+  state.counters["realtime_factor"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+void BM_PhysicsArmHolding(benchmark::State& state) {
+  const auto simulation = assembly();
+  simulateSeconds(state, *simulation);
+}
+BENCHMARK(BM_PhysicsArmHolding)->Unit(benchmark::kMillisecond);
+
+void BM_PhysicsArmMoving(benchmark::State& state) {
+  const auto simulation = assembly();
+  // Swing the arm back and forth over the table at full speed.
+  const arm::JointVector a = sim::Simulation::homeConfiguration();
+  arm::JointVector b = a;
+  b[0] = -1.5;
+  b[1] = -1.8;
+  const auto out =
+      std::make_shared<arm::JointTrajectory>(arm::JointTrajectory::pointToPoint(a, b, arm::JointLimits::ur5(), 1.0));
+  const auto back =
+      std::make_shared<arm::JointTrajectory>(arm::JointTrajectory::pointToPoint(b, a, arm::JointLimits::ur5(), 1.0));
+  const Duration period = out->duration() + back->duration();
+  simulation->setArmSetpointSource([&](TimePoint t) {
+    const Duration phase = Duration(t.time_since_epoch().count() % period.count());
+    const arm::TrajectoryPoint p = phase < out->duration() ? out->sample(phase) : back->sample(phase - out->duration());
+    return sim::ArmSetpoint{p.position, p.velocity, p.acceleration};
+  });
+  simulateSeconds(state, *simulation);
+}
+BENCHMARK(BM_PhysicsArmMoving)->Unit(benchmark::kMillisecond);
+
+void BM_CaptureRgbdFrame(benchmark::State& state) {
+  const auto simulation = assembly();
+  simulation->captureRgbd(0);  // the first frame compiles shaders
+  std::uint64_t seed = 1;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(simulation->captureRgbd(seed++).points.data());
+  }
+}
+BENCHMARK(BM_CaptureRgbdFrame)->Unit(benchmark::kMillisecond);
+
+void BM_LoadWorkcell(benchmark::State& state) {
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(assembly().get());
+  }
+}
+BENCHMARK(BM_LoadWorkcell)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace costar::bench
+
+BENCHMARK_MAIN();

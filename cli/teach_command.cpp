@@ -1,0 +1,215 @@
+#include "cli/teach_command.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "bt/builder.h"
+#include "bt/executor.h"
+#include "bt/plan_xml.h"
+#include "core/image.h"
+#include "sim/simulation.h"
+#include "workcell/workcell.h"
+
+namespace costar::cli {
+
+namespace {
+
+constexpr const char* kHelp = R"(commands:
+  where                               the tool's pose and the joint angles
+  list                                taught waypoints
+  jog joint N DEGREES                 turn joint N (1 = base ... 6 = wrist 3)
+  jog x|y|z METRES [tool]             move the tool in a straight line (world axes, or the tool's)
+  jog roll|pitch|yaw DEGREES [tool]   turn the tool about an axis
+  teach NAME [joints] [in FRAME]      save where the arm is: the tool's pose (relative to FRAME,
+                                      default world), or with 'joints' the joint angles
+  move NAME [SPEED]                   go to a waypoint (SPEED: 0.01 .. 1, default 0.5)
+  home                                go to the home configuration
+  rename OLD NEW | delete NAME        manage waypoints
+  open | close                        the gripper
+  snapshot FILE.png                   a picture of the cell (simulated cells)
+  help | quit
+)";
+
+std::string escape(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    out += c == '"'   ? std::string("&quot;")
+           : c == '&' ? std::string("&amp;")
+           : c == '<' ? std::string("&lt;")
+                      : std::string(1, c);
+  }
+  return out;
+}
+
+/// Runs one operation node (XML) to completion; prints the outcome.
+bool runNode(workcell::Workcell& cell, const std::string& node) {
+  try {
+    const bt::Plan plan =
+        bt::loadPlanText(R"(<root BTCPP_format="4"><BehaviorTree ID="teach">)" + node + "</BehaviorTree></root>",
+                         "command", {.follow_includes = false});
+    bt::Tree tree = bt::buildTree(plan, cell.nodes(), cell.clock());
+    bt::Executor executor(tree, cell.clock());
+    executor.setBeforeTick([&cell] { cell.beforeTick(); });
+    const bt::RunResult result = executor.run();
+    if (result.status == bt::Status::kSuccess) {
+      std::printf("ok (%.2f s)\n", toSeconds(result.elapsed));
+      return true;
+    }
+    std::printf("failed: %s\n", result.failure_reason.c_str());
+  } catch (const bt::PlanError& error) {
+    for (const auto& diagnostic : error.diagnostics()) {
+      std::printf("error: %s\n", diagnostic.message.c_str());
+    }
+  }
+  return false;
+}
+
+void printWhere(workcell::Workcell& cell) {
+  cell.beforeTick();
+  const auto& world = cell.components().world();
+  if (const auto* endpoint = world.symbol("endpoint"); endpoint != nullptr && endpoint->frame() != nullptr) {
+    const world::Pose& pose = endpoint->frame()->pose;
+    const Eigen::Vector3d rpy = world::rpyOf(pose.linear()) * 180.0 / M_PI;
+    std::printf("tool: x %.4f  y %.4f  z %.4f m   roll %.1f  pitch %.1f  yaw %.1f deg\n", pose.translation().x(),
+                pose.translation().y(), pose.translation().z(), rpy.x(), rpy.y(), rpy.z());
+  }
+  if (const auto* joints = world.symbol("arm_joints"); joints != nullptr && joints->joints() != nullptr) {
+    std::printf("joints (deg):");
+    for (const double q : joints->joints()->positions) {
+      std::printf(" %.1f", q * 180.0 / M_PI);
+    }
+    std::printf("\n");
+  }
+}
+
+void printWaypoints(workcell::Workcell& cell) {
+  cell.beforeTick();
+  int count = 0;
+  for (const world::Symbol* symbol : cell.components().world().symbols()) {
+    if (symbol->source != "arm" || symbol->name == "endpoint" || symbol->name == "arm_joints") {
+      continue;
+    }
+    ++count;
+    if (const auto* frame = symbol->frame()) {
+      const auto& p = frame->pose.translation();
+      std::printf("  %-20s pose in %s: %.4f %.4f %.4f\n", symbol->name.c_str(), frame->parent.c_str(), p.x(), p.y(),
+                  p.z());
+    } else {
+      std::printf("  %-20s joint configuration\n", symbol->name.c_str());
+    }
+  }
+  if (count == 0) {
+    std::printf("  (no waypoints taught yet)\n");
+  }
+}
+
+/// One command line; returns false to end the session.
+bool handle(workcell::Workcell& cell, const std::string& line) {
+  std::istringstream words(line);
+  std::vector<std::string> w;
+  for (std::string word; words >> word;) {
+    w.push_back(word);
+  }
+  if (w.empty() || w[0].starts_with("#")) {
+    return true;
+  }
+  const std::string& command = w[0];
+  if (command == "quit" || command == "exit") {
+    return false;
+  }
+  if (command == "help") {
+    std::printf("%s", kHelp);
+  } else if (command == "where") {
+    printWhere(cell);
+  } else if (command == "list") {
+    printWaypoints(cell);
+  } else if (command == "home") {
+    runNode(cell, "<Home/>");
+  } else if (command == "open" || command == "close") {
+    runNode(cell, command == "open" ? "<Open/>" : "<Close/>");
+  } else if (command == "jog" && w.size() >= 3 && w[1] == "joint" && w.size() == 4) {
+    runNode(cell, "<JogJoint joint=\"" + escape(w[2]) + "\" degrees=\"" + escape(w[3]) + "\"/>");
+  } else if (command == "jog" && w.size() >= 3) {
+    const std::string frame = w.size() > 3 && w[3] == "tool" ? "tool" : "world";
+    runNode(cell,
+            "<JogCartesian axis=\"" + escape(w[1]) + "\" amount=\"" + escape(w[2]) + "\" frame=\"" + frame + "\"/>");
+  } else if (command == "teach" && w.size() >= 2) {
+    std::string kind = "pose";
+    std::string frame = "world";
+    for (std::size_t i = 2; i < w.size(); ++i) {
+      if (w[i] == "joints") {
+        kind = "joints";
+      } else if (w[i] == "in" && i + 1 < w.size()) {
+        frame = w[++i];
+      }
+    }
+    runNode(cell, "<Teach waypoint=\"" + escape(w[1]) + "\" kind=\"" + kind + "\" frame=\"" + escape(frame) + "\"/>");
+  } else if (command == "move" && w.size() >= 2) {
+    const std::string speed = w.size() > 2 ? " speed=\"" + escape(w[2]) + "\"" : "";
+    runNode(cell, "<Move waypoint=\"" + escape(w[1]) + "\"" + speed + "/>");
+  } else if (command == "rename" && w.size() == 3) {
+    runNode(cell, "<RenameWaypoint waypoint=\"" + escape(w[1]) + "\" new_name=\"" + escape(w[2]) + "\"/>");
+  } else if (command == "delete" && w.size() == 2) {
+    runNode(cell, "<DeleteWaypoint waypoint=\"" + escape(w[1]) + "\"/>");
+  } else if (command == "snapshot" && w.size() == 2) {
+    if (cell.simulation() == nullptr) {
+      std::printf("failed: '%s' is not a simulated workcell\n", cell.name().c_str());
+    } else {
+      try {
+        writePng(w[1], cell.simulation()->renderImage("overview", 1280, 960));
+        std::printf("wrote %s\n", w[1].c_str());
+      } catch (const std::exception& e) {
+        std::printf("failed: %s\n", e.what());
+      }
+    }
+  } else {
+    std::printf("unknown or incomplete command '%s' (type 'help')\n", line.c_str());
+  }
+  return true;
+}
+
+}  // namespace
+
+void addTeachCommand(CLI::App& app, int& exit_code) {
+  auto options = std::make_shared<workcell::WorkcellOptions>();
+  CLI::App* teach = app.add_subcommand(
+      "teach", "Jog the arm and teach waypoints, interactively (commands from standard input; 'help' lists them)");
+  teach->add_option("-w,--workcell", options->name, "workcell")->capture_default_str();
+  teach->add_option("--scene", options->scene, "simulated workcells: scene file")->check(CLI::ExistingFile);
+  teach->add_option(
+      "--waypoints", options->waypoints,
+      "waypoint file to read and write (default " + workcell::defaultWaypointFile("<workcell>").string() + ")");
+  teach->footer(kHelp);
+  teach->callback([options, &exit_code] {
+    std::unique_ptr<workcell::Workcell> cell;
+    try {
+      cell = workcell::makeWorkcell(*options);
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      exit_code = 2;
+      return;
+    }
+    const bool interactive = ::isatty(STDIN_FILENO) != 0;
+    if (interactive) {
+      std::printf("costar teach on %s. Type 'help' for the commands.\n", cell->description().c_str());
+    }
+    std::string line;
+    while (true) {
+      if (interactive) {
+        std::printf("costar> ");
+        std::fflush(stdout);
+      }
+      if (!std::getline(std::cin, line) || !handle(*cell, line)) {
+        break;
+      }
+      std::fflush(stdout);
+    }
+    exit_code = 0;
+  });
+}
+
+}  // namespace costar::cli
