@@ -1,5 +1,7 @@
 #include "component/nodes.h"
 
+#include <algorithm>
+
 namespace costar::component {
 
 OperationNode::OperationNode(std::string id, std::string name, Component& component, ParamMap params,
@@ -61,11 +63,15 @@ PredicateCondition::PredicateCondition(std::string id, std::string name, const w
       predicate_(std::move(predicate)),
       args_(std::move(args)),
       expected_(expected) {
-  failure_text_ = world::predicateKey(predicate_, args_) + (expected_ ? " is false" : " is true");
+  wildcard_ = std::find(args_.begin(), args_.end(), world::WorldState::kWildcard) != args_.end();
+  const std::string key = world::predicateKey(predicate_, args_);
+  failure_text_ = wildcard_ ? (expected_ ? "no symbol satisfies " + key : "some symbol satisfies " + key)
+                            : key + (expected_ ? " is false" : " is true");
 }
 
 bt::Status PredicateCondition::onTick() {
-  if (world_.holds(predicate_, args_) == expected_) {
+  const bool holds = wildcard_ ? !world_.match(predicate_, args_).empty() : world_.holds(predicate_, args_);
+  if (holds == expected_) {
     return bt::Status::kSuccess;
   }
   return fail(failure_text_);

@@ -49,6 +49,7 @@ class PredicateCondition final : public bt::LeafNode {
   std::string predicate_;
   std::vector<std::string> args_;
   bool expected_;
+  bool wildcard_ = false;
   std::string failure_text_;
 };
 

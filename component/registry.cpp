@@ -145,14 +145,18 @@ void ComponentRegistry::registerNodes(bt::NodeRegistry& nodes) {
   }
   check.ports = {names.empty() ? bt::PortSpec::text("predicate", "predicate name")
                                : bt::PortSpec::choice("predicate", "predicate name", names, std::nullopt),
-                 bt::PortSpec::text("args", "arguments (symbol names), ';'-separated", ""),
+                 bt::PortSpec::text("args", "arguments (symbol names), ';'-separated; one may be ? (any symbol)", ""),
                  bt::PortSpec::boolean("expected", "the value that makes the condition succeed", "true")};
   check.check_instance = [this](const bt::NodeArgs& args, std::size_t) -> std::string {
     const auto it = predicates_.find(args.get("predicate"));
     if (it == predicates_.end()) {
       return {};
     }
-    const std::size_t count = parseValue(ValueType::kStringList, args.get("args"))->asList().size();
+    const auto list = parseValue(ValueType::kStringList, args.get("args"))->asList();
+    const std::size_t count = list.size();
+    if (std::count(list.begin(), list.end(), "?") > 1) {
+      return "only one argument may be the wildcard ?";
+    }
     if (count != it->second.arity) {
       return "predicate '" + it->first + "' takes " + std::to_string(it->second.arity) + " argument(s), " +
              std::to_string(count) + " given";

@@ -1,5 +1,8 @@
 #include "world/world_state.h"
 
+#include <algorithm>
+#include <stdexcept>
+
 namespace costar::world {
 
 const char* toString(SymbolKind kind) {
@@ -75,7 +78,49 @@ std::vector<const Symbol*> WorldState::symbols() const {
 
 bool WorldState::holds(std::string_view name, std::span<const std::string> args) const {
   const auto it = predicate_index_.find(predicateKey(name, args));
-  return it != predicate_index_.end() && it->second.first > 0 && it->second.second == 0;
+  if (it != predicate_index_.end()) {
+    return it->second.first > 0 && it->second.second == 0;
+  }
+  const auto evaluator = evaluators_.find(std::string(name));
+  return evaluator != evaluators_.end() && evaluator->second(*this, args);
+}
+
+void WorldState::setEvaluator(const std::string& predicate, PredicateEvaluator evaluator) {
+  evaluators_[predicate] = std::move(evaluator);
+}
+
+std::vector<std::string> WorldState::match(std::string_view name, std::span<const std::string> args) const {
+  const auto wildcard = std::find(args.begin(), args.end(), kWildcard);
+  if (wildcard == args.end()) {
+    return holds(name, args) ? std::vector<std::string>{""} : std::vector<std::string>{};
+  }
+  if (std::find(wildcard + 1, args.end(), kWildcard) != args.end()) {
+    throw std::invalid_argument("a predicate pattern may have one '?' only");
+  }
+  const auto position = static_cast<std::size_t>(wildcard - args.begin());
+  std::vector<std::string> candidates;
+  if (isDerived(name)) {
+    for (const auto& [symbol_name, symbol] : symbol_index_) {
+      candidates.push_back(symbol_name);
+    }
+  } else {
+    for (const Predicate* predicate : predicates(name)) {
+      if (predicate->args.size() == args.size()) {
+        candidates.push_back(predicate->args[position]);
+      }
+    }
+  }
+  std::sort(candidates.begin(), candidates.end());
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  std::vector<std::string> found;
+  std::vector<std::string> filled(args.begin(), args.end());
+  for (const auto& candidate : candidates) {
+    filled[position] = candidate;
+    if (holds(name, filled)) {
+      found.push_back(candidate);
+    }
+  }
+  return found;
 }
 
 std::vector<const Predicate*> WorldState::predicates(std::string_view name) const {

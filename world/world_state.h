@@ -4,6 +4,7 @@
 // configurations and object classes; predicates are named relations over symbol names.
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <span>
@@ -65,10 +66,16 @@ struct Report {
   std::vector<Predicate> predicates;
 };
 
+/// Evaluates a derived predicate (e.g. left_of for any reference frame) from the symbols.
+using PredicateEvaluator = std::function<bool(const class WorldState&, std::span<const std::string> args)>;
+
 /// The union of every source's report. Not thread-safe: one thread updates and reads it
 /// (the executor's); others get copies.
 class WorldState {
  public:
+  /// The wildcard of match() patterns: "?" stands for any symbol.
+  static constexpr std::string_view kWildcard = "?";
+
   /// Replaces everything `source` reported. Symbols and predicates get `source` stamped in.
   void update(const std::string& source, Report report);
   void removeSource(const std::string& source);
@@ -76,8 +83,19 @@ class WorldState {
   const Symbol* symbol(std::string_view name) const;
   std::vector<const Symbol*> symbols() const;
 
-  /// True when some source reports name(args) with value true and none reports it false.
+  /// True when some source reports name(args) with value true and none reports it false, or,
+  /// for a derived predicate not reported, when its evaluator says so.
   bool holds(std::string_view name, std::span<const std::string> args) const;
+
+  /// Registers how to evaluate a derived predicate on demand (the Predicator's geometric
+  /// predicates: any reference frame, not only those it reports).
+  void setEvaluator(const std::string& predicate, PredicateEvaluator evaluator);
+  bool isDerived(std::string_view predicate) const { return evaluators_.contains(std::string(predicate)); }
+
+  /// The symbols that make name(args) hold when put in place of the one "?" in `args`
+  /// (sorted). With no "?", the empty list or {""} when it holds.
+  /// @throws std::invalid_argument when `args` has more than one "?".
+  std::vector<std::string> match(std::string_view name, std::span<const std::string> args) const;
   /// Every predicate reported with this name (all of them if `name` is empty).
   std::vector<const Predicate*> predicates(std::string_view name = {}) const;
 
@@ -95,6 +113,7 @@ class WorldState {
   // name -> symbol, and "name(args)" -> (true votes, false votes), rebuilt on update.
   std::unordered_map<std::string, const Symbol*> symbol_index_;
   std::unordered_map<std::string, std::pair<int, int>> predicate_index_;
+  std::unordered_map<std::string, PredicateEvaluator> evaluators_;
   std::uint64_t version_ = 0;
 };
 

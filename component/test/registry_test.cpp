@@ -190,6 +190,19 @@ TEST_F(RunsPlans, ConditionsTestTheWorldStateAndSayWhichPredicateFailed) {
   EXPECT_EQ(counter->value("parts"), 3);
 }
 
+TEST_F(RunsPlans, AWildcardAsksWhetherAnySymbolSatisfiesThePredicate) {
+  const bt::RunResult result = run(R"(<Sequence>
+      <TestCount counter="parts"/>
+      <CheckPredicate predicate="test_count" args="?;1"/>
+      <CheckPredicate predicate="test_count" args="parts;?"/>
+      <CheckPredicate predicate="test_count" args="?;7" expected="false"/>
+      <CheckPredicate predicate="test_count" args="?;2"/></Sequence>)");
+  EXPECT_EQ(result.status, Status::kFailure);
+  EXPECT_EQ(result.failure_reason, "no symbol satisfies test_count(?,2)");
+  EXPECT_EQ(problems(R"(<CheckPredicate predicate="test_count" args="?;?"/>)")[0].message,
+            "CheckPredicate: only one argument may be the wildcard ?");
+}
+
 TEST_F(RunsPlans, UnknownPredicatesAndWrongArityFailValidation) {
   const auto bad = problems(R"(<Sequence><CheckPredicate predicate="is_blue" args="x"/>
       <CheckPredicate predicate="test_count" args="parts"/></Sequence>)");

@@ -81,3 +81,33 @@ TEST(Pose, RpyOfInvertsPoseFromXyzRpy) {
 
 }  // namespace
 }  // namespace costar::world
+
+namespace costar::world {
+namespace {
+
+TEST(WorldState, DerivedPredicatesAreEvaluatedOnDemand) {
+  WorldState world;
+  world.update("perception", {{Symbol{"a", "", {}, FrameValue{"world", Pose(Eigen::Translation3d(0, 0.3, 0))}},
+                               Symbol{"b", "", {}, FrameValue{"world", Pose(Eigen::Translation3d(0, -0.3, 0))}}},
+                              {{"is_a", {"a", "node"}, true, ""}, {"is_a", {"b", "node"}, true, ""}}});
+  world.setEvaluator("left_of", [](const WorldState& w, std::span<const std::string> args) {
+    const auto subject = w.worldPose(args[0]);
+    const auto reference = w.worldPose(args[1]);
+    return subject && reference && subject->translation().y() > reference->translation().y() + 0.02;
+  });
+  const std::vector<std::string> ab{"a", "b"};
+  const std::vector<std::string> ba{"b", "a"};
+  EXPECT_TRUE(world.holds("left_of", ab));
+  EXPECT_FALSE(world.holds("left_of", ba));
+  // Wildcards: which symbols are left of b; which are nodes.
+  const std::vector<std::string> left_of_b{"?", "b"};
+  EXPECT_EQ(world.match("left_of", left_of_b), std::vector<std::string>{"a"});
+  const std::vector<std::string> nodes{"?", "node"};
+  EXPECT_EQ(world.match("is_a", nodes), (std::vector<std::string>{"a", "b"}));
+  const std::vector<std::string> two{"?", "?"};
+  EXPECT_THROW(world.match("is_a", two), std::invalid_argument);
+  EXPECT_EQ(world.match("is_a", std::vector<std::string>{"a", "node"}).size(), 1u);
+}
+
+}  // namespace
+}  // namespace costar::world
