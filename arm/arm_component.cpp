@@ -224,8 +224,11 @@ MotionPlan ArmComponent::timed(std::vector<JointVector> path, double speed) cons
   return plan;
 }
 
-MotionPlan ArmComponent::planToJoints(const JointVector& goal, double speed) const {
-  const JointVector start = driver_.read().position;
+world::Pose ArmComponent::toolAt(const JointVector& q) const {
+  return config_.base_in_world * kinematics_.forward(q) * config_.tcp_in_flange;
+}
+
+MotionPlan ArmComponent::planToJoints(const JointVector& start, const JointVector& goal, double speed) const {
   for (int j = 0; j < kJointCount; ++j) {
     if (goal[j] < config_.limits.min_position[j] || goal[j] > config_.limits.max_position[j]) {
       return {nullptr, goal, "joint " + std::to_string(j + 1) + " would leave its limits"};
@@ -271,8 +274,7 @@ MotionPlan ArmComponent::planToPose(const world::Pose& tcp_in_world, double spee
               first_problem + ")"};
 }
 
-MotionPlan ArmComponent::planLine(const world::Pose& target, double speed) const {
-  const JointVector current = driver_.read().position;
+MotionPlan ArmComponent::planLine(const JointVector& current, const world::Pose& target, double speed) const {
   const world::Pose start = config_.base_in_world * kinematics_.forward(current) * config_.tcp_in_flange;
   const double distance = (target.translation() - start.translation()).norm();
   const double angle = world::rotationAngle(start, target);
@@ -314,7 +316,7 @@ std::optional<world::Pose> ArmComponent::waypointPose(const Waypoint& waypoint) 
   return *frame * waypoint.pose;
 }
 
-std::unique_ptr<component::RunningOperation> ArmComponent::run(MotionPlan plan, const std::string& what) {
+std::unique_ptr<component::RunningOperation> ArmComponent::execute(MotionPlan plan, const std::string& what) {
   if (!plan.ok()) {
     return std::make_unique<component::FinishedOperation>(OperationResult::failure(what + ": " + plan.failure));
   }
@@ -343,17 +345,17 @@ std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::stri
                                                (known.empty() ? " (none taught yet)" : " (known: " + known + ")")));
     }
     if (waypoint->kind == Waypoint::Kind::kJoints) {
-      return run(planToJoints(waypoint->joints, speed()), "Move to '" + name + "'");
+      return execute(planToJoints(waypoint->joints, speed()), "Move to '" + name + "'");
     }
     const auto pose = waypointPose(*waypoint);
     if (!pose) {
       return finished(OperationResult::failure("waypoint '" + name + "' is relative to '" + waypoint->frame +
                                                "', which is not known now"));
     }
-    return run(planToPose(*pose, speed()), "Move to '" + name + "'");
+    return execute(planToPose(*pose, speed()), "Move to '" + name + "'");
   }
   if (operation == "Home") {
-    return run(planToJoints(config_.home, speed()), "Home");
+    return execute(planToJoints(config_.home, speed()), "Home");
   }
   if (operation == "MoveToPose") {
     const std::string frame = params.at("frame").asString();
@@ -362,7 +364,7 @@ std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::stri
     if (!base) {
       return finished(OperationResult::failure("unknown frame '" + frame + "'"));
     }
-    return run(planToPose(*base * params.at("pose").asPose(), speed()), "MoveToPose");
+    return execute(planToPose(*base * params.at("pose").asPose(), speed()), "MoveToPose");
   }
   if (operation == "MoveRelative" || operation == "JogCartesian") {
     world::Pose offset = world::Pose::Identity();
@@ -389,12 +391,12 @@ std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::stri
       target.translation() = now.translation() + offset.translation();
       target.linear() = offset.linear() * now.linear();
     }
-    return run(planLine(target, speed()), operation);
+    return execute(planLine(target, speed()), operation);
   }
   if (operation == "JogJoint") {
     JointVector goal = driver_.read().position;
     goal[params.at("joint").asInt() - 1] += params.at("degrees").asDouble() * M_PI / 180.0;
-    return run(planToJoints(goal, speed()), "JogJoint");
+    return execute(planToJoints(goal, speed()), "JogJoint");
   }
   if (operation == "Teach") {
     Waypoint waypoint;

@@ -81,11 +81,24 @@ class ArmComponent final : public component::LocalComponent {
   /// Every IK solution for a TCP pose in the world, each expressed nearest to `seed` within
   /// the joint limits, nearest first.
   std::vector<JointVector> solutions(const world::Pose& tcp_in_world, const JointVector& seed) const;
+  /// The joint configuration now (from the encoders).
+  JointVector joints() const { return driver_.read().position; }
   /// A collision-free motion from the current configuration to the TCP pose.
   MotionPlan planToPose(const world::Pose& tcp_in_world, double speed) const;
-  MotionPlan planToJoints(const JointVector& goal, double speed) const;
-  /// A straight Cartesian line of the TCP from where it is to `tcp_in_world`.
-  MotionPlan planLine(const world::Pose& tcp_in_world, double speed) const;
+  /// A collision-free motion from `from` (default: where the arm is) to `goal`.
+  MotionPlan planToJoints(const JointVector& goal, double speed) const { return planToJoints(joints(), goal, speed); }
+  MotionPlan planToJoints(const JointVector& from, const JointVector& goal, double speed) const;
+  /// A straight Cartesian line of the TCP from where it is (or from `from`) to `tcp_in_world`.
+  MotionPlan planLine(const world::Pose& tcp_in_world, double speed) const {
+    return planLine(joints(), tcp_in_world, speed);
+  }
+  MotionPlan planLine(const JointVector& from, const world::Pose& tcp_in_world, double speed) const;
+  /// TCP pose in the world at a joint configuration.
+  world::Pose toolAt(const JointVector& q) const;
+
+  /// Runs a plan. Fails at once (nothing moves) when the plan is empty or does not start
+  /// where the arm is.
+  std::unique_ptr<component::RunningOperation> execute(MotionPlan plan, const std::string& what);
 
   const ArmConfig& config() const { return config_; }
   const Ur5Kinematics& kinematics() const { return kinematics_; }
@@ -93,7 +106,6 @@ class ArmComponent final : public component::LocalComponent {
  private:
   std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
                                                      const component::ParamMap& params) override;
-  std::unique_ptr<component::RunningOperation> run(MotionPlan plan, const std::string& what);
   std::optional<world::Pose> waypointPose(const Waypoint& waypoint) const;
   world::Pose flangeInBase(const world::Pose& tcp_in_world) const;
   MotionPlan timed(std::vector<JointVector> path, double speed) const;

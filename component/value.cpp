@@ -285,6 +285,11 @@ std::string ParamSpec::check(std::string_view text) const {
   if (!value) {
     return error;
   }
+  if (validate) {
+    if (std::string problem = validate(text); !problem.empty()) {
+      return problem;
+    }
+  }
   if (!choices.empty() && std::find(choices.begin(), choices.end(), value->asString()) == choices.end()) {
     std::string allowed;
     for (const auto& choice : choices) {

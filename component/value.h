@@ -2,6 +2,7 @@
 // Typed, serializable parameters and results of operations. A plan writes them as XML
 // attributes; across a process boundary they travel as JSON.
 
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -75,6 +76,8 @@ struct ParamSpec {
   /// For strings whose allowed values come from what the system knows at run time
   /// ("waypoint", "object_class", "predicate", "frame"): the editor offers that list.
   std::string choices_from;
+  /// Further checks of a written value (e.g. its syntax): empty when valid, else the problem.
+  std::function<std::string(std::string_view)> validate;
 
   /// Checks a written value: empty when valid, else the problem.
   std::string check(std::string_view text) const;

@@ -124,6 +124,10 @@ void CollisionWorld::allow(const std::string& robot_link, const std::string& obs
   impl_->allowed.emplace(robot_link, obstacle);
 }
 
+void CollisionWorld::disallow(const std::string& robot_link, const std::string& obstacle) {
+  impl_->allowed.erase({robot_link, obstacle});
+}
+
 void CollisionWorld::disallowAll() { impl_->allowed.clear(); }
 
 std::optional<Contact> CollisionWorld::check(const Eigen::VectorXd& q) const {

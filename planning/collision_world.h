@@ -49,6 +49,7 @@ class CollisionWorld {
 
   /// Lets `robot_link` touch `obstacle` (e.g. the fingers and the part being grasped).
   void allow(const std::string& robot_link, const std::string& obstacle);
+  void disallow(const std::string& robot_link, const std::string& obstacle);
   void disallowAll();
 
   /// The first contact of the robot at `q`, or nullopt when it is free.

@@ -4,9 +4,11 @@
 #include "core/paths.h"
 #include "gripper/parallel_gripper.h"
 #include "planning/collision_world.h"
+#include "predicator/predicator.h"
 #include "sim/arm_driver.h"
 #include "sim/drivers.h"
 #include "sim/simulation.h"
+#include "smartmove/smartmove.h"
 
 namespace costar::workcell {
 
@@ -40,6 +42,33 @@ class FixedFrames final : public component::LocalComponent {
   std::vector<std::pair<std::string, world::Pose>> frames_;
 };
 
+/// TEST ONLY: the simulator's true part poses as object symbols, standing in for perception
+/// when SmartMove is tested apart from it.
+class TestOraclePerception final : public component::LocalComponent {
+ public:
+  explicit TestOraclePerception(sim::Simulation& simulation) : simulation_(simulation) {
+    description_.name = "test_oracle_perception";
+    description_.type = "TestOraclePerception";
+    description_.predicates = {{"is_a", 2, "TEST ONLY: is_a(part, class) from ground truth"}};
+  }
+  const component::ComponentDescription& description() const override { return description_; }
+  world::Report report() const override {
+    world::Report report;
+    for (const sim::PartState& part : simulation_.parts()) {
+      report.symbols.push_back({part.name, "", {}, world::FrameValue{"world", part.pose}});
+      report.predicates.push_back({"is_a", {part.name, part.object_class}, true, ""});
+    }
+    return report;
+  }
+
+ private:
+  std::unique_ptr<component::RunningOperation> begin(const std::string&, const component::ParamMap&) override {
+    return nullptr;
+  }
+  component::ComponentDescription description_;
+  sim::Simulation& simulation_;
+};
+
 const world::Pose kBaseInWorld(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
 const world::Pose kTableCenter(Eigen::Translation3d(0.5, 0.0, 0.0));
 
@@ -57,7 +86,9 @@ class Ur5SimWorkcell final : public Workcell {
                     {toEigen(sim::Simulation::homeConfiguration())}),
         waypoints_(options.memory_only
                        ? std::filesystem::path()
-                       : (options.waypoints.empty() ? defaultWaypointFile("ur5-sim") : options.waypoints)) {
+                       : (options.waypoints.empty() ? defaultWaypointFile("ur5-sim") : options.waypoints)),
+        grasps_(dataRoot() / "data/grasps.json",
+                options.memory_only ? std::filesystem::path() : defaultGraspFile("ur5-sim")) {
     simulation_->attach(static_cast<SimClock&>(clock()));
     collisions_.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
     collisions_.allow("base_link", "table");  // the robot stands on it
@@ -65,13 +96,29 @@ class Ur5SimWorkcell final : public Workcell {
     arm::ArmConfig arm_config;
     arm_config.base_in_world = kBaseInWorld;
     arm_config.home = sim::Simulation::homeConfiguration();
-    components().add(std::make_shared<arm::ArmComponent>(
+    auto arm = std::make_shared<arm::ArmComponent>(
         arm_driver_, clock(), collisions_, waypoints_,
-        [this](const std::string& frame) { return components().world().worldPose(frame); }, arm_config));
-    components().add(std::make_shared<gripper::ParallelGripper>(gripper_driver_, clock()));
+        [this](const std::string& frame) { return components().world().worldPose(frame); }, arm_config);
+    auto gripper = std::make_shared<gripper::ParallelGripper>(gripper_driver_, clock());
+    components().add(arm);
+    components().add(gripper);
     components().add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
         {"table_center", kTableCenter}, {"robot_base", kBaseInWorld}}));
+    if (options.test_oracle_perception) {
+      components().add(std::make_shared<TestOraclePerception>(*simulation_));
+    }
+    smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(*arm, *gripper, components().world(), collisions_,
+                                                                 simulation_->objectClasses(), grasps_);
+    components().add(smartmove_);
+    // Last: it derives its predicates from what the others report.
+    components().add(std::make_shared<predicator::Predicator>(components().world(), simulation_->objectClasses()));
     registerNodes();
+    smartmove_->syncObstacles();
+  }
+
+  void beforeTick() override {
+    Workcell::beforeTick();
+    smartmove_->syncObstacles();
   }
 
   std::string name() const override { return "ur5-sim"; }
@@ -96,6 +143,8 @@ class Ur5SimWorkcell final : public Workcell {
   planning::RobotModel robot_;
   planning::CollisionWorld collisions_;
   arm::WaypointStore waypoints_;
+  smartmove::GraspLibrary grasps_;
+  std::shared_ptr<smartmove::SmartMoveComponent> smartmove_;
 };
 
 }  // namespace

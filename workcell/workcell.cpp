@@ -16,16 +16,24 @@ void Workcell::registerNodes() {
   components_.refreshWorld();
 }
 
-std::filesystem::path defaultWaypointFile(const std::string& workcell) {
-  std::filesystem::path state;
+namespace {
+
+std::filesystem::path stateDir() {
   if (const char* xdg = std::getenv("XDG_STATE_HOME"); xdg != nullptr && *xdg != '\0') {
-    state = xdg;
-  } else if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0') {
-    state = std::filesystem::path(home) / ".local" / "state";
-  } else {
-    state = ".";
+    return std::filesystem::path(xdg) / "costar";
   }
-  return state / "costar" / workcell / "waypoints.json";
+  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0') {
+    return std::filesystem::path(home) / ".local" / "state" / "costar";
+  }
+  return "costar-state";
+}
+
+}  // namespace
+
+std::filesystem::path defaultGraspFile(const std::string& workcell) { return stateDir() / workcell / "grasps.json"; }
+
+std::filesystem::path defaultWaypointFile(const std::string& workcell) {
+  return stateDir() / workcell / "waypoints.json";
 }
 
 namespace {

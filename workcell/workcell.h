@@ -29,8 +29,11 @@ struct WorkcellOptions {
   /// Where taught waypoints are kept (default: $XDG_STATE_HOME or ~/.local/state, then
   /// costar/<workcell>/waypoints.json). Empty string in `memory_only` mode.
   std::filesystem::path waypoints;
-  /// Keep waypoints in memory only (tests).
+  /// Keep waypoints and taught grasps in memory only (tests).
   bool memory_only = false;
+  /// TEST ONLY: report the simulator's true part poses as object symbols in place of
+  /// perception, to test SmartMove apart from perception. Never set by the CLI.
+  bool test_oracle_perception = false;
 };
 
 class Workcell {
@@ -78,5 +81,7 @@ std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& options);
 
 /// Where waypoints of `workcell` are kept by default.
 std::filesystem::path defaultWaypointFile(const std::string& workcell);
+/// Where grasps taught on `workcell` are kept by default.
+std::filesystem::path defaultGraspFile(const std::string& workcell);
 
 }  // namespace costar::workcell

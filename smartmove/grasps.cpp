@@ -1,0 +1,122 @@
+#include "smartmove/grasps.h"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "core/files.h"
+
+namespace costar::smartmove {
+
+namespace {
+
+void read(const std::filesystem::path& file, std::map<std::pair<std::string, std::string>, Grasp>& into) {
+  std::ifstream stream(file);
+  if (!stream) {
+    throw std::runtime_error("cannot open grasp file '" + file.string() + "'");
+  }
+  try {
+    const nlohmann::json json = nlohmann::json::parse(stream);
+    for (const auto& item : json.at("grasps")) {
+      Grasp grasp;
+      grasp.object_class = item.at("class").get<std::string>();
+      grasp.name = item.at("name").get<std::string>();
+      const auto p = item.at("position").get<std::array<double, 3>>();
+      const auto rpy = item.at("rpy_degrees").get<std::array<double, 3>>();
+      constexpr double kDeg = M_PI / 180.0;
+      grasp.tcp_in_object = world::poseFromXyzRpy(p[0], p[1], p[2], rpy[0] * kDeg, rpy[1] * kDeg, rpy[2] * kDeg);
+      into[{grasp.object_class, grasp.name}] = grasp;
+    }
+  } catch (const std::exception& e) {
+    throw std::runtime_error("grasp file '" + file.string() + "': " + e.what());
+  }
+}
+
+}  // namespace
+
+GraspLibrary::GraspLibrary(const std::filesystem::path& defaults_file, std::filesystem::path taught_file)
+    : taught_file_(std::move(taught_file)) {
+  read(defaults_file, defaults_);
+  if (!taught_file_.empty() && std::filesystem::exists(taught_file_)) {
+    read(taught_file_, taught_);
+  }
+}
+
+std::optional<Grasp> GraspLibrary::find(const std::string& object_class, const std::string& name) const {
+  if (const auto it = taught_.find({object_class, name}); it != taught_.end()) {
+    return it->second;
+  }
+  if (const auto it = defaults_.find({object_class, name}); it != defaults_.end()) {
+    return it->second;
+  }
+  return std::nullopt;
+}
+
+std::vector<Grasp> GraspLibrary::forClass(const std::string& object_class) const {
+  std::map<std::string, Grasp> found;
+  for (const auto* source : {&defaults_, &taught_}) {
+    for (const auto& [key, grasp] : *source) {
+      if (key.first == object_class) {
+        found[key.second] = grasp;
+      }
+    }
+  }
+  std::vector<Grasp> grasps;
+  for (auto& [name, grasp] : found) {
+    grasps.push_back(std::move(grasp));
+  }
+  return grasps;
+}
+
+std::vector<std::string> GraspLibrary::names() const {
+  std::vector<std::string> names;
+  for (const auto* source : {&defaults_, &taught_}) {
+    for (const auto& [key, grasp] : *source) {
+      if (std::find(names.begin(), names.end(), key.second) == names.end()) {
+        names.push_back(key.second);
+      }
+    }
+  }
+  return names;
+}
+
+void GraspLibrary::teach(const Grasp& grasp) {
+  taught_[{grasp.object_class, grasp.name}] = grasp;
+  if (taught_file_.empty()) {
+    return;
+  }
+  nlohmann::json json = {{"grasps", nlohmann::json::array()}};
+  for (const auto& [key, g] : taught_) {
+    const Eigen::Vector3d rpy = world::rpyOf(g.tcp_in_object.linear()) * (180.0 / M_PI);
+    const Eigen::Vector3d& p = g.tcp_in_object.translation();
+    json["grasps"].push_back({{"class", g.object_class},
+                              {"name", g.name},
+                              {"position", {p.x(), p.y(), p.z()}},
+                              {"rpy_degrees", {rpy.x(), rpy.y(), rpy.z()}}});
+  }
+  if (taught_file_.has_parent_path()) {
+    std::filesystem::create_directories(taught_file_.parent_path());
+  }
+  writeFileAtomically(taught_file_, json.dump(2) + "\n");
+}
+
+world::Pose snapToCanonical(const world::Pose& tcp_in_object, const world::ObjectClass& object_class) {
+  // The canonical top grasp: tool z along -object z, fingers closing along -object y.
+  const Eigen::Matrix3d canonical = world::poseFromXyzRpy(0, 0, 0, M_PI, 0, 0).linear();
+  world::Pose best = tcp_in_object;
+  double best_angle = 1e9;
+  for (const Eigen::Matrix3d& symmetry : object_class.symmetries) {
+    // The object turned by a symmetry looks the same: the grasp relative to it is s^-1 * T.
+    world::Pose candidate = world::Pose::Identity();
+    candidate.linear() = symmetry.transpose();
+    candidate = candidate * tcp_in_object;
+    const double angle = Eigen::AngleAxisd(canonical.transpose() * candidate.linear()).angle();
+    if (angle < best_angle - 1e-9) {
+      best_angle = angle;
+      best = candidate;
+    }
+  }
+  return best;
+}
+
+}  // namespace costar::smartmove

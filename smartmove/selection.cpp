@@ -1,0 +1,128 @@
+#include "smartmove/selection.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+namespace costar::smartmove {
+
+namespace {
+
+double jointDistance(const arm::JointVector& a, const arm::JointVector& b) {
+  double sum = 0.0;
+  for (int j = 0; j < arm::kJointCount; ++j) {
+    sum += std::abs(a[j] - b[j]);
+  }
+  return sum;
+}
+
+std::string summarize(const std::vector<Candidate>& candidates) {
+  std::map<std::string, int> reasons;
+  for (const Candidate& candidate : candidates) {
+    if (!candidate.rejected.empty()) {
+      ++reasons[candidate.rejected.substr(0, candidate.rejected.find(':'))];
+    }
+  }
+  std::string text = std::to_string(candidates.size()) + " candidate" + (candidates.size() == 1 ? "" : "s");
+  if (candidates.empty()) {
+    return "no candidates";
+  }
+  std::string details;
+  for (const auto& [reason, count] : reasons) {
+    details += (details.empty() ? "" : ", ") + std::to_string(count) + " " + reason;
+  }
+  return text + ", none feasible (" + details + ")";
+}
+
+}  // namespace
+
+Selection selectAmong(std::vector<Candidate> candidates, const ArmModel& arm, const CostWeights& weights,
+                      const FeasibilityCheck& feasible) {
+  const auto start = std::chrono::steady_clock::now();
+  Selection selection;
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    Candidate& candidate = candidates[i];
+    candidate.solutions = arm.solutions(candidate.goal);
+    if (candidate.solutions.empty()) {
+      candidate.rejected = "no IK solution: out of reach or beyond the joint limits";
+      continue;
+    }
+    const Eigen::Vector3d tool_z = candidate.goal.linear().col(2);
+    const double tilt = std::acos(std::clamp(-tool_z.z(), -1.0, 1.0));
+    candidate.cost = weights.joint * jointDistance(candidate.solutions.front(), arm.joints) + weights.tilt * tilt +
+                     weights.travel * (candidate.goal.translation() - arm.tool.translation()).norm();
+    order.push_back(i);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&candidates](std::size_t a, std::size_t b) { return candidates[a].cost < candidates[b].cost; });
+  for (const std::size_t i : order) {
+    Candidate& candidate = candidates[i];
+    if (selection.chosen) {
+      candidate.rejected = "not checked: a cheaper candidate works";
+      continue;
+    }
+    candidate.rejected = feasible(candidate);
+    if (candidate.rejected.empty()) {
+      candidate.chosen = true;
+      selection.chosen = i;
+    }
+  }
+  selection.candidates = std::move(candidates);
+  selection.summarizeFailure();
+  selection.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return selection;
+}
+
+Selection selectGoal(const std::vector<std::pair<std::string, world::Pose>>& objects,
+                     const world::ObjectClass& object_class, const world::Pose& relative, const ArmModel& arm,
+                     const CostWeights& weights, const FeasibilityCheck& feasible) {
+  std::vector<Candidate> candidates;
+  candidates.reserve(objects.size() * object_class.symmetries.size());
+  for (const auto& [name, pose] : objects) {
+    for (std::size_t s = 0; s < object_class.symmetries.size(); ++s) {
+      world::Pose symmetry = world::Pose::Identity();
+      symmetry.linear() = object_class.symmetries[s];
+      Candidate candidate;
+      candidate.object = name;
+      candidate.symmetry = static_cast<int>(s);
+      candidate.goal = pose * symmetry * relative;
+      candidates.push_back(std::move(candidate));
+    }
+  }
+  return selectAmong(std::move(candidates), arm, weights, feasible);
+}
+
+void Selection::summarizeFailure() {
+  if (!chosen) {
+    failure = summarize(candidates);
+  }
+}
+
+nlohmann::json Selection::toJson() const {
+  nlohmann::json list = nlohmann::json::array();
+  for (const Candidate& candidate : candidates) {
+    const Eigen::Vector3d& p = candidate.goal.translation();
+    nlohmann::json item = {{"object", candidate.object},
+                           {"symmetry", candidate.symmetry},
+                           {"goal", {p.x(), p.y(), p.z()}},
+                           {"chosen", candidate.chosen}};
+    if (std::isfinite(candidate.cost)) {
+      item["cost"] = candidate.cost;
+    }
+    if (!candidate.rejected.empty()) {
+      item["rejected"] = candidate.rejected;
+    }
+    list.push_back(std::move(item));
+  }
+  nlohmann::json json = {{"candidates", std::move(list)}, {"seconds", seconds}};
+  if (chosen) {
+    json["chosen"] = candidates[*chosen].object;
+  } else {
+    json["failure"] = failure;
+  }
+  return json;
+}
+
+}  // namespace costar::smartmove

@@ -1,0 +1,640 @@
+#include "smartmove/smartmove.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace costar::smartmove {
+
+using component::OperationResult;
+using component::OperationState;
+using component::ParamSpec;
+using component::RunningOperation;
+using component::ValueType;
+
+namespace {
+
+std::string trim(std::string text) {
+  const auto first = text.find_first_not_of(" \t\n");
+  if (first == std::string::npos) {
+    return {};
+  }
+  const auto last = text.find_last_not_of(" \t\n");
+  return text.substr(first, last - first + 1);
+}
+
+bool isName(const std::string& text) {
+  return !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '?';
+  });
+}
+
+/// An operation of another component, started now, as a step.
+class ComponentStep final : public RunningOperation {
+ public:
+  ComponentStep(component::Component& component, const std::string& operation, const component::ParamMap& params)
+      : component_(component), id_(component.start(operation, params)) {}
+  OperationResult poll() override { return component_.poll(id_); }
+  void cancel() override { component_.cancel(id_); }
+
+ private:
+  component::Component& component_;
+  component::OperationId id_;
+};
+
+/// A short script of steps, each an operation started when the previous one succeeded.
+class Script final : public RunningOperation {
+ public:
+  struct Step {
+    std::string what;
+    std::function<std::unique_ptr<RunningOperation>()> start;
+    /// Checks the step's result; empty when the script may go on.
+    std::function<std::string(const OperationResult&)> check;
+  };
+
+  Script(std::vector<Step> steps, nlohmann::json data, std::function<void(bool)> on_end)
+      : steps_(std::move(steps)), data_(std::move(data)), on_end_(std::move(on_end)) {}
+
+  OperationResult poll() override {
+    while (next_ < steps_.size() || current_) {
+      if (!current_) {
+        try {
+          current_ = steps_[next_].start();
+        } catch (const std::exception& e) {
+          return finish(OperationResult::failure(steps_[next_].what + ": " + e.what(), data_));
+        }
+      }
+      OperationResult result = current_->poll();
+      if (result.state == OperationState::kRunning) {
+        return OperationResult::running();
+      }
+      current_.reset();
+      const Step& step = steps_[next_++];
+      if (result.state == OperationState::kFailure) {
+        return finish(OperationResult::failure(step.what + ": " + result.reason, data_));
+      }
+      if (step.check) {
+        if (const std::string problem = step.check(result); !problem.empty()) {
+          return finish(OperationResult::failure(step.what + ": " + problem, data_));
+        }
+      }
+    }
+    return finish(OperationResult::success(data_));
+  }
+
+  void cancel() override {
+    if (current_) {
+      current_->cancel();
+      current_.reset();
+    }
+    if (on_end_) {
+      on_end_(false);
+      on_end_ = nullptr;
+    }
+  }
+
+ private:
+  OperationResult finish(OperationResult result) {
+    if (on_end_) {
+      on_end_(result.state == OperationState::kSuccess);
+      on_end_ = nullptr;
+    }
+    return result;
+  }
+
+  std::vector<Step> steps_;
+  std::size_t next_ = 0;
+  std::unique_ptr<RunningOperation> current_;
+  nlohmann::json data_;
+  std::function<void(bool)> on_end_;
+};
+
+std::unique_ptr<RunningOperation> failed(std::string reason, nlohmann::json data = {}) {
+  return std::make_unique<component::FinishedOperation>(OperationResult::failure(std::move(reason), std::move(data)));
+}
+
+world::Pose up(double metres) { return world::Pose(Eigen::Translation3d(0, 0, metres)); }
+
+}  // namespace
+
+std::vector<predicator::Pattern> parsePredicateList(const std::string& text) {
+  std::vector<predicator::Pattern> patterns;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(';', start), text.size());
+    const std::string item = trim(text.substr(start, end - start));
+    start = end + 1;
+    if (item.empty()) {
+      continue;
+    }
+    predicator::Pattern pattern;
+    const auto open = item.find('(');
+    if (open == std::string::npos) {
+      pattern.predicate = item;
+    } else {
+      if (item.back() != ')') {
+        throw std::invalid_argument("'" + item + "' must look like name(arg, ...)");
+      }
+      pattern.predicate = trim(item.substr(0, open));
+      const std::string inside = item.substr(open + 1, item.size() - open - 2);
+      std::size_t a = 0;
+      while (a <= inside.size()) {
+        const std::size_t b = std::min(inside.find(',', a), inside.size());
+        const std::string arg = trim(inside.substr(a, b - a));
+        if (!arg.empty() || b < inside.size()) {
+          if (!isName(arg)) {
+            throw std::invalid_argument("'" + arg + "' in '" + item + "' is not a symbol name");
+          }
+          pattern.args.push_back(arg);
+        }
+        a = b + 1;
+      }
+    }
+    if (!isName(pattern.predicate) || pattern.predicate.find('?') != std::string::npos) {
+      throw std::invalid_argument("'" + pattern.predicate + "' is not a predicate name");
+    }
+    const auto wildcards = std::count(pattern.args.begin(), pattern.args.end(), "?");
+    if (wildcards == 0) {
+      pattern.args.insert(pattern.args.begin(), "?");  // the object is the first argument
+    } else if (wildcards > 1) {
+      throw std::invalid_argument("'" + item + "' has more than one '?'");
+    }
+    patterns.push_back(std::move(pattern));
+  }
+  return patterns;
+}
+
+std::string partObstacle(const std::string& object) { return "part:" + object; }
+
+SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Component& gripper, world::WorldState& world,
+                                       planning::CollisionWorld& collisions, std::vector<world::ObjectClass> classes,
+                                       GraspLibrary& grasps, SmartMoveConfig config)
+    : arm_(arm),
+      gripper_(gripper),
+      world_(world),
+      collisions_(collisions),
+      classes_(std::move(classes)),
+      grasps_(grasps),
+      config_(std::move(config)) {
+  description_.name = config_.name;
+  description_.type = "SmartMove";
+  std::vector<std::string> class_names;
+  for (const auto& object : classes_) {
+    class_names.push_back(object.name);
+  }
+  ParamSpec object_class{"object_class", ValueType::kString, "class of the part", {}, class_names};
+  object_class.choices_from = "object_class";
+  ParamSpec predicates{"predicates", ValueType::kString,
+                       "conditions on the part, e.g. right_of(table_center); near(node_1)", std::string()};
+  predicates.choices_from = "predicate";
+  predicates.validate = [](std::string_view text) -> std::string {
+    try {
+      parsePredicateList(std::string(text));
+      return {};
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+  };
+  ParamSpec grasp{"grasp", ValueType::kString, "a grasp taught for the class", std::string("top")};
+  grasp.choices_from = "grasp";
+  ParamSpec approach{"approach", ValueType::kDouble, "distance of the straight approach and retreat (m)",
+                     config_.approach};
+  approach.min = 0.02;
+  approach.max = 0.3;
+  ParamSpec speed{"speed", ValueType::kDouble, "fraction of the arm's top speed", config_.default_speed};
+  speed.min = 0.01;
+  speed.max = 1.0;
+  std::vector<std::string> optional_classes = class_names;
+  optional_classes.insert(optional_classes.begin(), "");
+  ParamSpec target_class{"target_class", ValueType::kString, "put the part on a part of this class", std::string(),
+                         optional_classes};
+  ParamSpec target{"target", ValueType::kString, "or put it down at this frame (e.g. a taught waypoint)",
+                   std::string()};
+  target.choices_from = "frame";
+  description_.operations = {{"SmartMove",
+                              "Moves the tool to the best reachable part that satisfies the conditions.",
+                              {object_class, predicates, grasp, speed}},
+                             {"SmartGrasp",
+                              "Picks up the best reachable part that satisfies the conditions.",
+                              {object_class, predicates, grasp, approach, speed}},
+                             {"SmartRelease",
+                              "Puts the part held on a part that satisfies the conditions, or at a frame.",
+                              {target_class, predicates, target, approach, speed}},
+                             {"TeachGrasp",
+                              "Saves how the gripper holds the nearest part of a class as a named grasp.",
+                              {object_class, {"grasp", ValueType::kString, "name of the new grasp", {}}},
+                              component::OperationKind::kKnowledge}};
+  description_.predicates = {{"holding", 1, "holding(o): the gripper holds part o"}};
+}
+
+const world::ObjectClass* SmartMoveComponent::objectClass(const std::string& name) const {
+  for (const auto& object : classes_) {
+    if (object.name == name) {
+      return &object;
+    }
+  }
+  return nullptr;
+}
+
+world::Report SmartMoveComponent::report() const {
+  world::Report report;
+  if (held_ && world_.holds("gripper_holding", {})) {
+    report.predicates.push_back({"holding", {*held_}, true, ""});
+  }
+  return report;
+}
+
+void SmartMoveComponent::syncObstacles() {
+  std::vector<std::string> present;
+  for (const world::Predicate* is_a : world_.predicates("is_a")) {
+    if (is_a->args.size() != 2 || (held_ && is_a->args[0] == *held_)) {
+      continue;
+    }
+    const world::ObjectClass* object = objectClass(is_a->args[1]);
+    const auto pose = world_.worldPose(is_a->args[0]);
+    if (object == nullptr || !pose) {
+      continue;
+    }
+    const Eigen::AlignedBox3d bounds = object->bounds();
+    collisions_.setBox(partObstacle(is_a->args[0]), *pose * Eigen::Translation3d(bounds.center()), bounds.sizes());
+    present.push_back(partObstacle(is_a->args[0]));
+  }
+  for (const auto& name : obstacles_) {
+    if (std::find(present.begin(), present.end(), name) == present.end()) {
+      collisions_.remove(name);
+    }
+  }
+  obstacles_ = std::move(present);
+}
+
+void SmartMoveComponent::allowGripperContact(const std::string& object, bool allowed) {
+  for (const auto& link : config_.gripper_links) {
+    if (allowed) {
+      collisions_.allow(link, partObstacle(object));
+    } else {
+      collisions_.disallow(link, partObstacle(object));
+    }
+  }
+}
+
+SmartMoveComponent::Matches SmartMoveComponent::matching(const std::string& object_class,
+                                                         const std::vector<predicator::Pattern>& patterns,
+                                                         const std::string& exclude) const {
+  Matches matches;
+  const std::vector<std::string> is_a{"?", object_class};
+  for (const std::string& object : world_.match("is_a", is_a)) {
+    const auto pose = world_.worldPose(object);
+    if (object == exclude || !pose) {
+      continue;
+    }
+    std::string failing;
+    for (const auto& pattern : patterns) {
+      std::vector<std::string> args = pattern.args;
+      std::replace(args.begin(), args.end(), std::string("?"), object);
+      if (!world_.holds(pattern.predicate, args)) {
+        failing = world::predicateKey(pattern.predicate, args) + " is false";
+        break;
+      }
+    }
+    if (failing.empty()) {
+      matches.objects.emplace_back(object, *pose);
+    } else {
+      matches.rejected.emplace_back(object, failing);
+    }
+  }
+  return matches;
+}
+
+ArmModel SmartMoveComponent::armModel() const {
+  const arm::JointVector now = arm_.joints();
+  return {[this, now](const world::Pose& goal) { return arm_.solutions(goal, now); }, arm_.endpoint(), now};
+}
+
+namespace {
+
+/// The first collision-free configuration among IK solutions, or why there is none.
+std::optional<arm::JointVector> freeConfiguration(const std::vector<arm::JointVector>& solutions,
+                                                  const planning::CollisionWorld& collisions, std::string& reason) {
+  for (const auto& q : solutions) {
+    const auto contact = collisions.check(Eigen::Map<const Eigen::VectorXd>(q.data(), arm::kJointCount));
+    if (!contact) {
+      return q;
+    }
+    if (reason.empty()) {
+      reason = contact->str();
+    }
+  }
+  return std::nullopt;
+}
+
+void addRejected(Selection& selection, const SmartMoveComponent::Matches& matches) {
+  for (const auto& [object, reason] : matches.rejected) {
+    Candidate candidate;
+    candidate.object = object;
+    candidate.symmetry = -1;
+    candidate.rejected = "predicate false: " + reason;
+    selection.candidates.push_back(std::move(candidate));
+  }
+  selection.summarizeFailure();
+  if (!selection.ok() && selection.candidates.empty()) {
+    selection.failure = "no part of the class is known (detect the parts first)";
+  }
+}
+
+}  // namespace
+
+Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
+                                          const std::vector<predicator::Pattern>& patterns, const world::Pose& grasp,
+                                          double approach, double speed) {
+  const bool with_approach = approach > 0.0;
+  const world::ObjectClass* object = objectClass(object_class);
+  if (object == nullptr) {
+    Selection none;
+    none.failure = "unknown object class '" + object_class + "'";
+    return none;
+  }
+  syncObstacles();
+  const Matches matches = matching(object_class, patterns);
+  const arm::JointVector now = arm_.joints();
+  const FeasibilityCheck feasible = [&](Candidate& candidate) -> std::string {
+    allowGripperContact(candidate.object, true);
+    struct Restore {
+      SmartMoveComponent& self;
+      std::string object;
+      ~Restore() { self.allowGripperContact(object, false); }
+    } restore{*this, candidate.object};
+    std::string reason;
+    const auto goal = freeConfiguration(candidate.solutions, collisions_, reason);
+    if (!goal) {
+      return "collision at the goal: " + reason;
+    }
+    if (!with_approach) {
+      const arm::MotionPlan path = arm_.planToJoints(now, *goal, speed);
+      return path.ok() ? std::string() : "no path: " + path.failure;
+    }
+    const world::Pose pregrasp = candidate.goal * world::Pose(Eigen::Translation3d(0, 0, -approach));
+    const auto pre = freeConfiguration(arm_.solutions(pregrasp, *goal), collisions_, reason);
+    if (!pre) {
+      return "no reachable, collision-free pre-grasp: " + (reason.empty() ? "no IK solution" : reason);
+    }
+    const arm::MotionPlan line = arm_.planLine(*pre, candidate.goal, config_.approach_speed);
+    if (!line.ok()) {
+      return "no straight approach: " + line.failure;
+    }
+    const arm::MotionPlan retreat =
+        arm_.planLine(line.goal, up(config_.retreat) * candidate.goal, config_.approach_speed);
+    if (!retreat.ok()) {
+      return "no straight retreat: " + retreat.failure;
+    }
+    const arm::MotionPlan path = arm_.planToJoints(now, *pre, speed);
+    return path.ok() ? std::string() : "no path to the pre-grasp: " + path.failure;
+  };
+  Selection selection = selectGoal(matches.objects, *object, grasp, armModel(), config_.weights, feasible);
+  addRejected(selection, matches);
+  return selection;
+}
+
+std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& operation,
+                                                            const component::ParamMap& params) {
+  const auto text = [&params](const char* name) { return params.at(name).asString(); };
+  std::vector<predicator::Pattern> patterns;
+  double speed = config_.default_speed;
+  if (operation != "TeachGrasp") {
+    try {
+      patterns = parsePredicateList(text("predicates"));
+    } catch (const std::invalid_argument& e) {
+      return failed(std::string("predicates: ") + e.what());
+    }
+    speed = params.at("speed").asDouble();
+  }
+
+  if (operation == "SmartMove" || operation == "SmartGrasp") {
+    const bool grasping = operation == "SmartGrasp";
+    const std::string object_class = text("object_class");
+    const auto grasp = grasps_.find(object_class, text("grasp"));
+    if (!grasp) {
+      return failed("no grasp '" + text("grasp") + "' is taught for class '" + object_class + "'");
+    }
+    if (grasping && held_ && world_.holds("gripper_holding", {})) {
+      return failed("the gripper already holds " + *held_ + ": release it first");
+    }
+    const double approach = grasping ? params.at("approach").asDouble() : 0.0;
+    Selection selection = selectGrasp(object_class, patterns, grasp->tcp_in_object, approach, speed);
+    nlohmann::json data = selection.toJson();
+    if (!selection.ok()) {
+      return failed("no feasible " + object_class + ": " + selection.failure, data);
+    }
+    const Candidate chosen = selection.best();
+    const world::Pose object_pose = *world_.worldPose(chosen.object);
+    if (!grasping) {
+      return std::make_unique<Script>(
+          std::vector<Script::Step>{
+              {"move to " + chosen.object,
+               [this, chosen, speed] {
+                 std::string reason;
+                 const auto goal = freeConfiguration(arm_.solutions(chosen.goal, arm_.joints()), collisions_, reason);
+                 return arm_.execute(goal ? arm_.planToJoints(*goal, speed)
+                                          : arm::MotionPlan{nullptr, {}, "collision at the goal: " + reason},
+                                     "SmartMove");
+               },
+               nullptr}},
+          data, nullptr);
+    }
+    const world::Pose pregrasp = chosen.goal * world::Pose(Eigen::Translation3d(0, 0, -approach));
+    const std::string object = chosen.object;
+    std::vector<Script::Step> steps;
+    steps.push_back({"open the gripper",
+                     [this] {
+                       return std::make_unique<ComponentStep>(gripper_, "Open", component::ParamMap{{"speed", 0.1}});
+                     },
+                     nullptr});
+    steps.push_back({"move above " + object,
+                     [this, pregrasp, chosen, speed] {
+                       std::string reason;
+                       const auto pre =
+                           freeConfiguration(arm_.solutions(pregrasp, chosen.solutions.front()), collisions_, reason);
+                       return arm_.execute(pre ? arm_.planToJoints(*pre, speed)
+                                               : arm::MotionPlan{nullptr, {}, "no collision-free pre-grasp: " + reason},
+                                           "pre-grasp");
+                     },
+                     nullptr});
+    steps.push_back({"approach " + object,
+                     [this, chosen, object] {
+                       allowGripperContact(object, true);
+                       return arm_.execute(arm_.planLine(chosen.goal, config_.approach_speed), "approach");
+                     },
+                     nullptr});
+    steps.push_back({"close on " + object,
+                     [this] {
+                       return std::make_unique<ComponentStep>(gripper_, "Close",
+                                                              component::ParamMap{{"speed", 0.1}, {"force", 40.0}});
+                     },
+                     [this, object, object_class, object_pose, chosen](const OperationResult& result) -> std::string {
+                       if (!result.data.value("holding", false)) {
+                         return "the fingers closed on nothing: " + object + " was not where it was seen";
+                       }
+                       held_ = object;
+                       held_class_ = object_class;
+                       held_grasp_ = object_pose.inverse() * chosen.goal;
+                       collisions_.remove(partObstacle(object));
+                       return {};
+                     }});
+    steps.push_back({"lift " + object,
+                     [this] {
+                       return arm_.execute(arm_.planLine(up(config_.retreat) * arm_.endpoint(), config_.approach_speed),
+                                           "retreat");
+                     },
+                     [this](const OperationResult&) -> std::string {
+                       return world_.holds("gripper_holding", {}) || !held_ ? std::string() : "the part slipped out";
+                     }});
+    return std::make_unique<Script>(std::move(steps), data,
+                                    [this, object](bool) { allowGripperContact(object, false); });
+  }
+
+  if (operation == "SmartRelease") {
+    if (!held_) {
+      return failed("nothing to release: no part was grasped with SmartGrasp");
+    }
+    const world::ObjectClass* held_object = objectClass(held_class_);
+    const std::string target_class = text("target_class");
+    const std::string target = text("target");
+    if (target_class.empty() == target.empty()) {
+      return failed("give either target_class (put the part on such a part) or target (put it at a frame)");
+    }
+    syncObstacles();
+    // Candidate poses of the held part: on top of each matching part, every symmetric way.
+    std::vector<Candidate> candidates;
+    Matches matches;
+    const auto addPlacements = [&](const std::string& name, const world::Pose& support, double lift) {
+      for (std::size_t h = 0; h < held_object->symmetries.size(); ++h) {
+        world::Pose held_symmetry = world::Pose::Identity();
+        held_symmetry.linear() = held_object->symmetries[h];
+        Candidate candidate;
+        candidate.object = name;
+        candidate.symmetry = static_cast<int>(h);
+        candidate.goal = support * up(lift) * held_symmetry * held_grasp_;
+        candidates.push_back(std::move(candidate));
+      }
+    };
+    if (!target.empty()) {
+      const auto frame = world_.worldPose(target);
+      if (!frame) {
+        return failed("unknown frame '" + target + "'");
+      }
+      addPlacements(target, *frame, held_object->rest_height + config_.place_clearance);
+    } else {
+      const world::ObjectClass* support = objectClass(target_class);
+      matches = matching(target_class, patterns, *held_);
+      for (const auto& [name, pose] : matches.objects) {
+        for (const Eigen::Matrix3d& symmetry : support->symmetries) {
+          world::Pose frame = pose;
+          frame.linear() = pose.linear() * symmetry;
+          if (frame.linear().col(2).z() < 0.98) {
+            continue;  // only the part's top side faces up
+          }
+          addPlacements(name, frame,
+                        support->bounds().max().z() - held_object->bounds().min().z() + config_.place_clearance);
+        }
+      }
+    }
+    const FeasibilityCheck feasible = [&](Candidate& candidate) -> std::string {
+      allowGripperContact(candidate.object, true);
+      struct Restore {
+        SmartMoveComponent& self;
+        std::string object;
+        ~Restore() { self.allowGripperContact(object, false); }
+      } restore{*this, candidate.object};
+      std::string reason;
+      const auto goal = freeConfiguration(candidate.solutions, collisions_, reason);
+      if (!goal) {
+        return "collision at the goal: " + reason;
+      }
+      const world::Pose above = up(params.at("approach").asDouble()) * candidate.goal;
+      const auto pre = freeConfiguration(arm_.solutions(above, *goal), collisions_, reason);
+      if (!pre) {
+        return "no reachable, collision-free point above: " + (reason.empty() ? "no IK solution" : reason);
+      }
+      const arm::MotionPlan line = arm_.planLine(*pre, candidate.goal, config_.approach_speed);
+      if (!line.ok()) {
+        return "no straight way down: " + line.failure;
+      }
+      const arm::MotionPlan path = arm_.planToJoints(arm_.joints(), *pre, speed);
+      return path.ok() ? std::string() : "no path: " + path.failure;
+    };
+    Selection selection = selectAmong(std::move(candidates), armModel(), config_.weights, feasible);
+    addRejected(selection, matches);
+    nlohmann::json data = selection.toJson();
+    if (!selection.ok()) {
+      return failed("no feasible place for " + *held_ + ": " + selection.failure, data);
+    }
+    const Candidate chosen = selection.best();
+    const double approach = params.at("approach").asDouble();
+    const std::string released = *held_;
+    const std::string support_object = chosen.object;
+    std::vector<Script::Step> steps;
+    steps.push_back({"move above " + support_object,
+                     [this, chosen, approach, speed] {
+                       std::string reason;
+                       const auto pre = freeConfiguration(
+                           arm_.solutions(up(approach) * chosen.goal, chosen.solutions.front()), collisions_, reason);
+                       return arm_.execute(
+                           pre ? arm_.planToJoints(*pre, speed)
+                               : arm::MotionPlan{nullptr, {}, "no collision-free point above: " + reason},
+                           "above the place");
+                     },
+                     nullptr});
+    steps.push_back({"lower onto " + support_object,
+                     [this, chosen, support_object] {
+                       allowGripperContact(support_object, true);
+                       return arm_.execute(arm_.planLine(chosen.goal, config_.approach_speed), "lower");
+                     },
+                     nullptr});
+    steps.push_back({"release " + released,
+                     [this] {
+                       return std::make_unique<ComponentStep>(gripper_, "Open", component::ParamMap{{"speed", 0.1}});
+                     },
+                     [this](const OperationResult&) -> std::string {
+                       held_.reset();
+                       return {};
+                     }});
+    steps.push_back({"lift away",
+                     [this, approach] {
+                       return arm_.execute(arm_.planLine(up(approach) * arm_.endpoint(), config_.approach_speed),
+                                           "retreat");
+                     },
+                     nullptr});
+    return std::make_unique<Script>(std::move(steps), data,
+                                    [this, support_object](bool) { allowGripperContact(support_object, false); });
+  }
+
+  if (operation == "TeachGrasp") {
+    const std::string object_class = text("object_class");
+    const world::ObjectClass* object = objectClass(object_class);
+    const world::Pose tool = arm_.endpoint();
+    std::optional<std::pair<std::string, world::Pose>> nearest;
+    for (const auto& [name, pose] : matching(object_class, {}).objects) {
+      if ((pose.translation() - tool.translation()).norm() < 0.1 &&
+          (!nearest || (pose.translation() - tool.translation()).norm() <
+                           (nearest->second.translation() - tool.translation()).norm())) {
+        nearest = {name, pose};
+      }
+    }
+    if (object == nullptr || !nearest) {
+      return failed("no " + object_class +
+                    " within 10 cm of the gripper: detect the parts, then put the gripper "
+                    "around one");
+    }
+    const world::Pose relative = snapToCanonical(nearest->second.inverse() * tool, *object);
+    try {
+      grasps_.teach({object_class, text("grasp"), relative});
+    } catch (const std::exception& e) {
+      return failed(std::string("cannot save the grasp: ") + e.what());
+    }
+    const Eigen::Vector3d& p = relative.translation();
+    return std::make_unique<component::FinishedOperation>(
+        OperationResult::success({{"object", nearest->first}, {"position", {p.x(), p.y(), p.z()}}}));
+  }
+  return failed("unknown operation " + operation);
+}
+
+}  // namespace costar::smartmove

@@ -1,0 +1,110 @@
+#pragma once
+// SmartMove (the paper, Sec. IV-C and Algorithm 2): operations that select their goal from the
+// world state instead of coordinates in the plan.
+//
+//   SmartMove(object_class, predicates, grasp)    moves the tool to the cheapest feasible goal
+//                                                 o * s * T over matching objects o, symmetries
+//                                                 s of their class, and the class's grasp T
+//   SmartGrasp(object_class, predicates, grasp)   the same goal, reached from a pre-grasp
+//                                                 `approach` back along the tool axis by a
+//                                                 straight line; closes; checks the part is held;
+//                                                 lifts `retreat` straight up
+//   SmartRelease(target_class | target, predicates) puts the held part on top of a matching
+//                                                 object (or at a frame), lowering onto it in a
+//                                                 straight line, opens, lifts
+//   TeachGrasp(object_class, grasp)               stores the tool's pose relative to the nearest
+//                                                 part of the class as a named grasp
+//
+// `predicates` is a ';'-separated list like "right_of(table_center); near(node_1)": each is
+// applied to the object (as its first argument, or where "?" stands). The result of every
+// operation lists every candidate with its cost or the reason it was rejected.
+// Predicate: holding(o) — the gripper holds part o (grasped by SmartGrasp, and still squeezing).
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "arm/arm_component.h"
+#include "component/component.h"
+#include "planning/collision_world.h"
+#include "predicator/predicator.h"
+#include "smartmove/grasps.h"
+#include "smartmove/selection.h"
+#include "world/object_class.h"
+#include "world/world_state.h"
+
+namespace costar::smartmove {
+
+struct SmartMoveConfig {
+  std::string name = "smartmove";
+  double approach = 0.10;          // m, default of the operations' approach parameter
+  double retreat = 0.10;           // m, straight up after grasping or releasing
+  double default_speed = 0.5;      // fraction of the arm's top speed
+  double approach_speed = 0.15;    // fraction, for the straight approach and retreat
+  double place_clearance = 0.004;  // m between the part and its support when released
+  /// Robot links that may touch the part being grasped (the gripper).
+  std::vector<std::string> gripper_links = {"tool0", "wrist_3_link"};
+  CostWeights weights;
+};
+
+/// Parses "right_of(table_center); near(node_1)" into patterns with "?" for the object.
+/// @throws std::invalid_argument naming the problem.
+std::vector<predicator::Pattern> parsePredicateList(const std::string& text);
+
+/// Obstacle name of a known part in the collision world.
+std::string partObstacle(const std::string& object);
+
+class SmartMoveComponent final : public component::LocalComponent {
+ public:
+  /// Everything passed by reference must outlive the component.
+  SmartMoveComponent(arm::ArmComponent& arm, component::Component& gripper, world::WorldState& world,
+                     planning::CollisionWorld& collisions, std::vector<world::ObjectClass> classes,
+                     GraspLibrary& grasps, SmartMoveConfig config = {});
+
+  const component::ComponentDescription& description() const override { return description_; }
+  world::Report report() const override;
+
+  /// Puts every known part (symbols classified by is_a) in the collision world as a box, and
+  /// removes parts that are gone; the part held is left out. Call before planning (the
+  /// workcell does it before every tick).
+  void syncObstacles();
+
+  /// The part held since the last SmartGrasp, if the gripper still holds something.
+  const std::optional<std::string>& held() const { return held_; }
+
+  /// Objects of a class that satisfy every pattern, with the patterns that others fail.
+  struct Matches {
+    std::vector<std::pair<std::string, world::Pose>> objects;
+    std::vector<std::pair<std::string, std::string>> rejected;  // object, reason
+  };
+  Matches matching(const std::string& object_class, const std::vector<predicator::Pattern>& patterns,
+                   const std::string& exclude = {}) const;
+
+  /// The candidate search of SmartMove (approach 0) and SmartGrasp (no motion).
+  Selection selectGrasp(const std::string& object_class, const std::vector<predicator::Pattern>& patterns,
+                        const world::Pose& grasp, double approach, double speed);
+
+ private:
+  std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
+                                                     const component::ParamMap& params) override;
+  const world::ObjectClass* objectClass(const std::string& name) const;
+  ArmModel armModel() const;
+  void allowGripperContact(const std::string& object, bool allowed);
+
+  friend class SmartStep;
+  component::ComponentDescription description_;
+  arm::ArmComponent& arm_;
+  component::Component& gripper_;
+  world::WorldState& world_;
+  planning::CollisionWorld& collisions_;
+  std::vector<world::ObjectClass> classes_;
+  GraspLibrary& grasps_;
+  SmartMoveConfig config_;
+
+  std::optional<std::string> held_;
+  std::string held_class_;
+  world::Pose held_grasp_ = world::Pose::Identity();  // the TCP in the held part's frame
+  std::vector<std::string> obstacles_;
+};
+
+}  // namespace costar::smartmove

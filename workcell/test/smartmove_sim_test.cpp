@@ -1,0 +1,119 @@
+// SmartGrasp / SmartRelease / SmartMove in the simulated cell, apart from perception: a TEST
+// ONLY oracle reports the true part poses as symbols. Success is judged from the simulator's
+// true state.
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "bt/builder.h"
+#include "bt/executor.h"
+#include "bt/plan_xml.h"
+#include "core/paths.h"
+#include "sim/simulation.h"
+#include "workcell/workcell.h"
+
+namespace costar::workcell {
+namespace {
+
+class SmartMoveSim : public ::testing::Test {
+ protected:
+  void open(const std::string& scene_json) {
+    const auto scene = std::filesystem::temp_directory_path() / "costar_smartmove_scene.json";
+    std::ofstream(scene) << scene_json;
+    cell = makeWorkcell({.name = "ur5-sim", .scene = scene, .memory_only = true, .test_oracle_perception = true});
+  }
+
+  bt::RunResult run(const std::string& body) {
+    const auto plan = bt::loadPlanText(
+        R"x(<root BTCPP_format="4"><BehaviorTree ID="main">)x" + body + "</BehaviorTree></root>", "test.xml");
+    bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
+    bt::Executor executor(tree, cell->clock(), {.time_limit = std::chrono::seconds(60)});
+    executor.setBeforeTick([this] { cell->beforeTick(); });
+    return executor.run();
+  }
+
+  sim::PartState part(const std::string& name) {
+    for (const auto& state : cell->simulation()->parts()) {
+      if (state.name == name) {
+        return state;
+      }
+    }
+    ADD_FAILURE() << "no part " << name;
+    return {};
+  }
+
+  std::unique_ptr<Workcell> cell;
+};
+
+TEST_F(SmartMoveSim, GraspsTheNodeThePredicatesSelectAndLiftsIt) {
+  open(R"x({"parts": [{"class": "node", "color": "red", "at": [0.45, -0.2, 25]},
+                     {"class": "node", "color": "blue", "at": [0.5, 0.2, -40]}]})x");
+  const bt::RunResult result =
+      run(R"x(<SmartGrasp object_class="node" predicates="left_of(table_center)" grasp="top"/>)x");
+  ASSERT_EQ(result.status, bt::Status::kSuccess) << result.failure_path << ": " << result.failure_reason;
+  EXPECT_GT(part("node_1").pose.translation().z(), 0.1);  // the left one is up in the gripper
+  EXPECT_LT(part("node_0").pose.translation().z(), 0.03);
+  cell->beforeTick();
+  EXPECT_TRUE(cell->components().world().holds("holding", std::vector<std::string>{"node_1"}));
+  EXPECT_EQ(cell->simulation()->armTableContactSteps(), 0u);
+}
+
+TEST_F(SmartMoveSim, StacksANodeOnAnotherAndALinkOnANode) {
+  open(R"x({"parts": [{"class": "node", "color": "red", "at": [0.45, -0.25, 0]},
+                     {"class": "node", "color": "blue", "at": [0.5, 0.2, 30]},
+                     {"class": "link", "color": "wood", "at": [0.4, -0.1, 70]}]})x");
+  // The link on the left node, then the right node on top of the link.
+  const bt::RunResult result = run(R"x(<Sequence>
+      <SmartGrasp object_class="link" grasp="middle"/>
+      <SmartRelease target_class="node" predicates="left_of(table_center)"/>
+      <SmartGrasp object_class="node" predicates="right_of(table_center)"/>
+      <SmartRelease target_class="link"/>
+      <Home/></Sequence>)x");
+  ASSERT_EQ(result.status, bt::Status::kSuccess) << result.failure_path << ": " << result.failure_reason;
+  cell->simulation()->stepTo(cell->simulation()->time() + std::chrono::seconds(1));
+  const auto base = part("node_1");
+  const auto link = part("link_0");
+  const auto top = part("node_0");
+  EXPECT_NEAR(link.pose.translation().z(), 0.05 + 0.0125, 0.004);
+  EXPECT_LT((link.pose.translation() - base.pose.translation()).head<2>().norm(), 0.01);
+  EXPECT_NEAR(top.pose.translation().z(), 0.075 + 0.025, 0.005);
+  EXPECT_LT((top.pose.translation() - base.pose.translation()).head<2>().norm(), 0.015);
+  cell->beforeTick();
+  EXPECT_TRUE(cell->components().world().holds("on", std::vector<std::string>{"link_0", "node_1"}));
+  EXPECT_TRUE(cell->components().world().holds("on", std::vector<std::string>{"node_0", "link_0"}));
+}
+
+TEST_F(SmartMoveSim, NoMatchingPartFailsWithTheReasonsOfEveryCandidate) {
+  open(R"x({"parts": [{"class": "node", "color": "red", "at": [0.45, -0.2, 0]},
+                     {"class": "node", "color": "blue", "at": [0.95, 0.45, 0]}]})x");
+  const bt::RunResult none =
+      run(R"x(<SmartGrasp object_class="node" predicates="left_of(table_center); behind(table_center)"/>)x");
+  ASSERT_EQ(none.status, bt::Status::kFailure);
+  EXPECT_NE(none.failure_reason.find("no feasible node"), std::string::npos) << none.failure_reason;
+  EXPECT_NE(none.failure_reason.find("predicate false"), std::string::npos) << none.failure_reason;
+  const bt::RunResult far = run(R"x(<SmartMove object_class="node" predicates="left_of(table_center)"/>)x");
+  ASSERT_EQ(far.status, bt::Status::kFailure);  // the blue node is out of the arm's reach
+  EXPECT_NE(far.failure_reason.find("no IK solution"), std::string::npos) << far.failure_reason;
+  EXPECT_EQ(run(R"x(<SmartRelease target_class="node"/>)x").failure_reason,
+            "nothing to release: no part was grasped with SmartGrasp");
+}
+
+TEST_F(SmartMoveSim, APlanNamingAnUnknownClassOrBadPredicatesFailsValidation) {
+  open(R"x({"parts": []})x");
+  const auto problems = [this](const std::string& body) {
+    return bt::validatePlan(
+        bt::loadPlanText(R"x(<root BTCPP_format="4"><BehaviorTree ID="m">)x" + body + "</BehaviorTree></root>",
+                         "v.xml"),
+        cell->nodes());
+  };
+  auto found = problems(R"x(<SmartGrasp object_class="gear"/>)x");
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_NE(found[0].message.find("'gear' is not one of: link, node"), std::string::npos) << found[0].message;
+  found = problems(R"x(<SmartGrasp object_class="node" predicates="left_of(table_center"/>)x");
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_NE(found[0].message.find("must look like name(arg"), std::string::npos) << found[0].message;
+}
+
+}  // namespace
+}  // namespace costar::workcell
