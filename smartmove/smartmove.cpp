@@ -187,9 +187,15 @@ SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Compon
   ParamSpec predicates{"predicates", ValueType::kString,
                        "conditions on the part, e.g. right_of(table_center); near(node_1)", std::string()};
   predicates.choices_from = "predicate";
-  predicates.validate = [](std::string_view text) -> std::string {
+  predicates.validate = [check = pattern_check_](std::string_view text) -> std::string {
     try {
-      parsePredicateList(std::string(text));
+      for (const auto& pattern : parsePredicateList(std::string(text))) {
+        if (*check) {
+          if (std::string problem = (*check)(pattern); !problem.empty()) {
+            return problem;
+          }
+        }
+      }
       return {};
     } catch (const std::invalid_argument& e) {
       return e.what();

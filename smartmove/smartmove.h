@@ -20,6 +20,8 @@
 // operation lists every candidate with its cost or the reason it was rejected.
 // Predicate: holding(o) — the gripper holds part o (grasped by SmartGrasp, and still squeezing).
 
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -54,6 +56,10 @@ std::vector<predicator::Pattern> parsePredicateList(const std::string& text);
 /// Obstacle name of a known part in the collision world.
 std::string partObstacle(const std::string& object);
 
+/// Checks one predicate pattern of a plan before it runs (known predicate, right number of
+/// arguments, known reference frames): empty when fine, else the problem.
+using PatternCheck = std::function<std::string(const predicator::Pattern&)>;
+
 class SmartMoveComponent final : public component::LocalComponent {
  public:
   /// Everything passed by reference must outlive the component.
@@ -68,6 +74,10 @@ class SmartMoveComponent final : public component::LocalComponent {
   /// removes parts that are gone; the part held is left out. Call before planning (the
   /// workcell does it before every tick).
   void syncObstacles();
+
+  /// Sets what plan validation checks of each predicate pattern (the workcell knows which
+  /// predicates are declared and which frames exist). Call before the node types are made.
+  void setPatternCheck(PatternCheck check) { *pattern_check_ = std::move(check); }
 
   /// The part held since the last SmartGrasp, if the gripper still holds something.
   const std::optional<std::string>& held() const { return held_; }
@@ -105,6 +115,7 @@ class SmartMoveComponent final : public component::LocalComponent {
   std::string held_class_;
   world::Pose held_grasp_ = world::Pose::Identity();  // the TCP in the held part's frame
   std::vector<std::string> obstacles_;
+  std::shared_ptr<PatternCheck> pattern_check_ = std::make_shared<PatternCheck>();
 };
 
 }  // namespace costar::smartmove

@@ -112,6 +112,7 @@ class Ur5SimWorkcell final : public Workcell {
     components().add(smartmove_);
     // Last: it derives its predicates from what the others report.
     components().add(std::make_shared<predicator::Predicator>(components().world(), simulation_->objectClasses()));
+    smartmove_->setPatternCheck([this](const predicator::Pattern& pattern) { return checkPattern(pattern); });
     registerNodes();
     smartmove_->syncObstacles();
   }
@@ -119,6 +120,34 @@ class Ur5SimWorkcell final : public Workcell {
   void beforeTick() override {
     Workcell::beforeTick();
     smartmove_->syncObstacles();
+  }
+
+  /// A plan's predicate pattern names a declared predicate with the right number of arguments,
+  /// and its other arguments are frames that exist now (fixed frames, waypoints) or object
+  /// classes; names of detected parts are not known before the plan runs and are refused.
+  std::string checkPattern(const predicator::Pattern& pattern) {
+    const auto& declared = components().predicates();
+    const auto it = declared.find(pattern.predicate);
+    if (it == declared.end()) {
+      std::string known;
+      for (const auto& [name, decl] : declared) {
+        known += (known.empty() ? "" : ", ") + name;
+      }
+      return "unknown predicate '" + pattern.predicate + "' (known: " + known + ")";
+    }
+    if (pattern.args.size() != it->second.arity) {
+      return "predicate '" + pattern.predicate + "' takes " + std::to_string(it->second.arity) + " argument(s), " +
+             std::to_string(pattern.args.size()) + " given (the part counts as one)";
+    }
+    components().refreshWorld();
+    for (const auto& arg : pattern.args) {
+      const bool is_class = std::any_of(simulation_->objectClasses().begin(), simulation_->objectClasses().end(),
+                                        [&arg](const world::ObjectClass& c) { return c.name == arg; });
+      if (arg != "?" && !is_class && components().world().symbol(arg) == nullptr) {
+        return "unknown reference frame '" + arg + "' in " + pattern.predicate + "(...)";
+      }
+    }
+    return {};
   }
 
   std::string name() const override { return "ur5-sim"; }

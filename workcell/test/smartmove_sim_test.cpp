@@ -113,6 +113,17 @@ TEST_F(SmartMoveSim, APlanNamingAnUnknownClassOrBadPredicatesFailsValidation) {
   found = problems(R"x(<SmartGrasp object_class="node" predicates="left_of(table_center"/>)x");
   ASSERT_EQ(found.size(), 1u);
   EXPECT_NE(found[0].message.find("must look like name(arg"), std::string::npos) << found[0].message;
+  found = problems(R"x(<SmartGrasp object_class="node" predicates="leftof(table_center)"/>)x");
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_NE(found[0].message.find("unknown predicate 'leftof'"), std::string::npos) << found[0].message;
+  found = problems(R"x(<SmartGrasp object_class="node" predicates="left_of(table_centre)"/>)x");
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_NE(found[0].message.find("unknown reference frame 'table_centre'"), std::string::npos) << found[0].message;
+  found = problems(R"x(<SmartGrasp object_class="node" predicates="near"/>)x");
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_NE(found[0].message.find("takes 2 argument(s), 1 given"), std::string::npos) << found[0].message;
+  EXPECT_TRUE(
+      problems(R"x(<SmartGrasp object_class="node" predicates="right_of(table_center); is_a(node)"/>)x").empty());
 }
 
 }  // namespace

@@ -1,0 +1,122 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "core/paths.h"
+#include "smartmove/grasps.h"
+#include "smartmove/selection.h"
+#include "smartmove/smartmove.h"
+
+namespace costar::smartmove {
+namespace {
+
+world::ObjectClass loadClass(const std::string& name) {
+  return world::loadObjectClass(dataRoot() / "data/objects" / (name + ".json"));
+}
+
+TEST(PredicateList, ObjectIsTheFirstArgumentUnlessAWildcardSaysOtherwise) {
+  const auto patterns = parsePredicateList(" right_of(table_center) ; on(node_1, ?);is_a(node)  ;");
+  ASSERT_EQ(patterns.size(), 3u);
+  EXPECT_EQ(patterns[0].predicate, "right_of");
+  EXPECT_EQ(patterns[0].args, (std::vector<std::string>{"?", "table_center"}));
+  EXPECT_EQ(patterns[1].args, (std::vector<std::string>{"node_1", "?"}));
+  EXPECT_EQ(patterns[2].args, (std::vector<std::string>{"?", "node"}));
+  EXPECT_TRUE(parsePredicateList("").empty());
+  EXPECT_EQ(parsePredicateList("gripper_open")[0].args, std::vector<std::string>{"?"});
+  EXPECT_THROW(parsePredicateList("left_of(table_center"), std::invalid_argument);
+  EXPECT_THROW(parsePredicateList("near(?, ?)"), std::invalid_argument);
+  EXPECT_THROW(parsePredicateList("left of(x)"), std::invalid_argument);
+  EXPECT_THROW(parsePredicateList("near(a;b)"), std::invalid_argument);
+}
+
+TEST(Grasps, ATeachingOnATurnedPartSnapsToTheSameCanonicalGrasp) {
+  const world::ObjectClass node = loadClass("node");
+  const world::Pose canonical = world::poseFromXyzRpy(0, 0, 0.005, M_PI, 0, 0);
+  for (const Eigen::Matrix3d& symmetry : node.symmetries) {
+    // The same physical grasp, seen from the node's frame turned by a symmetry.
+    world::Pose turned = world::Pose::Identity();
+    turned.linear() = symmetry;
+    const world::Pose taught = turned.inverse() * canonical;
+    const world::Pose snapped = snapToCanonical(taught, node);
+    EXPECT_TRUE(snapped.isApprox(canonical, 1e-9));
+  }
+}
+
+TEST(Grasps, TaughtGraspsOverrideDefaultsAndPersist) {
+  const auto file = std::filesystem::temp_directory_path() / "costar_grasps_test.json";
+  std::filesystem::remove(file);
+  {
+    GraspLibrary library(dataRoot() / "data/grasps.json", file);
+    ASSERT_TRUE(library.find("node", "top").has_value());
+    EXPECT_FALSE(library.find("node", "side").has_value());
+    library.teach({"node", "side", world::poseFromXyzRpy(0.03, 0, 0, 0, -M_PI / 2, 0)});
+    library.teach({"node", "top", world::poseFromXyzRpy(0, 0, 0.01, M_PI, 0, 0)});
+  }
+  GraspLibrary reloaded(dataRoot() / "data/grasps.json", file);
+  EXPECT_NEAR(reloaded.find("node", "top")->tcp_in_object.translation().z(), 0.01, 1e-12);
+  EXPECT_TRUE(reloaded.find("node", "side").has_value());
+  EXPECT_EQ(reloaded.forClass("node").size(), 2u);
+  std::filesystem::remove(file);
+}
+
+/// An arm that reaches goals with x < 0.6; "joints" encode the goal for the cost.
+ArmModel fakeArm() {
+  ArmModel arm;
+  arm.solutions = [](const world::Pose& goal) -> std::vector<arm::JointVector> {
+    if (goal.translation().x() >= 0.6) {
+      return {};
+    }
+    return {{goal.translation().x(), goal.translation().y(), 0, 0, 0, 0}};
+  };
+  arm.tool = world::poseFromXyzRpy(0.2, 0, 0.3, M_PI, 0, 0);
+  arm.joints = {0.2, 0, 0, 0, 0, 0};
+  return arm;
+}
+
+TEST(Selection, ChecksInOrderOfCostAndStopsAtTheFirstFeasible) {
+  const world::ObjectClass node = loadClass("node");
+  const std::vector<std::pair<std::string, world::Pose>> objects = {
+      {"near_but_blocked", world::Pose(Eigen::Translation3d(0.25, 0, 0.025))},
+      {"middle", world::Pose(Eigen::Translation3d(0.4, 0.1, 0.025))},
+      {"far_away", world::Pose(Eigen::Translation3d(0.9, 0, 0.025))}};
+  int checks = 0;
+  const Selection selection =
+      selectGoal(objects, node, world::poseFromXyzRpy(0, 0, 0.005, M_PI, 0, 0), fakeArm(), {},
+                 [&checks](Candidate& candidate) -> std::string {
+                   ++checks;
+                   return candidate.object == "near_but_blocked" ? "collision at the goal: x" : "";
+                 });
+  ASSERT_TRUE(selection.ok());
+  EXPECT_EQ(selection.best().object, "middle");
+  EXPECT_EQ(selection.candidates.size(), 72u);  // 3 objects x 24 symmetries
+  // The top-down ones of the nearest node were checked first and failed.
+  EXPECT_LE(checks, 24 + 1);
+  int unreachable = 0;
+  int not_checked = 0;
+  for (const Candidate& candidate : selection.candidates) {
+    unreachable += candidate.object == "far_away" ? 1 : 0;
+    if (candidate.object == "far_away") {
+      EXPECT_EQ(candidate.rejected, "no IK solution: out of reach or beyond the joint limits");
+    }
+    not_checked += candidate.rejected == "not checked: a cheaper candidate works" ? 1 : 0;
+  }
+  EXPECT_EQ(unreachable, 24);
+  EXPECT_GT(not_checked, 0);
+  // The chosen goal approaches from above: least tilt among the node's symmetric goals.
+  EXPECT_NEAR(selection.best().goal.linear().col(2).z(), -1.0, 1e-9);
+  const nlohmann::json json = selection.toJson();
+  EXPECT_EQ(json.at("chosen"), "middle");
+  EXPECT_EQ(json.at("candidates").size(), 72u);
+}
+
+TEST(Selection, WithNothingFeasibleTheFailureCountsTheReasons) {
+  const world::ObjectClass link = loadClass("link");
+  const Selection selection = selectGoal(
+      {{"link_1", world::Pose(Eigen::Translation3d(0.9, 0, 0.0125))}, {"link_2", world::Pose::Identity()}}, link,
+      world::Pose::Identity(), fakeArm(), {}, [](Candidate&) { return std::string("collision at the goal: y"); });
+  EXPECT_FALSE(selection.ok());
+  EXPECT_EQ(selection.failure, "16 candidates, none feasible (8 collision at the goal, 8 no IK solution)");
+}
+
+}  // namespace
+}  // namespace costar::smartmove
