@@ -59,7 +59,7 @@ Waypoint fromJson(const nlohmann::json& json) {
 
 }  // namespace
 
-WaypointStore::WaypointStore(std::filesystem::path file) : file_(std::move(file)) {
+WaypointStore::WaypointStore(std::filesystem::path file, bool persist) : file_(std::move(file)), persist_(persist) {
   if (file_.empty() || !std::filesystem::exists(file_)) {
     return;
   }
@@ -143,7 +143,7 @@ void WaypointStore::rename(const std::string& from, const std::string& to) {
 }
 
 void WaypointStore::save() const {
-  if (file_.empty()) {
+  if (file_.empty() || !persist_) {
     return;
   }
   nlohmann::json json = {{"waypoints", nlohmann::json::array()}};

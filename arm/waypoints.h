@@ -29,9 +29,10 @@ std::string checkWaypointName(const std::string& name);
 
 class WaypointStore {
  public:
-  /// Loads `file` if it exists (an empty store otherwise). An empty path keeps waypoints in
-  /// memory only. @throws std::runtime_error naming the file when it cannot be read.
-  explicit WaypointStore(std::filesystem::path file = {});
+  /// Loads `file` if it exists (an empty store otherwise). Changes are saved to it when
+  /// `persist`; an empty path or persist = false keeps changes in memory only.
+  /// @throws std::runtime_error naming the file when it cannot be read.
+  explicit WaypointStore(std::filesystem::path file = {}, bool persist = true);
 
   std::optional<Waypoint> find(const std::string& name) const;
   std::vector<Waypoint> all() const;
@@ -47,6 +48,7 @@ class WaypointStore {
  private:
   void save() const;
   std::filesystem::path file_;
+  bool persist_ = true;
   std::map<std::string, Waypoint> waypoints_;
 };
 

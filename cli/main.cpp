@@ -6,6 +6,7 @@
 #include "cli/plan_commands.h"
 #include "cli/sim_commands.h"
 #include "cli/teach_command.h"
+#include "cli/trials_command.h"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -18,6 +19,7 @@ int main(int argc, char** argv) {
   costar::cli::addSimCommands(app, exit_code);
   costar::cli::addPerceptionCommands(app, exit_code);
   costar::cli::addTeachCommand(app, exit_code);
+  costar::cli::addTrialsCommand(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

@@ -20,6 +20,8 @@ PACKAGES=(
   libmujoco-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
   # arm kinematics from URDF (Orocos KDL), collision checking (FCL), motion planning (OMPL)
   liborocos-kdl-dev libkdl-parser-dev liburdfdom-dev libfcl-dev libompl-dev
+  # plots of trial results
+  libcairo2-dev
 )
 
 SUDO=""

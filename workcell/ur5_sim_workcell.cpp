@@ -84,9 +84,10 @@ class Ur5SimWorkcell final : public Workcell {
         robot_(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp")),
         collisions_(robot_, kBaseInWorld, {.padding = 0.005, .resolution = 0.01},
                     {toEigen(sim::Simulation::homeConfiguration())}),
-        waypoints_(options.memory_only
-                       ? std::filesystem::path()
-                       : (options.waypoints.empty() ? defaultWaypointFile("ur5-sim") : options.waypoints)),
+        waypoints_(!options.waypoints.empty()
+                       ? options.waypoints
+                       : (options.memory_only ? std::filesystem::path() : defaultWaypointFile("ur5-sim")),
+                   /*persist=*/!options.memory_only),
         grasps_(dataRoot() / "data/grasps.json",
                 options.memory_only ? std::filesystem::path() : defaultGraspFile("ur5-sim")) {
     simulation_->attach(static_cast<SimClock&>(clock()));

@@ -29,7 +29,8 @@ struct WorkcellOptions {
   /// Where taught waypoints are kept (default: $XDG_STATE_HOME or ~/.local/state, then
   /// costar/<workcell>/waypoints.json). Empty string in `memory_only` mode.
   std::filesystem::path waypoints;
-  /// Keep waypoints and taught grasps in memory only (tests).
+  /// Never write waypoints or taught grasps (tests, trials): the waypoint file, if given, is
+  /// read only.
   bool memory_only = false;
   /// TEST ONLY: report the simulator's true part poses as object symbols in place of
   /// perception, to test SmartMove apart from perception. Never set by the CLI.

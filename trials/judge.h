@@ -1,0 +1,36 @@
+#pragma once
+// Judges of the paper's evaluation tasks: each decides success from the simulator's TRUE final
+// state (part poses, contacts), never from what the plan believes.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "sim/simulation.h"
+
+namespace costar::trials {
+
+struct Verdict {
+  bool success = false;
+  std::string reason;  // why not (or what was achieved)
+};
+
+/// Judges the end of a trial, given the parts as they were at its start.
+using Judge = std::function<Verdict(sim::Simulation& simulation, const std::vector<sim::PartState>& initial)>;
+
+struct JudgeInfo {
+  std::string name;
+  std::string description;
+};
+
+/// "lift" (task 1): some node is held at least 5 cm above the table by the fingers.
+/// "right_to_left" (task 2): at least two nodes that started right of table_center (y < 0)
+///   rest on the table left of it (y > 0.02).
+/// "assembly" (task 3): a node rests on the table left of table_center, a link rests on it
+///   (centred within 2 cm), a node rests on the link (centred within 2 cm), all at rest.
+/// "blind_place": node_0 rests within 1 cm of (0.45, 0.25) (examples/ur5/blind_pick_place.xml).
+std::vector<JudgeInfo> judges();
+/// @throws std::invalid_argument naming the known judges.
+Judge judge(const std::string& name);
+
+}  // namespace costar::trials

@@ -1,0 +1,73 @@
+#include "trials/trials.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "bt/plan.h"
+#include "core/paths.h"
+#include "trials/judge.h"
+
+namespace costar::trials {
+namespace {
+
+TrialOptions blind(int count, const std::string& judge) {
+  TrialOptions options;
+  options.plan = dataRoot() / "examples/ur5/blind_pick_place.xml";
+  options.scene = dataRoot() / "sim/scenes/one_node.json";
+  options.waypoints = dataRoot() / "examples/ur5/blind_waypoints.json";
+  options.judge = judge;
+  options.count = count;
+  options.seed = 5;
+  options.jobs = 2;
+  return options;
+}
+
+std::string contents(const std::filesystem::path& file) {
+  std::ifstream stream(file);
+  return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
+}
+
+TEST(Trials, RunJudgeAndSummarize) {
+  const std::string waypoints_before = contents(dataRoot() / "examples/ur5/blind_waypoints.json");
+  int calls = 0;
+  const Summary summary = runTrials(blind(2, "blind_place"), [&calls](const TrialResult&, int done) {
+    ++calls;
+    EXPECT_EQ(done, calls);
+  });
+  EXPECT_EQ(calls, 2);
+  EXPECT_EQ(summary.successes(), 2);
+  EXPECT_EQ(summary.trials[1].seed, 6u);
+  EXPECT_GT(summary.cycleTimes().at("median"), 5.0);  // simulated seconds of a real pick and place
+  const nlohmann::json json = summary.toJson();
+  EXPECT_EQ(json.at("success_rate"), 1.0);
+  EXPECT_EQ(json.at("results").size(), 2u);
+  const auto png = std::filesystem::temp_directory_path() / "costar_trials_test.png";
+  writePlot(summary, png);
+  EXPECT_GT(std::filesystem::file_size(png), 5000u);
+  std::filesystem::remove(png);
+  // Waypoints are read, never written (the plan moves through them; the file is unchanged).
+  EXPECT_EQ(contents(dataRoot() / "examples/ur5/blind_waypoints.json"), waypoints_before);
+}
+
+TEST(Trials, AJudgeThatDisagreesMakesAFailureWithItsReason) {
+  const Summary summary = runTrials(blind(1, "lift"));
+  EXPECT_EQ(summary.successes(), 0);
+  ASSERT_EQ(summary.failureHistogram().size(), 1u);
+  EXPECT_EQ(summary.failureHistogram()[0].first, "judge: no node is held # cm above the table");
+  EXPECT_NE(summary.text().find("0 of 1 trials succeeded"), std::string::npos);
+}
+
+TEST(Trials, BadInputIsRefusedBeforeAnyTrial) {
+  TrialOptions options = blind(1, "blind_place");
+  options.judge = "tidy";
+  EXPECT_THROW(runTrials(options), std::invalid_argument);
+  options = blind(1, "blind_place");
+  options.plan = dataRoot() / "cli/test/fixtures/invalid.xml";
+  EXPECT_THROW(runTrials(options), bt::PlanError);
+}
+
+}  // namespace
+}  // namespace costar::trials
