@@ -1,5 +1,7 @@
 #include "bt/executor.h"
 
+#include <algorithm>
+
 namespace costar::bt {
 
 Executor::Executor(Tree& tree, Clock& clock, ExecutorOptions options) : tree_(tree), clock_(clock), options_(options) {}
@@ -31,6 +33,14 @@ RunResult Executor::run() {
     if (before_tick_) {
       before_tick_();
     }
+    if (paused_.load()) {
+      if (steps_requested_.load() == 0) {
+        next_tick += options_.tick_period;
+        clock_.sleepUntil(std::max(next_tick, clock_.now()));
+        continue;  // paused: no tick, but time (and the robot) goes on
+      }
+      steps_requested_.fetch_sub(1);
+    }
     const Status status = tree_.tick();
     ++result.ticks;
     if (isCompleted(status)) {
@@ -42,7 +52,7 @@ RunResult Executor::run() {
       }
       break;
     }
-    if (context.takeImmediateTickRequest() && immediate_ticks < options_.max_immediate_ticks) {
+    if (context.takeImmediateTickRequest() && !paused_.load() && immediate_ticks < options_.max_immediate_ticks) {
       ++immediate_ticks;
       continue;
     }

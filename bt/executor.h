@@ -48,6 +48,12 @@ class Executor {
 
   /// Thread-safe: the run halts the tree at the next tick boundary and returns.
   void requestStop() { stop_requested_.store(true); }
+  /// Thread-safe: stops ticking the tree (operations already running go on: a Move finishes
+  /// its motion) until resume(); time goes on. step() while paused ticks exactly once.
+  void pause() { paused_.store(true); }
+  void resume() { paused_.store(false); }
+  void step() { steps_requested_.fetch_add(1); }
+  bool paused() const { return paused_.load(); }
 
  private:
   Tree& tree_;
@@ -55,6 +61,8 @@ class Executor {
   ExecutorOptions options_;
   std::function<void()> before_tick_;
   std::atomic<bool> stop_requested_{false};
+  std::atomic<bool> paused_{false};
+  std::atomic<int> steps_requested_{0};
 };
 
 }  // namespace costar::bt

@@ -72,6 +72,25 @@ TEST(Executor, StopFromAnotherThreadHaltsAndCancelsTheRunningOperation) {
   EXPECT_EQ(tree.root().status(), Status::kIdle);
 }
 
+TEST(Executor, PauseStopsTheTicksStepTicksOnceResumeGoesOn) {
+  testing::TestTree t(R"(<Sequence><TestLeaf name="a"/><TestLeaf name="b"/><TestLeaf name="c"/></Sequence>)");
+  Executor executor(t.tree, t.clock);
+  executor.pause();
+  int hooks = 0;
+  executor.setBeforeTick([&] {
+    ++hooks;
+    if (hooks == 5) {
+      EXPECT_TRUE(t.log.events.empty());  // paused: nothing ticked, time went on
+      executor.step();
+    }
+  });
+  const RunResult result = executor.run();
+  EXPECT_EQ(result.status, Status::kSuccess);
+  EXPECT_EQ(result.ticks, 1u);             // one tick: the step
+  EXPECT_EQ(t.log.count("c:success"), 1);  // it ran the whole (synchronous) tree
+  EXPECT_EQ(result.elapsed, 40ms);         // four paused periods went by first
+}
+
 TEST(Executor, BeforeTickHookRunsBeforeEveryTick) {
   testing::TestTree t(R"(<TestLeaf ticks="4"/>)");
   Executor executor(t.tree, t.clock);
