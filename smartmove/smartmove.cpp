@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace costar::smartmove {
@@ -214,7 +215,9 @@ SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Compon
   optional_classes.insert(optional_classes.begin(), "");
   ParamSpec target_class{"target_class", ValueType::kString, "put the part on a part of this class", std::string(),
                          optional_classes};
-  ParamSpec target{"target", ValueType::kString, "or put it down at this frame (e.g. a taught waypoint)",
+  ParamSpec target{"target", ValueType::kString,
+                   "or put it down at a frame (e.g. a taught waypoint), or 'table': a free spot on the table that "
+                   "satisfies the predicates",
                    std::string()};
   target.choices_from = "frame";
   description_.operations = {{"SmartMove",
@@ -400,6 +403,25 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
   return selection;
 }
 
+std::string SmartMoveComponent::spotFailsPattern(const Eigen::Vector3d& spot,
+                                                 const predicator::Pattern& pattern) const {
+  const auto relation = predicator::relationFromName(pattern.predicate);
+  const bool usable = relation && *relation != predicator::Relation::kOn && *relation != predicator::Relation::kAbove &&
+                      *relation != predicator::Relation::kBelow;
+  if (!usable || pattern.args.size() != 2 || pattern.args[0] != "?") {
+    return "only left_of, right_of, in_front_of, behind, near(?, frame) can choose a spot on the table: " +
+           pattern.predicate;
+  }
+  const auto reference = world_.worldPose(pattern.args[1]);
+  if (!reference) {
+    return "unknown frame '" + pattern.args[1] + "'";
+  }
+  const auto viewpoint = world_.worldPose("table_center");
+  const Eigen::Matrix3d axes = viewpoint ? Eigen::Matrix3d(viewpoint->linear()) : Eigen::Matrix3d::Identity();
+  const bool holds = predicator::relationHolds(*relation, {spot, {}}, {reference->translation(), {}}, axes, {});
+  return holds ? std::string() : pattern.predicate + " is false there";
+}
+
 std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& operation,
                                                             const component::ParamMap& params) {
   const auto text = [&params](const char* name) { return params.at(name).asString(); };
@@ -522,7 +544,65 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
         candidates.push_back(std::move(candidate));
       }
     };
-    if (!target.empty()) {
+    if (target == "table") {
+      // Free spots on the table that satisfy the predicates, clear of every known part.
+      const std::vector<std::pair<std::string, world::Pose>> others = [&] {
+        std::vector<std::pair<std::string, world::Pose>> parts;
+        for (const auto& object : classes_) {
+          for (const auto& entry : matching(object.name, {}, *held_).objects) {
+            parts.push_back(entry);
+          }
+        }
+        return parts;
+      }();
+      for (const auto& pattern : patterns) {
+        const std::string problem = spotFailsPattern(Eigen::Vector3d::Zero(), pattern);
+        if (problem.rfind("only ", 0) == 0 || problem.rfind("unknown frame", 0) == 0) {
+          return failed(problem);
+        }
+      }
+      const double held_radius = 0.5 * held_object->bounds().sizes().head<2>().norm();
+      const double step = config_.table_spot_step;
+      for (double x = config_.table_min.x(); x <= config_.table_max.x() + 1e-9; x += step) {
+        for (double y = config_.table_min.y(); y <= config_.table_max.y() + 1e-9; y += step) {
+          const Eigen::Vector3d spot(x, y, 0.0);
+          const bool clear =
+              std::all_of(others.begin(), others.end(), [&](const std::pair<std::string, world::Pose>& other) {
+                const world::ObjectClass* c = nullptr;
+                for (const auto& object : classes_) {
+                  if (world_.holds("is_a", std::vector<std::string>{other.first, object.name})) {
+                    c = &object;
+                  }
+                }
+                const double radius = c != nullptr ? 0.5 * c->bounds().sizes().head<2>().norm() : 0.05;
+                return (other.second.translation().head<2>() - spot.head<2>()).norm() > held_radius + radius + 0.02;
+              });
+          std::string failing;
+          for (const auto& pattern : patterns) {
+            failing = spotFailsPattern(spot, pattern);
+            if (!failing.empty()) {
+              break;
+            }
+          }
+          if (!clear || !failing.empty()) {
+            continue;
+          }
+          char name[48];
+          std::snprintf(name, sizeof name, "table(%.2f,%.2f)", x, y);
+          world::Pose frame = world::Pose::Identity();
+          frame.translation() = spot;
+          addPlacements(name, frame, held_object->rest_height + config_.place_clearance);
+        }
+      }
+      // Keep the held part's placements that rest it as it rests canonically (its z up).
+      std::erase_if(candidates, [this](const Candidate& candidate) {
+        const world::Pose part = candidate.goal * held_grasp_.inverse();
+        return part.linear().col(2).z() < 0.98;
+      });
+      if (candidates.empty()) {
+        return failed("no free spot on the table satisfies " + text("predicates"));
+      }
+    } else if (!target.empty()) {
       const auto frame = world_.worldPose(target);
       if (!frame) {
         return failed("unknown frame '" + target + "'");

@@ -10,8 +10,10 @@
 //                                                 straight line; closes; checks the part is held;
 //                                                 lifts `retreat` straight up
 //   SmartRelease(target_class | target, predicates) puts the held part on top of a matching
-//                                                 object (or at a frame), lowering onto it in a
-//                                                 straight line, opens, lifts
+//                                                 object (or at a frame, or with target="table"
+//                                                 at a free spot on the table that satisfies the
+//                                                 predicates), lowering onto it in a straight
+//                                                 line, opens, lifts
 //   TeachGrasp(object_class, grasp)               stores the tool's pose relative to the nearest
 //                                                 part of the class as a named grasp
 //
@@ -44,6 +46,10 @@ struct SmartMoveConfig {
   double default_speed = 0.5;      // fraction of the arm's top speed
   double approach_speed = 0.15;    // fraction, for the straight approach and retreat
   double place_clearance = 0.004;  // m between the part and its support when released
+  /// SmartRelease target="table": spots searched on this part of the table, this far apart.
+  Eigen::Vector2d table_min{0.30, -0.40};
+  Eigen::Vector2d table_max{0.70, 0.40};
+  double table_spot_step = 0.03;
   /// Robot links that may touch the part being grasped (the gripper).
   std::vector<std::string> gripper_links = {"tool0", "wrist_3_link"};
   CostWeights weights;
@@ -98,6 +104,8 @@ class SmartMoveComponent final : public component::LocalComponent {
   std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
                                                      const component::ParamMap& params) override;
   const world::ObjectClass* objectClass(const std::string& name) const;
+  /// Why a spot on the table does not satisfy `pattern` (empty if it does).
+  std::string spotFailsPattern(const Eigen::Vector3d& spot, const predicator::Pattern& pattern) const;
   ArmModel armModel() const;
   void allowGripperContact(const std::string& object, bool allowed);
 

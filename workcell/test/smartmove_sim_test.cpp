@@ -84,6 +84,25 @@ TEST_F(SmartMoveSim, StacksANodeOnAnotherAndALinkOnANode) {
   EXPECT_TRUE(cell->components().world().holds("on", std::vector<std::string>{"node_0", "link_0"}));
 }
 
+TEST_F(SmartMoveSim, PutsAPartDownOnAFreeSpotOfTheTableThatSatisfiesThePredicates) {
+  open(R"x({"parts": [{"class": "node", "color": "red", "at": [0.45, -0.25, 10]},
+                      {"class": "node", "color": "blue", "at": [0.45, 0.12, 0]}]})x");
+  const bt::RunResult result = run(R"x(<Sequence>
+      <SmartGrasp object_class="node" predicates="right_of(table_center)"/>
+      <SmartRelease target="table" predicates="left_of(table_center); behind(table_center)"/></Sequence>)x");
+  ASSERT_EQ(result.status, bt::Status::kSuccess) << result.failure_path << ": " << result.failure_reason;
+  cell->simulation()->stepTo(cell->simulation()->time() + std::chrono::seconds(1));
+  const auto moved = part("node_0");
+  EXPECT_GT(moved.pose.translation().y(), 0.02);            // left of table_center
+  EXPECT_LT(moved.pose.translation().x(), 0.48);            // behind it (nearer the robot)
+  EXPECT_NEAR(moved.pose.translation().z(), 0.025, 0.003);  // resting on the table
+  EXPECT_GT((moved.pose.translation() - part("node_1").pose.translation()).head<2>().norm(), 0.07);  // clear
+  EXPECT_EQ(run(R"x(<Sequence><SmartGrasp object_class="node" predicates="left_of(table_center)"/>
+      <SmartRelease target="table" predicates="on(table_center)"/></Sequence>)x")
+                .failure_reason,
+            "only left_of, right_of, in_front_of, behind, near(?, frame) can choose a spot on the table: on");
+}
+
 TEST_F(SmartMoveSim, NoMatchingPartFailsWithTheReasonsOfEveryCandidate) {
   open(R"x({"parts": [{"class": "node", "color": "red", "at": [0.45, -0.2, 0]},
                      {"class": "node", "color": "blue", "at": [0.95, 0.45, 0]}]})x");
