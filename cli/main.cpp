@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   costar::cli::addSimCommands(app, exit_code);
   costar::cli::addPerceptionCommands(app, exit_code);
   costar::cli::addTeachCommand(app, exit_code);
+  costar::cli::addSmartMoveCommands(app, exit_code);
   costar::cli::addTrialsCommand(app, exit_code);
   try {
     app.parse(argc, argv);

@@ -30,6 +30,10 @@ constexpr const char* kHelp = R"(commands:
   home                                go to the home configuration
   rename OLD NEW | delete NAME        manage waypoints
   open | close                        the gripper
+  detect                              detect the parts (DetectObjects)
+  objects                             the parts detected, with their poses
+  grasp CLASS NAME                    teach a grasp: the gripper is around a detected part of
+                                      CLASS now; SmartMove will grasp parts of CLASS like this
   snapshot FILE.png                   a picture of the cell (simulated cells)
   help | quit
 )";
@@ -129,6 +133,27 @@ bool handle(workcell::Workcell& cell, const std::string& line) {
     printWaypoints(cell);
   } else if (command == "home") {
     runNode(cell, "<Home/>");
+  } else if (command == "detect") {
+    runNode(cell, "<DetectObjects/>");
+  } else if (command == "objects") {
+    cell.beforeTick();
+    const auto& world = cell.components().world();
+    int count = 0;
+    for (const world::Predicate* is_a : world.predicates("is_a")) {
+      if (is_a->args.size() == 2) {
+        if (const auto pose = world.worldPose(is_a->args[0])) {
+          const auto& p = pose->translation();
+          std::printf("  %-12s %-6s at %.3f %.3f %.3f\n", is_a->args[0].c_str(), is_a->args[1].c_str(), p.x(), p.y(),
+                      p.z());
+          ++count;
+        }
+      }
+    }
+    if (count == 0) {
+      std::printf("  (no parts detected: try 'detect')\n");
+    }
+  } else if (command == "grasp" && w.size() == 3) {
+    runNode(cell, "<TeachGrasp object_class=\"" + escape(w[1]) + "\" grasp=\"" + escape(w[2]) + "\"/>");
   } else if (command == "open" || command == "close") {
     runNode(cell, command == "open" ? "<Open/>" : "<Close/>");
   } else if (command == "jog" && w.size() >= 3 && w[1] == "joint" && w.size() == 4) {
@@ -173,6 +198,43 @@ bool handle(workcell::Workcell& cell, const std::string& line) {
 }
 
 }  // namespace
+
+void addSmartMoveCommands(CLI::App& app, int& exit_code) {
+  CLI::App* smartmove = app.add_subcommand("smartmove", "SmartMove set-up");
+  smartmove->require_subcommand(1);
+  auto options = std::make_shared<workcell::WorkcellOptions>();
+  auto object_class = std::make_shared<std::string>();
+  auto grasp = std::make_shared<std::string>();
+  auto at = std::make_shared<std::string>();
+  CLI::App* teach = smartmove->add_subcommand(
+      "teach",
+      "Teach a grasp by demonstration: detect the parts, move the gripper around one (to a taught "
+      "waypoint), store how it holds the part");
+  teach->add_option("class", *object_class, "object class (e.g. node)")->required();
+  teach->add_option("name", *grasp, "name of the grasp (e.g. top)")->required();
+  teach->add_option("--at", *at, "a taught waypoint where the gripper is around a part")->required();
+  teach->add_option("-w,--workcell", options->name, "workcell")->capture_default_str();
+  teach->add_option("--scene", options->scene, "simulated workcells: scene file")->check(CLI::ExistingFile);
+  teach->add_option("--waypoints", options->waypoints, "waypoint file")->check(CLI::ExistingFile);
+  teach->callback([=, &exit_code] {
+    std::unique_ptr<workcell::Workcell> cell;
+    try {
+      cell = workcell::makeWorkcell(*options);
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      exit_code = 2;
+      return;
+    }
+    const bool ok = runNode(*cell, "<Sequence><Home/><DetectObjects/><Move waypoint=\"" + escape(*at) +
+                                       "\"/><TeachGrasp object_class=\"" + escape(*object_class) + "\" grasp=\"" +
+                                       escape(*grasp) + "\"/></Sequence>");
+    if (ok) {
+      std::printf("taught grasp '%s' for class '%s' (kept in %s)\n", grasp->c_str(), object_class->c_str(),
+                  workcell::defaultGraspFile(cell->name()).c_str());
+    }
+    exit_code = ok ? 0 : 1;
+  });
+}
 
 void addTeachCommand(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<workcell::WorkcellOptions>();

@@ -6,5 +6,7 @@
 namespace costar::cli {
 
 void addTeachCommand(CLI::App& app, int& exit_code);
+/// `costar smartmove teach CLASS NAME --at WAYPOINT`.
+void addSmartMoveCommands(CLI::App& app, int& exit_code);
 
 }  // namespace costar::cli
