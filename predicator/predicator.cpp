@@ -88,7 +88,7 @@ void Predicator::refresh() const {
   recomputed_ = 0;
   // The objects now: symbols classified by is_a with a known class and a pose.
   std::map<std::string, ObjectState> now;
-  for (const world::Predicate* is_a : world_.predicates("is_a")) {
+  for (const world::Predicate* is_a : world_.predicatesNamed("is_a")) {
     if (is_a->args.size() != 2 || !is_a->value) {
       continue;
     }

@@ -1,6 +1,7 @@
 #include "world/world_state.h"
 
 #include <algorithm>
+#include <set>
 #include <stdexcept>
 
 namespace costar::world {
@@ -36,29 +37,79 @@ void WorldState::update(const std::string& source, Report report) {
   for (auto& predicate : report.predicates) {
     predicate.source = source;
   }
-  reports_.insert_or_assign(source, std::move(report));
-  rebuildIndex();
+  auto it = reports_.find(source);
+  if (it == reports_.end()) {
+    it = reports_.emplace(source, Report{}).first;
+  } else {
+    unindex(it->second);
+  }
+  it->second = std::move(report);
+  index(it->second);
+  ++version_;
 }
 
 void WorldState::removeSource(const std::string& source) {
-  if (reports_.erase(source) > 0) {
-    rebuildIndex();
+  const auto it = reports_.find(source);
+  if (it != reports_.end()) {
+    unindex(it->second);
+    reports_.erase(it);
+    ++version_;
   }
 }
 
-void WorldState::rebuildIndex() {
-  symbol_index_.clear();
-  predicate_index_.clear();
-  for (const auto& [source, report] : reports_) {
-    for (const auto& symbol : report.symbols) {
-      symbol_index_[symbol.name] = &symbol;
-    }
-    for (const auto& predicate : report.predicates) {
-      auto& votes = predicate_index_[predicateKey(predicate.name, predicate.args)];
-      (predicate.value ? votes.first : votes.second) += 1;
+void WorldState::unindex(const Report& report) {
+  for (const auto& symbol : report.symbols) {
+    const auto found = symbol_index_.find(symbol.name);
+    if (found != symbol_index_.end() && found->second == &symbol) {
+      symbol_index_.erase(found);
+      // Another source may report the same name: let it show again.
+      for (const auto& [other_source, other] : reports_) {
+        if (&other != &report) {
+          for (const auto& candidate : other.symbols) {
+            if (candidate.name == symbol.name) {
+              symbol_index_[symbol.name] = &candidate;
+            }
+          }
+        }
+      }
     }
   }
-  ++version_;
+  std::set<std::string_view> names;
+  for (const auto& predicate : report.predicates) {
+    const std::string key = predicateKey(predicate.name, predicate.args);
+    auto& votes = predicate_index_[key];
+    (predicate.value ? votes.first : votes.second) -= 1;
+    if (votes.first == 0 && votes.second == 0) {
+      predicate_index_.erase(key);
+    }
+    names.insert(predicate.name);
+  }
+  // The report's predicates are contiguous: drop them from each name's list in one pass.
+  if (!report.predicates.empty()) {
+    const Predicate* first = report.predicates.data();
+    const Predicate* last = first + report.predicates.size();
+    for (const std::string_view name : names) {
+      auto& named = by_name_[std::string(name)];
+      std::erase_if(named, [first, last](const Predicate* p) { return p >= first && p < last; });
+    }
+  }
+}
+
+void WorldState::index(const Report& report) {
+  for (const auto& symbol : report.symbols) {
+    symbol_index_[symbol.name] = &symbol;
+  }
+  for (const auto& predicate : report.predicates) {
+    auto& votes = predicate_index_[predicateKey(predicate.name, predicate.args)];
+    (predicate.value ? votes.first : votes.second) += 1;
+    by_name_[predicate.name].push_back(&predicate);
+  }
+}
+
+const std::vector<const Predicate*>& WorldState::predicatesNamed(const std::string& name) const {
+  static const std::vector<const Predicate*> kNone;
+  const auto it = by_name_.find(name);
+  return it == by_name_.end() ? kNone : it->second;
 }
 
 const Symbol* WorldState::symbol(std::string_view name) const {
@@ -124,12 +175,13 @@ std::vector<std::string> WorldState::match(std::string_view name, std::span<cons
 }
 
 std::vector<const Predicate*> WorldState::predicates(std::string_view name) const {
+  if (!name.empty()) {
+    return predicatesNamed(std::string(name));
+  }
   std::vector<const Predicate*> found;
   for (const auto& [source, report] : reports_) {
     for (const auto& predicate : report.predicates) {
-      if (name.empty() || predicate.name == name) {
-        found.push_back(&predicate);
-      }
+      found.push_back(&predicate);
     }
   }
   return found;

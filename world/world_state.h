@@ -98,6 +98,8 @@ class WorldState {
   std::vector<std::string> match(std::string_view name, std::span<const std::string> args) const;
   /// Every predicate reported with this name (all of them if `name` is empty).
   std::vector<const Predicate*> predicates(std::string_view name = {}) const;
+  /// The same without copying, for one name (empty list when none).
+  const std::vector<const Predicate*>& predicatesNamed(const std::string& name) const;
 
   /// Pose of a frame symbol in "world", composing parents; nullopt when the frame or one of
   /// its parents is unknown (or the parents form a loop).
@@ -107,12 +109,14 @@ class WorldState {
   std::uint64_t version() const { return version_; }
 
  private:
-  void rebuildIndex();
+  void unindex(const Report& report);
+  void index(const Report& report);
 
   std::map<std::string, Report, std::less<>> reports_;
-  // name -> symbol, and "name(args)" -> (true votes, false votes), rebuilt on update.
-  std::unordered_map<std::string, const Symbol*> symbol_index_;
-  std::unordered_map<std::string, std::pair<int, int>> predicate_index_;
+  // Indexes kept up to date source by source: an update costs the size of that source's report.
+  std::unordered_map<std::string, const Symbol*> symbol_index_;             // name -> symbol
+  std::unordered_map<std::string, std::pair<int, int>> predicate_index_;    // "name(args)" -> votes
+  std::unordered_map<std::string, std::vector<const Predicate*>> by_name_;  // name -> predicates
   std::unordered_map<std::string, PredicateEvaluator> evaluators_;
   std::uint64_t version_ = 0;
 };
