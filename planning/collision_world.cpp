@@ -132,6 +132,9 @@ void CollisionWorld::disallowAll() { impl_->allowed.clear(); }
 
 std::optional<Contact> CollisionWorld::check(const Eigen::VectorXd& q) const {
   ++checks_;
+  if (workspace_ && !workspace_->contains((impl_->base * robot_.forward(q)).translation())) {
+    return Contact{"tcp", "the workspace boundary"};
+  }
   impl_->place(robot_, q);
   const auto& links = robot_.links();
   for (std::size_t i = 0; i < impl_->links.size(); ++i) {

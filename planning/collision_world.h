@@ -4,6 +4,7 @@
 // runs, and by the planner.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <memory>
 #include <optional>
 #include <set>
@@ -47,6 +48,10 @@ class CollisionWorld {
   void removeAll(const std::string& prefix = "");
   std::vector<std::string> obstacleNames() const;
 
+  /// Keeps the robot's tip (the tool centre point) inside `box` (world frame): a configuration
+  /// with the tip outside is reported as "tcp would leave the workspace".
+  void setWorkspace(const Eigen::AlignedBox3d& box) { workspace_ = box; }
+
   /// Lets `robot_link` touch `obstacle` (e.g. the fingers and the part being grasped).
   void allow(const std::string& robot_link, const std::string& obstacle);
   void disallow(const std::string& robot_link, const std::string& obstacle);
@@ -68,6 +73,7 @@ class CollisionWorld {
   CollisionOptions options_;
   std::unique_ptr<Impl> impl_;
   mutable std::uint64_t checks_ = 0;
+  std::optional<Eigen::AlignedBox3d> workspace_;
 };
 
 }  // namespace costar::planning

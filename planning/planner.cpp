@@ -17,7 +17,23 @@ namespace og = ompl::geometric;
 
 namespace {
 
-std::mutex g_ompl_mutex;  // OMPL's seed is global
+std::mutex g_ompl_mutex;  // OMPL keeps global state (its log level, its seed generator)
+
+/// Uniform samples from an RNG seeded for this plan, so a plan does not depend on what was
+/// planned before in the process (OMPL's global seed works only before its first use).
+class SeededSampler final : public ob::RealVectorStateSampler {
+ public:
+  SeededSampler(const ob::StateSpace* space, std::uint64_t seed) : ob::RealVectorStateSampler(space) {
+    rng_.setLocalSeed(static_cast<std::uint_fast32_t>(seed));
+  }
+};
+
+class SeededSimplifier final : public og::PathSimplifier {
+ public:
+  SeededSimplifier(const ob::SpaceInformationPtr& si, std::uint64_t seed) : og::PathSimplifier(si) {
+    rng_.setLocalSeed(static_cast<std::uint_fast32_t>(seed));
+  }
+};
 
 }  // namespace
 
@@ -44,9 +60,11 @@ PlanResult planPath(const CollisionWorld& world, const Eigen::VectorXd& start, c
 
   std::lock_guard lock(g_ompl_mutex);
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
-  ompl::RNG::setSeed(options.seed == 0 ? 1 : options.seed);
   const auto dof = static_cast<unsigned>(start.size());
   auto space = std::make_shared<ob::RealVectorStateSpace>(dof);
+  const std::uint64_t seed = options.seed == 0 ? 1 : options.seed;
+  space->setStateSamplerAllocator(
+      [seed](const ob::StateSpace* state_space) { return std::make_shared<SeededSampler>(state_space, seed); });
   ob::RealVectorBounds bounds(dof);
   const RobotModel& robot = world.robot();
   for (unsigned j = 0; j < dof; ++j) {
@@ -82,7 +100,7 @@ PlanResult planPath(const CollisionWorld& world, const Eigen::VectorXd& start, c
     return result;
   }
   og::PathGeometric& path = setup.getSolutionPath();
-  og::PathSimplifier simplifier(setup.getSpaceInformation());
+  SeededSimplifier simplifier(setup.getSpaceInformation(), seed + 1);
   simplifier.shortcutPath(path);
   simplifier.reduceVertices(path);
   for (std::size_t i = 0; i < path.getStateCount(); ++i) {

@@ -95,7 +95,8 @@ struct Simulation::Impl {
   int finger_actuator = 0;
   int left_pad = 0;
   int right_pad = 0;
-  int table_geom = 0;
+  int table_geom = 0;          // the box the arm collides with
+  int table_surface_geom = 0;  // the plane parts rest on
   int tcp_site = 0;
   int rgbd_camera = 0;
   int first_arm_body = 0;
@@ -277,6 +278,7 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->left_pad = impl->id(mjOBJ_GEOM, "left_pad");
   impl->right_pad = impl->id(mjOBJ_GEOM, "right_pad");
   impl->table_geom = impl->id(mjOBJ_GEOM, "table");
+  impl->table_surface_geom = impl->id(mjOBJ_GEOM, "table_surface");
   impl->tcp_site = impl->id(mjOBJ_SITE, "tcp");
   impl->rgbd_camera = impl->id(mjOBJ_CAMERA, "rgbd");
   impl->first_arm_body = impl->id(mjOBJ_BODY, "shoulder_link");
@@ -464,8 +466,12 @@ std::vector<std::pair<std::string, std::string>> Simulation::contacts() const {
   const mjModel* m = impl_->model;
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& contact = d->contact[i];
-    std::string a = contact.geom1 == impl_->table_geom ? "table" : impl_->bodyLabel(m->geom_bodyid[contact.geom1]);
-    std::string b = contact.geom2 == impl_->table_geom ? "table" : impl_->bodyLabel(m->geom_bodyid[contact.geom2]);
+    const auto label = [&](int geom) {
+      return geom == impl_->table_geom || geom == impl_->table_surface_geom ? std::string("table")
+                                                                            : impl_->bodyLabel(m->geom_bodyid[geom]);
+    };
+    std::string a = label(contact.geom1);
+    std::string b = label(contact.geom2);
     if (a > b) {
       std::swap(a, b);
     }

@@ -93,6 +93,8 @@ class Ur5SimWorkcell final : public Workcell {
     simulation_->attach(static_cast<SimClock&>(clock()));
     collisions_.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
     collisions_.allow("base_link", "table");  // the robot stands on it
+    // The tool stays above the table top, within the cell.
+    collisions_.setWorkspace(Eigen::AlignedBox3d(Eigen::Vector3d(-0.45, -0.65, 0.0), Eigen::Vector3d(1.05, 0.65, 1.2)));
 
     arm::ArmConfig arm_config;
     arm_config.base_in_world = kBaseInWorld;

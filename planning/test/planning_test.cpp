@@ -151,12 +151,21 @@ TEST_F(Collisions, ThePlannerFindsAWayAroundAnObstacleThatBlocksTheStraightMotio
   for (std::size_t i = 1; i < plan.path.size(); ++i) {
     EXPECT_FALSE(world.checkSegment(plan.path[i - 1], plan.path[i]).has_value());
   }
-  // The same seed gives the same plan.
+  // The same seed gives the same plan, whatever was planned in between.
+  planPath(world, right, left, {.time_limit_s = 5.0, .seed = 99});
   const PlanResult again = planPath(world, left, right, {.time_limit_s = 5.0, .seed = 7});
   ASSERT_EQ(again.path.size(), plan.path.size());
   for (std::size_t i = 0; i < plan.path.size(); ++i) {
     EXPECT_TRUE(again.path[i].isApprox(plan.path[i], 1e-12));
   }
+}
+
+TEST_F(Collisions, TheToolStaysInsideTheWorkspace) {
+  EXPECT_FALSE(world.check(kHome).has_value());
+  world.setWorkspace(Eigen::AlignedBox3d(Eigen::Vector3d(0.3, -1, 0), Eigen::Vector3d(1, 1, 1)));
+  const auto contact = world.check(kHome);  // home's tool is at x = 0.17
+  ASSERT_TRUE(contact.has_value());
+  EXPECT_EQ(contact->str(), "tcp would touch the workspace boundary");
 }
 
 TEST_F(Collisions, ThePlannerSaysWhyWhenTheGoalIsInCollision) {
