@@ -4,6 +4,7 @@
 
 #include "cli/perception_commands.h"
 #include "cli/plan_commands.h"
+#include "cli/serve_command.h"
 #include "cli/sim_commands.h"
 #include "cli/teach_command.h"
 #include "cli/trials_command.h"
@@ -21,6 +22,7 @@ int main(int argc, char** argv) {
   costar::cli::addTeachCommand(app, exit_code);
   costar::cli::addSmartMoveCommands(app, exit_code);
   costar::cli::addTrialsCommand(app, exit_code);
+  costar::cli::addServeCommand(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

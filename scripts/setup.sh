@@ -22,6 +22,8 @@ PACKAGES=(
   liborocos-kdl-dev libkdl-parser-dev liburdfdom-dev libfcl-dev libompl-dev
   # plots of trial results
   libcairo2-dev
+  # the editor's server (costar serve): SQLite store; Boost.Beast comes with libboost-dev
+  libsqlite3-dev
 )
 
 SUDO=""

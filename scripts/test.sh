@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Quick start 2: set up, build, and run every test: unit and end-to-end tests (CTest), and
-# the plan-parser fuzz target in smoke mode (libFuzzer, clang, address + UB sanitizers).
+# Quick start 2: set up, build, and run every test: unit and end-to-end tests (CTest), the
+# plan-parser and API fuzz targets in smoke mode (libFuzzer, clang, address + UB sanitizers),
+# and the editor's page (Vitest, then end to end in headless Chromium).
 #   FUZZ_RUNS=20000 (default) sets the smoke run's length; FUZZ_RUNS=0 skips it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -26,6 +27,37 @@ if [[ "$FUZZ_RUNS" -gt 0 ]]; then
   cp fuzz/corpus/plan_parser/* "$corpus/"
   "$BUILD_DIR-fuzz/fuzz/plan_parser_fuzz" -dict=fuzz/plan.dict -max_len=4096 -seed=1 \
     -runs="$FUZZ_RUNS" -artifact_prefix="$corpus/" "$corpus" 2>&1 | tail -n 3
+
+  echo
+  echo "test: fuzzing the editor's API request handling, $FUZZ_RUNS runs (smoke mode)"
+  cmake --build "$BUILD_DIR-fuzz" --target api_fuzz -j "$(nproc)"
+  api_corpus=$(mktemp -d)
+  cp server/fuzz/corpus/* "$api_corpus/"
+  "$BUILD_DIR-fuzz/server/api_fuzz" -dict=server/fuzz/api.dict -max_len=4096 -seed=1 \
+    -runs="$FUZZ_RUNS" -artifact_prefix="$api_corpus/" "$api_corpus" 2>&1 | tail -n 3
+  rm -rf "$api_corpus"
+fi
+
+# The task editor's page (web/): Vitest unit tests, the production build, then the end-to-end
+# test in Debian's Chromium (headless, driven by playwright-core): the "pick up node" plan
+# built by clicks, saved, run in the simulated cell, judged from the simulator's true state.
+# EDITOR_E2E=0 skips the browser test.
+echo
+echo "test: the editor's page (npm ci, Vitest, vite build)"
+(cd web && npm ci --no-audit --no-fund --loglevel=error && npm test && npm run build)
+if [[ "${EDITOR_E2E:-1}" != "0" ]]; then
+  if ! dpkg-query -W -f='${Status}' chromium 2>/dev/null | grep -q "install ok installed"; then
+    echo "test: installing Debian's chromium for the end-to-end test"
+    SUDO=""
+    if [[ $(id -u) -ne 0 ]]; then
+      SUDO="sudo"
+    fi
+    $SUDO apt-get update -q
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends chromium
+  fi
+  echo
+  echo "test: the editor end to end in Chromium (artifacts in $BUILD_DIR/test-artifacts)"
+  node web/e2e/pick_up_node.mjs --costar "$BUILD_DIR/cli/costar" --artifacts "$BUILD_DIR/test-artifacts"
 fi
 echo
 echo "test: all passed in $(( $(date +%s) - start )) s"

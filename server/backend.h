@@ -1,0 +1,77 @@
+#pragma once
+// What the HTTP API needs from the system behind it. The Engine (engine.h) implements it on
+// a workcell; the API fuzz target implements it without one.
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "bt/plan.h"
+
+namespace costar::server {
+
+/// A plan to run: parsed (not yet validated; the backend validates it where the workcell lives).
+struct RunRequest {
+  bt::Plan plan;
+  /// The plan file as it will be logged (bt::writePlanFile of plan.file).
+  std::string xml;
+  /// The saved plan it came from, if any.
+  std::string plan_name;
+  int version = 0;
+  /// A single operation from the menu or the waypoint panel: not written to the run log.
+  bool operation = false;
+  /// Start paused (for stepping through from the first tick).
+  bool start_paused = false;
+};
+
+struct StartResult {
+  /// The run's id when it started.
+  std::int64_t run_id = 0;
+  /// On refusal: an HTTP status (409 busy, 422 invalid plan) and why.
+  int status = 0;
+  std::string error;
+  std::vector<bt::Diagnostic> diagnostics;
+  bool started() const { return run_id != 0; }
+};
+
+enum class RunControl { kPause, kResume, kStep, kStop };
+
+/// Thrown when the backend cannot answer in time (its thread is stuck in a long computation)
+/// or is shutting down: the API answers 503.
+class BackendBusy : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  /// Workcell name and description, clock kind, pacing, features the menu offers.
+  virtual nlohmann::json info() = 0;
+  /// Every node type (the palette), as JSON text; fixed for the server's lifetime.
+  virtual const std::string& nodesJson() = 0;
+  /// What the system knows now, for the editor's lists: waypoints, frames, object classes,
+  /// predicates (name, arity), grasps per class.
+  virtual nlohmann::json choices() = 0;
+  /// Every problem of a plan against the workcell's node types.
+  virtual std::vector<bt::Diagnostic> validate(const bt::Plan& plan) = 0;
+  /// Starts a run unless one is active (409) or the plan is invalid (422).
+  virtual StartResult start(RunRequest request) = 0;
+  /// Pause, resume, single step or stop the active run (stop halts it, which cancels its
+  /// operations: the arm decelerates and stops). False when nothing runs.
+  virtual bool control(RunControl control) = 0;
+  /// The latest snapshot of the cell (same as the stream's "state" message).
+  virtual nlohmann::json state() = 0;
+  /// A run the backend still remembers (the active one, recent ones, operations), with its
+  /// nodes' last statuses; nullopt for an unknown id. No id: the active or last run.
+  virtual std::optional<nlohmann::json> runStatus(std::optional<std::int64_t> id) = 0;
+  /// TEST ONLY: the simulator's true part poses (nullopt without a simulator).
+  virtual std::optional<nlohmann::json> groundTruth() = 0;
+  /// Points seen by the cell's RGB-D camera, in the world frame (nullopt without one).
+  virtual std::optional<nlohmann::json> pointCloud(std::size_t max_points) = 0;
+};
+
+}  // namespace costar::server

@@ -1,0 +1,183 @@
+#pragma once
+// The Engine owns the workcell for the server: one thread (the executor's) ticks plans,
+// single operations and, between them, an idle loop that keeps the world state fresh and the
+// simulated robot alive. Nothing else touches the workcell, its world state or a tree:
+// network threads hand work to the engine thread (validation, starting runs, snapshots of
+// what the editor lists) and read copies that the engine thread publishes:
+//   - a snapshot of the cell (joints, endpoint, gripper, objects, waypoints, frames,
+//     predicates) at most `stream_hz` times a wall second,
+//   - each node's last status in the active run (coalesced between two reads of the stream),
+//   - run start and end events.
+// Every status transition of a plan run also goes to the store's run log, written by a
+// separate thread in batches, so ticks never wait for the disk.
+//
+// A simulated clock is paced to `pace` times real time for a person watching (0: as fast as
+// the machine allows while a plan runs; the idle loop then runs at real time).
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <filesystem>
+#include <functional>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bt/tree.h"
+#include "server/backend.h"
+#include "server/pacing.h"
+#include "server/store.h"
+
+namespace costar::workcell {
+class Workcell;
+}
+
+namespace costar::server {
+
+struct EngineOptions {
+  /// Simulated seconds per wall second (simulated clocks only); 0: unpaced runs.
+  double pace = 1.0;
+  /// Time between ticks (clock time).
+  Duration tick_period = std::chrono::milliseconds(10);
+  /// Snapshots of the cell per wall second (the stream's rate).
+  double stream_hz = 20.0;
+  /// Transitions kept in the run log per run; the rest are counted, not stored.
+  std::size_t max_logged_transitions = 200'000;
+  /// How long a network thread waits for the engine thread to answer (then 503).
+  std::chrono::milliseconds call_timeout{20000};
+  /// Finished runs and operations remembered for GET /api/runs/{id}.
+  std::size_t remembered_runs = 64;
+  /// Grasp files offered as choices (read-only here; SmartMove's GraspLibrary owns them).
+  std::filesystem::path grasp_defaults;
+  std::filesystem::path grasp_taught;
+};
+
+/// Counters of the engine thread, for benchmarks and the info endpoint.
+struct EngineStats {
+  std::uint64_t ticks = 0;        // before-tick hooks run (plan ticks and idle ticks)
+  std::uint64_t snapshots = 0;    // state snapshots taken
+  double snapshot_seconds = 0;    // wall time spent taking them
+  double paced_wait_seconds = 0;  // wall time waited for the pace
+  std::uint64_t runs = 0;         // runs started (plans and operations)
+};
+
+class Engine final : public Backend {
+ public:
+  /// `cell` and `store` (may be null: nothing logged) must outlive the engine.
+  Engine(workcell::Workcell& cell, Store* store, EngineOptions options = {});
+  ~Engine() override;
+  Engine(const Engine&) = delete;
+  Engine& operator=(const Engine&) = delete;
+
+  /// Starts the engine thread (and the log writer).
+  void startThread();
+  /// Stops the active run (cancelling its operations), ends the threads, writes what is
+  /// left of the run log. Idempotent.
+  void shutdown();
+
+  // --- Backend ----------------------------------------------------------------------------
+  nlohmann::json info() override;
+  const std::string& nodesJson() override { return nodes_json_; }
+  nlohmann::json choices() override;
+  std::vector<bt::Diagnostic> validate(const bt::Plan& plan) override;
+  StartResult start(RunRequest request) override;
+  bool control(RunControl control) override;
+  nlohmann::json state() override;
+  std::optional<nlohmann::json> runStatus(std::optional<std::int64_t> id) override;
+  std::optional<nlohmann::json> groundTruth() override;
+  std::optional<nlohmann::json> pointCloud(std::size_t max_points) override;
+
+  // --- the live stream ----------------------------------------------------------------------
+  /// The messages since the last call, in order: run_started, statuses (each changed node's
+  /// current and last status, failure reason, operation data), run_ended, and the newest
+  /// state snapshot if there is a new one. One caller (the broadcaster).
+  std::vector<std::string> drainStream();
+  /// The first message for a newly connected client: info, the active (or last) run with
+  /// every node's status, and the latest snapshot.
+  std::string helloMessage();
+
+  EngineStats stats() const;
+  /// Changes the pace (thread-safe).
+  void setPace(double pace);
+
+ private:
+  struct RunState;
+  class Observer;
+  struct LogCommand;
+
+  /// Runs `task` on the engine thread and waits for its result.
+  template <typename F>
+  auto call(F task) -> decltype(task());
+
+  void loop();
+  void runTasks();
+  void hook(bool running);
+  void waitWall(std::chrono::steady_clock::duration duration);
+  void executePending();
+  void takeSnapshot();
+  nlohmann::json buildState() const;
+  void onTransition(TimePoint time, const bt::TreeNode& node, bt::Status from, bt::Status to);
+  nlohmann::json runJson(const RunState& run, bool with_nodes) const;
+  nlohmann::json statusesJson(RunState& run, bool all);
+  void logWriterLoop();
+  void pushLog(LogCommand command);
+
+  workcell::Workcell& cell_;
+  Store* store_;
+  EngineOptions options_;
+  std::string nodes_json_;
+  nlohmann::json info_;
+
+  std::thread thread_;
+  std::atomic<bool> stopping_{false};
+  bool started_ = false;
+
+  // Work handed to the engine thread.
+  std::mutex task_mutex_;
+  std::condition_variable task_cv_;
+  std::deque<std::function<void()>> tasks_;
+
+  // Control of the active run, set by network threads, applied by the engine thread.
+  std::atomic<std::int64_t> active_run_{0};
+  std::atomic<bool> stop_requested_{false};
+  std::atomic<int> pause_requested_{0};  // +1 pause, -1 resume
+  std::atomic<int> steps_requested_{0};
+  std::atomic<bool> paused_{false};
+
+  // Engine-thread only.
+  std::optional<bt::Tree> pending_tree_;
+  std::shared_ptr<RunState> pending_run_;
+  std::unique_ptr<Observer> observer_;
+  Pacer pacer_;
+  std::atomic<double> pace_request_{-1};
+  std::chrono::steady_clock::time_point next_snapshot_{};
+  bool start_paused_ = false;
+
+  // Published for network threads (guarded by mutex_).
+  mutable std::mutex mutex_;
+  std::shared_ptr<RunState> current_;               // the active or last run
+  std::deque<std::shared_ptr<RunState>> finished_;  // recent runs
+  std::vector<std::string> events_;                 // stream messages not yet drained
+  std::string state_json_;
+  std::uint64_t state_version_ = 0;
+  std::uint64_t drained_state_version_ = 0;
+  EngineStats stats_;
+  std::int64_t next_run_id_ = 1;
+  std::string last_error_;  // the last exception of the idle loop, shown by info()
+
+  // The run log writer.
+  std::thread log_thread_;
+  std::mutex log_mutex_;
+  std::condition_variable log_cv_;
+  std::deque<LogCommand> log_queue_;
+  std::vector<TransitionRecord> log_pending_;
+  std::int64_t log_pending_run_ = 0;
+  bool log_stopping_ = false;
+};
+
+}  // namespace costar::server

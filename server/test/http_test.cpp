@@ -1,0 +1,210 @@
+// A real server on loopback (HTTP + WebSocket through Boost.Beast), driven the way a browser
+// drives it: tokens, limits, hostile requests, the live stream. The server keeps answering.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "server/auth.h"
+#include "server/engine.h"
+#include "server/http_server.h"
+#include "server/serve.h"
+#include "server/test/http_client.h"
+
+namespace costar::server {
+namespace {
+
+using nlohmann::json;
+using testing::Response;
+using testing::WebSocket;
+
+class HttpTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = std::filesystem::temp_directory_path() / ("costar_http_test_" + randomToken().substr(0, 8));
+    std::filesystem::create_directories(dir_ / "web" / "assets");
+    std::ofstream(dir_ / "web" / "index.html") << "<!doctype html><title>editor</title>";
+    std::ofstream(dir_ / "web" / "assets" / "app.js") << "console.log('hi')";
+    std::ofstream(dir_ / "secret.txt") << "secret";
+    ServeOptions options;
+    options.workcell.name = "test";
+    options.workcell.memory_only = true;
+    options.port = 0;
+    options.store = dir_ / "editor.sqlite";
+    options.web_root = dir_ / "web";
+    options.pace = 1.0;
+    server_ = new Server(options);
+  }
+  static void TearDownTestSuite() {
+    delete server_;
+    std::filesystem::remove_all(dir_);
+  }
+  void TearDown() override {
+    // Whatever the test sent, the server still answers.
+    EXPECT_EQ(testing::request(port(), "GET", "/api/info").status, 200);
+  }
+  static std::uint16_t port() { return server_->port(); }
+  static const std::string& token() { return server_->token(); }
+
+  static inline Server* server_ = nullptr;
+  static inline std::filesystem::path dir_;
+};
+
+TEST_F(HttpTest, ServesThePageAndReadOnlyApi) {
+  const Response page = testing::request(port(), "GET", "/");
+  EXPECT_EQ(page.status, 200);
+  EXPECT_NE(page.body.find("editor"), std::string::npos);
+  EXPECT_NE(page.headers.at("content-security-policy").find("default-src 'self'"), std::string::npos);
+  EXPECT_EQ(testing::request(port(), "GET", "/assets/app.js").headers["content-type"],
+            "text/javascript; charset=utf-8");
+  const Response info = testing::request(port(), "GET", "/api/info");
+  ASSERT_EQ(info.status, 200);
+  EXPECT_EQ(json::parse(info.body)["workcell"], "test");
+  EXPECT_EQ(info.headers.at("cache-control"), "no-store");
+}
+
+TEST_F(HttpTest, ChangesNeedTheToken) {
+  const std::string body =
+      R"({"plan": {"main_tree": "main", "trees": [{"id": "main", "root": {"id": "AlwaysSuccess"}}]}})";
+  EXPECT_EQ(testing::request(port(), "PUT", "/api/plans/p", body).status, 401);
+  EXPECT_EQ(testing::request(port(), "PUT", "/api/plans/p", body, "wrong-token-123456").status, 401);
+  EXPECT_EQ(testing::request(port(), "POST", "/api/operations", R"({"node": "TestLog"})").status, 401);
+  const Response saved = testing::request(port(), "PUT", "/api/plans/p", body, token());
+  EXPECT_EQ(saved.status, 201) << saved.body;
+}
+
+TEST_F(HttpTest, RefusesOversizeBodiesWithoutReadingThem) {
+  testing::Socket socket(port());
+  // Announce 2 MiB, send only the headers: the answer comes before the body.
+  socket.send("PUT /api/plans/big HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer " + token() +
+              "\r\nContent-Type: application/json\r\nContent-Length: 2097152\r\n\r\n{\"xml\": \"");
+  std::string pending;
+  EXPECT_EQ(testing::readResponse(socket, pending).status, 413);
+}
+
+TEST_F(HttpTest, AnswersMalformedRequestsWith400) {
+  testing::Socket socket(port());
+  socket.send("THIS IS NOT HTTP\r\n\r\n");
+  std::string pending;
+  EXPECT_EQ(testing::readResponse(socket, pending).status, 400);
+
+  testing::Socket long_header(port());
+  long_header.send("GET /api/info HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Long: " + std::string(20000, 'a') + "\r\n\r\n");
+  pending.clear();
+  EXPECT_EQ(testing::readResponse(long_header, pending).status, 400);
+}
+
+TEST_F(HttpTest, RefusesOtherHostsOnLoopback) {
+  EXPECT_EQ(testing::request(port(), "GET", "/api/info", {}, {}, "evil.example.com").status, 421);
+  EXPECT_EQ(testing::request(port(), "GET", "/api/info", {}, {}, "localhost:8080").status, 200);
+}
+
+TEST_F(HttpTest, StaticFilesStayInsideTheWebRoot) {
+  EXPECT_EQ(testing::request(port(), "GET", "/../secret.txt").status, 404);
+  EXPECT_EQ(testing::request(port(), "GET", "/%2e%2e/secret.txt").status, 404);
+  EXPECT_EQ(testing::request(port(), "GET", "/assets/../../secret.txt").status, 404);
+  EXPECT_EQ(testing::request(port(), "POST", "/index.html", "{}", token()).status, 405);
+}
+
+TEST_F(HttpTest, KeepsConnectionsAlive) {
+  testing::Socket socket(port());
+  std::string pending;
+  for (int i = 0; i < 3; ++i) {
+    socket.send("GET /api/info HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n");
+    EXPECT_EQ(testing::readResponse(socket, pending).status, 200);
+  }
+}
+
+TEST_F(HttpTest, StreamSendsHelloThenStateSnapshots) {
+  WebSocket ws(port());
+  ASSERT_EQ(ws.status, 101);
+  const auto hello = ws.read();
+  ASSERT_TRUE(hello);
+  const json first = json::parse(*hello);
+  EXPECT_EQ(first["type"], "hello");
+  EXPECT_EQ(first["info"]["workcell"], "test");
+  EXPECT_EQ(first["state"]["type"], "state");
+  double last_t = -1;
+  int states = 0;
+  while (states < 5) {
+    const auto message = ws.read();
+    ASSERT_TRUE(message);
+    const json m = json::parse(*message);
+    if (m["type"] == "state") {
+      EXPECT_GT(m["t"].get<double>(), last_t);  // fresh snapshots: simulated time goes on
+      last_t = m["t"];
+      ++states;
+    }
+  }
+}
+
+TEST_F(HttpTest, StreamCommandsNeedTheToken) {
+  WebSocket ws(port());
+  ASSERT_EQ(ws.status, 101);
+  const auto next = [&ws](const std::string& type) {
+    while (auto message = ws.read()) {
+      json m = json::parse(*message);
+      if (m["type"] == type || m["type"] == "error") {
+        return m;
+      }
+    }
+    return json();
+  };
+  ws.send(R"({"type": "control", "action": "stop"})");
+  EXPECT_EQ(next("control")["type"], "error");
+  ws.send(R"({"type": "auth", "token": "not-the-token-1234"})");
+  EXPECT_FALSE(next("auth")["ok"].get<bool>());
+  ws.send("{broken json");
+  EXPECT_EQ(next("nothing")["type"], "error");
+  ws.send(R"({"type": "auth", "token": ")" + token() + "\"}");
+  EXPECT_TRUE(next("auth")["ok"].get<bool>());
+  ws.send(R"({"type": "control", "action": "stop"})");
+  const json answer = next("control");
+  EXPECT_EQ(answer["type"], "control");
+  EXPECT_FALSE(answer["ok"].get<bool>());  // nothing runs
+}
+
+TEST_F(HttpTest, StreamShowsARunAndStopHaltsIt) {
+  WebSocket ws(port());
+  ASSERT_EQ(ws.status, 101);
+  const std::string body =
+      R"({"plan": {"main_tree": "main", "trees": [{"id": "main", "root": {"id": "TestAction", "attributes": [["polls", "100000000"]]}}]}})";
+  const Response started = testing::request(port(), "POST", "/api/runs", body, token());
+  ASSERT_EQ(started.status, 202) << started.body;
+  const std::int64_t id = json::parse(started.body)["run"];
+  bool running = false;
+  while (!running) {
+    const auto message = ws.read();
+    ASSERT_TRUE(message);
+    const json m = json::parse(*message);
+    if (m["type"] == "statuses" && m["run"] == id) {
+      for (const auto& n : m["nodes"]) {
+        running = running || n["status"] == "RUNNING";
+      }
+    }
+  }
+  ws.send(R"({"type": "auth", "token": ")" + token() + "\"}");
+  ws.send(R"({"type": "control", "action": "stop"})");
+  json ended;
+  while (ended.is_null()) {
+    const auto message = ws.read();
+    ASSERT_TRUE(message);
+    const json m = json::parse(*message);
+    if (m["type"] == "run_ended") {
+      ended = m;
+    }
+  }
+  EXPECT_EQ(ended["run"]["id"], id);
+  EXPECT_EQ(ended["run"]["result"], "STOPPED");
+}
+
+TEST_F(HttpTest, RefusesWebSocketsFromOtherSites) {
+  EXPECT_EQ(WebSocket(port(), "/api/stream", "http://evil.example.com").status, 403);
+  EXPECT_EQ(WebSocket(port(), "/api/other").status, 404);
+  EXPECT_EQ(WebSocket(port(), "/api/stream", "http://localhost:5173").status, 101);
+}
+
+}  // namespace
+}  // namespace costar::server

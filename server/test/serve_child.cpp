@@ -1,0 +1,54 @@
+// TEST ONLY: `costar serve` without the CLI around it, for tests that start a server as a child
+// process and kill it (kill_test.cpp). Arguments: --NAME VALUE pairs of ServeOptions
+// (workcell, scene, waypoints, store, token-file, pace, port, memory-only) and the flag
+// --test-endpoints and --test-oracle-perception. Prints what `costar serve` prints, including "listening on URL".
+
+#include <cstring>
+#include <iostream>
+#include <string>
+
+#include "server/serve.h"
+
+int main(int argc, char** argv) {
+  costar::server::ServeOptions options;
+  options.port = 0;
+  for (int i = 1; i < argc; ++i) {
+    const std::string key = argv[i];
+    if (key == "--test-endpoints") {
+      options.test_endpoints = true;
+      continue;
+    }
+    if (key == "--memory-only") {
+      options.workcell.memory_only = true;
+      continue;
+    }
+    if (key == "--test-oracle-perception") {  // TEST ONLY: true part poses as object symbols
+      options.workcell.test_oracle_perception = true;
+      continue;
+    }
+    if (i + 1 >= argc) {
+      std::cerr << "serve_child: " << key << " needs a value\n";
+      return 2;
+    }
+    const std::string value = argv[++i];
+    if (key == "--workcell") {
+      options.workcell.name = value;
+    } else if (key == "--scene") {
+      options.workcell.scene = value;
+    } else if (key == "--waypoints") {
+      options.workcell.waypoints = value;
+    } else if (key == "--store") {
+      options.store = value;
+    } else if (key == "--token-file") {
+      options.token_file = value;
+    } else if (key == "--pace") {
+      options.pace = std::stod(value);
+    } else if (key == "--port") {
+      options.port = static_cast<std::uint16_t>(std::stoi(value));
+    } else {
+      std::cerr << "serve_child: unknown option " << key << "\n";
+      return 2;
+    }
+  }
+  return costar::server::runServe(options, std::cout, std::cerr);
+}

@@ -1,0 +1,124 @@
+// The SQLite store: versions of plans and subtrees, run logs, reopening.
+
+#include "server/store.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "server/auth.h"
+
+namespace costar::server {
+namespace {
+
+class StoreTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("costar_store_test_" + randomToken().substr(0, 8));
+    std::filesystem::create_directories(dir_);
+    file_ = dir_ / "editor.sqlite";
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::filesystem::path dir_;
+  std::filesystem::path file_;
+};
+
+TEST_F(StoreTest, SavesVersionsAndLoadsThem) {
+  Store store(file_);
+  EXPECT_EQ(store.save(DocumentKind::kPlan, "pick", "<root>1</root>"), 1);
+  EXPECT_EQ(store.save(DocumentKind::kPlan, "pick", "<root>2</root>"), 2);
+  EXPECT_EQ(store.save(DocumentKind::kPlan, "place", "<root>a</root>"), 1);
+  EXPECT_EQ(store.save(DocumentKind::kSubtree, "pick", "<root>s</root>"), 1);  // another kind, own versions
+
+  EXPECT_EQ(store.load(DocumentKind::kPlan, "pick")->xml, "<root>2</root>");
+  EXPECT_EQ(store.load(DocumentKind::kPlan, "pick", 1)->xml, "<root>1</root>");
+  EXPECT_FALSE(store.load(DocumentKind::kPlan, "pick", 3));
+  EXPECT_FALSE(store.load(DocumentKind::kPlan, "nothing"));
+  EXPECT_EQ(store.load(DocumentKind::kSubtree, "pick")->xml, "<root>s</root>");
+
+  const auto plans = store.list(DocumentKind::kPlan);
+  ASSERT_EQ(plans.size(), 2u);
+  EXPECT_EQ(plans[0].name, "pick");
+  EXPECT_EQ(plans[0].latest_version, 2);
+  EXPECT_EQ(plans[0].versions, 2);
+  const auto versions = store.versions(DocumentKind::kPlan, "pick");
+  ASSERT_EQ(versions.size(), 2u);
+  EXPECT_EQ(versions[0].version, 2);
+
+  EXPECT_TRUE(store.remove(DocumentKind::kPlan, "pick"));
+  EXPECT_FALSE(store.remove(DocumentKind::kPlan, "pick"));
+  EXPECT_FALSE(store.load(DocumentKind::kPlan, "pick"));
+  EXPECT_EQ(store.integrityCheck(), "ok");
+}
+
+TEST_F(StoreTest, KeepsEverythingAcrossReopeningAndUsesWal) {
+  {
+    Store store(file_);
+    store.save(DocumentKind::kPlan, "pick", "<root/>");
+    EXPECT_TRUE(std::filesystem::exists(file_.string() + "-wal"));
+  }
+  Store again(file_);
+  EXPECT_EQ(again.load(DocumentKind::kPlan, "pick")->version, 1);
+  EXPECT_EQ(again.save(DocumentKind::kPlan, "pick", "<root/>"), 2);
+}
+
+TEST_F(StoreTest, RunLogsKeepNodesAndTransitions) {
+  Store store(file_);
+  EXPECT_EQ(store.maxRunId(), 0);
+  RunRecord run;
+  run.id = 7;
+  run.plan = "pick";
+  run.version = 2;
+  run.xml = "<root/>";
+  run.started_at = 100.0;
+  store.beginRun(run,
+                 {{0, -1, "Sequence", "main seq", "main/Sequence \"main seq\""}, {1, 0, "Open", "", "main/x/Open[1]"}});
+  store.appendTransitions(7, {{1, 0.0, 0, "IDLE", "RUNNING", "", "", ""}, {2, 0.01, 1, "IDLE", "RUNNING", "", "", ""}});
+  store.appendTransitions(7, {{3, 0.5, 1, "RUNNING", "FAILURE", "fingers stuck", "main/x/Open[1]", R"({"a":1})"}});
+  run.result = "FAILURE";
+  run.ended_at = 101.0;
+  run.clock_seconds = 0.5;
+  run.failure_path = "main/x/Open[1]";
+  run.failure_reason = "fingers stuck";
+  run.transitions = 3;
+  store.endRun(run);
+
+  EXPECT_EQ(store.maxRunId(), 7);
+  const auto log = store.run(7);
+  ASSERT_TRUE(log);
+  EXPECT_EQ(log->run.plan, "pick");
+  EXPECT_EQ(log->run.result, "FAILURE");
+  EXPECT_EQ(log->run.failure_reason, "fingers stuck");
+  ASSERT_EQ(log->nodes.size(), 2u);
+  EXPECT_EQ(log->nodes[1].parent, 0);
+  EXPECT_EQ(log->nodes[0].name, "main seq");
+  ASSERT_EQ(log->transitions.size(), 3u);
+  EXPECT_EQ(log->transitions[2].to, "FAILURE");
+  EXPECT_EQ(log->transitions[2].data, R"({"a":1})");
+  EXPECT_DOUBLE_EQ(log->transitions[2].t, 0.5);
+  EXPECT_FALSE(store.run(8));
+
+  const auto runs = store.runs();
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_TRUE(runs[0].xml.empty());  // listings leave the text out
+}
+
+TEST_F(StoreTest, RunsLeftOpenByADeadServerAreMarkedInterrupted) {
+  {
+    Store store(file_);
+    RunRecord run;
+    run.id = 1;
+    run.xml = "<root/>";
+    store.beginRun(run, {});
+  }
+  Store again(file_);
+  EXPECT_EQ(again.run(1)->run.result, "INTERRUPTED");
+}
+
+TEST_F(StoreTest, RefusesAFileItCannotOpen) {
+  std::filesystem::create_directories(dir_ / "a_folder");
+  EXPECT_THROW(Store(dir_ / "a_folder"), StoreError);
+}
+
+}  // namespace
+}  // namespace costar::server

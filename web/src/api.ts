@@ -1,0 +1,171 @@
+// The server's HTTP API (docs/EDITOR.md). Changes carry the token: Authorization: Bearer.
+
+import type { PlanJson } from './model/tree';
+import type { NodeStatus, RunNode, Transition } from './model/status';
+
+export interface PortInfo {
+  name: string;
+  type: string;
+  description: string;
+  default?: string;
+  choices?: string[];
+  choices_from?: string;
+  min?: number;
+  max?: number;
+}
+
+export interface NodeInfo {
+  id: string;
+  kind: 'Control' | 'Decorator' | 'Action' | 'Condition' | 'SubTree';
+  category: 'internal' | 'robot_action' | 'knowledge';
+  description: string;
+  asynchronous: boolean;
+  component?: string;
+  ports: PortInfo[];
+}
+
+export interface Choices {
+  waypoint: string[];
+  frame: string[];
+  object_class: string[];
+  predicate: { name: string; arity: number; description: string }[];
+  grasp: Record<string, string[]>;
+}
+
+export interface Info {
+  workcell: string;
+  description: string;
+  simulator: boolean;
+  features: { detect: boolean; calibrate: boolean; pointcloud: boolean; detect_node: string; calibrate_node: string };
+  pace?: number;
+}
+
+export interface Pose {
+  p: [number, number, number];
+  q: [number, number, number, number];
+}
+
+export interface CellState {
+  type: 'state';
+  t: number;
+  run: number;
+  mode: 'idle' | 'running' | 'paused';
+  arm: { joints?: number[]; endpoint?: Pose; moving?: boolean };
+  gripper: { open: boolean; closed: boolean; holding: boolean; mode?: string };
+  objects: (Pose & { name: string; class: string })[];
+  waypoints: (Partial<Pose> & { name: string; kind: 'pose' | 'joints'; frame?: string })[];
+  frames: (Pose & { name: string; parent: string })[];
+  predicates: string[];
+}
+
+export interface RunInfo {
+  id: number;
+  kind: 'plan' | 'operation';
+  plan: string;
+  version: number;
+  label: string;
+  active: boolean;
+  result: string;
+  failure_path?: string;
+  failure_reason?: string;
+  clock_seconds: number;
+  nodes?: RunNode[];
+  statuses?: NodeStatus[];
+  stopped?: boolean;
+}
+
+export interface StoredRun {
+  id: number;
+  plan: string;
+  version: number;
+  started_at: number;
+  result: string;
+  clock_seconds: number;
+  transitions: number;
+  failure_reason?: string;
+}
+
+export interface RunLog extends StoredRun {
+  xml: string;
+  plan_json: PlanJson | null;
+  nodes: RunNode[];
+  transition_list: Transition[];
+}
+
+export interface Diagnostic {
+  where: string;
+  line: number;
+  message: string;
+  node?: { tree: string; path: number[] };
+}
+
+export class ApiError extends Error {
+  constructor(
+    message: string,
+    public status: number,
+    public diagnostics: Diagnostic[] = [],
+  ) {
+    super(message);
+  }
+}
+
+export class Api {
+  constructor(public token: string) {}
+
+  private async request<T>(method: string, path: string, body?: unknown): Promise<T> {
+    const headers: Record<string, string> = {};
+    if (body !== undefined) headers['Content-Type'] = 'application/json';
+    if (this.token) headers.Authorization = `Bearer ${this.token}`;
+    const response = await fetch(path, { method, headers, body: body === undefined ? undefined : JSON.stringify(body) });
+    const text = await response.text();
+    let json: unknown = null;
+    try {
+      json = text ? JSON.parse(text) : null;
+    } catch {
+      json = null;
+    }
+    if (!response.ok) {
+      const error = (json as { error?: string; diagnostics?: Diagnostic[] }) ?? {};
+      throw new ApiError(error.error ?? `${response.status} ${response.statusText}`, response.status, error.diagnostics);
+    }
+    return json as T;
+  }
+
+  info = () => this.request<Info>('GET', '/api/info');
+  nodes = () => this.request<NodeInfo[]>('GET', '/api/nodes');
+  choices = () => this.request<Choices>('GET', '/api/choices');
+  state = () => this.request<CellState>('GET', '/api/state');
+  plans = () => this.request<{ name: string; latest_version: number; versions: number }[]>('GET', '/api/plans');
+  plan = (name: string, version?: number) =>
+    this.request<{ name: string; version: number; xml: string; plan: PlanJson }>(
+      'GET',
+      `/api/plans/${encodeURIComponent(name)}${version ? `?version=${version}` : ''}`,
+    );
+  savePlan = (name: string, plan: PlanJson) =>
+    this.request<{ name: string; version: number }>('PUT', `/api/plans/${encodeURIComponent(name)}`, { plan });
+  importPlan = (name: string, xml: string) =>
+    this.request<{ name: string; version: number }>('PUT', `/api/plans/${encodeURIComponent(name)}`, { xml });
+  deletePlan = (name: string) => this.request('DELETE', `/api/plans/${encodeURIComponent(name)}`);
+  subtrees = () => this.request<{ name: string; latest_version: number }[]>('GET', '/api/subtrees');
+  subtree = (name: string) =>
+    this.request<{ name: string; version: number; plan: PlanJson }>('GET', `/api/subtrees/${encodeURIComponent(name)}`);
+  saveSubtree = (name: string, plan: PlanJson) =>
+    this.request<{ name: string; version: number }>('PUT', `/api/subtrees/${encodeURIComponent(name)}`, { plan });
+  validate = (plan: PlanJson) =>
+    this.request<{ valid: boolean; diagnostics: Diagnostic[]; xml: string }>('POST', '/api/validate', { plan });
+  convertXml = (xml: string) =>
+    this.request<{ valid: boolean; diagnostics: Diagnostic[]; xml: string; plan: PlanJson }>('POST', '/api/validate', {
+      xml,
+    });
+  runPlan = (plan: PlanJson, paused = false) => this.request<{ run: number }>('POST', '/api/runs', { plan, paused });
+  runSaved = (name: string, version?: number, paused = false) =>
+    this.request<{ run: number }>('POST', '/api/runs', { name, version, paused });
+  control = (action: 'pause' | 'resume' | 'step' | 'stop') => this.request('POST', '/api/control', { action });
+  operation = (node: string, attributes: Record<string, string> = {}) =>
+    this.request<{ run: number }>('POST', '/api/operations', { node, attributes });
+  runStatus = (id: number) => this.request<RunInfo>('GET', `/api/runs/${id}`);
+  runs = () => this.request<StoredRun[]>('GET', '/api/runs');
+  runLog = (id: number) => this.request<RunLog>('GET', `/api/runs/${id}`);
+  pointCloud = (max = 20000) =>
+    this.request<{ points: number[]; colors: number[] }>('GET', `/api/pointcloud?max=${max}`);
+}

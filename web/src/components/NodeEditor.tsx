@@ -1,0 +1,261 @@
+// Pane 5: customise the selected operation. Every parameter whose values the system knows is
+// a list (waypoints, frames, object classes, grasps, predicates, fixed choices), never free text.
+
+import type { Choices, NodeInfo, PortInfo } from '../api';
+import type { EditorNode } from '../model/tree';
+import { formatPredicates, parsePredicates, PredicateTerm } from '../model/predicates';
+
+interface Props {
+  node: EditorNode | null;
+  info: NodeInfo | undefined;
+  choices: Choices | null;
+  objects: string[];
+  trees: string[];
+  readOnly: boolean;
+  onChange: (name: string, value: string | undefined) => void;
+}
+
+function value(node: EditorNode, name: string): string | undefined {
+  return node.attributes.find(([k]) => k === name)?.[1];
+}
+
+function Select(props: {
+  id: string;
+  current: string | undefined;
+  options: string[];
+  placeholder: string;
+  disabled: boolean;
+  onChange: (value: string | undefined) => void;
+}) {
+  const options = [...props.options];
+  if (props.current !== undefined && !options.includes(props.current)) options.unshift(props.current);
+  return (
+    <select
+      id={props.id}
+      value={props.current ?? ''}
+      disabled={props.disabled}
+      onChange={(e) => props.onChange(e.target.value === '' ? undefined : e.target.value)}
+    >
+      <option value="">{props.placeholder}</option>
+      {options.map((option) => (
+        <option key={option} value={option}>
+          {option === '' ? '(none)' : option}
+        </option>
+      ))}
+    </select>
+  );
+}
+
+function PredicateList(props: {
+  id: string;
+  text: string;
+  choices: Choices;
+  references: string[];
+  disabled: boolean;
+  onChange: (value: string | undefined) => void;
+}) {
+  const terms = parsePredicates(props.text);
+  const arity = (name: string) => props.choices.predicate.find((p) => p.name === name)?.arity ?? 1;
+  const update = (next: PredicateTerm[]) => {
+    const text = formatPredicates(next);
+    props.onChange(text === '' ? undefined : text);
+  };
+  const withArity = (name: string, args: string[]) => {
+    // The part is the first argument; the others are references the user picks.
+    const count = Math.max(0, arity(name) - 1);
+    const rest = args.filter((a) => a !== '?').slice(0, count);
+    const reference = props.references.includes('table_center') ? 'table_center' : props.references[0] ?? 'world';
+    while (rest.length < count) rest.push(reference);
+    return rest;
+  };
+  return (
+    <div className="predicate-list" id={props.id}>
+      {terms.map((term, i) => (
+        <div className="predicate-row" key={i}>
+          <select
+            value={term.name}
+            disabled={props.disabled}
+            aria-label="predicate"
+            onChange={(e) => {
+              const next = [...terms];
+              next[i] = { name: e.target.value, args: withArity(e.target.value, term.args) };
+              update(next);
+            }}
+          >
+            {props.choices.predicate
+              .filter((p) => p.arity >= 1)
+              .map((p) => (
+                <option key={p.name} value={p.name} title={p.description}>
+                  {p.name}
+                </option>
+              ))}
+          </select>
+          (part
+          {term.args
+            .filter((a) => a !== '?')
+            .map((arg, j) => (
+              <span key={j}>
+                ,{' '}
+                <select
+                  value={arg}
+                  disabled={props.disabled}
+                  aria-label="reference"
+                  onChange={(e) => {
+                    const next = [...terms];
+                    const args = [...next[i].args.filter((a) => a !== '?')];
+                    args[j] = e.target.value;
+                    next[i] = { ...next[i], args };
+                    update(next);
+                  }}
+                >
+                  {[...new Set([arg, ...props.references])].map((r) => (
+                    <option key={r} value={r}>
+                      {r}
+                    </option>
+                  ))}
+                </select>
+              </span>
+            ))}
+          )
+          <button
+            type="button"
+            disabled={props.disabled}
+            onClick={() => update(terms.filter((_, k) => k !== i))}
+            aria-label="remove condition"
+          >
+            ✕
+          </button>
+        </div>
+      ))}
+      <button
+        type="button"
+        disabled={props.disabled}
+        onClick={() => {
+          const name = props.choices.predicate.find((p) => p.name === 'right_of')?.name ??
+            props.choices.predicate.find((p) => p.arity >= 1)?.name ?? 'near';
+          update([...terms, { name, args: withArity(name, []) }]);
+        }}
+      >
+        + condition
+      </button>
+    </div>
+  );
+}
+
+export function NodeEditor({ node, info, choices, objects, trees, readOnly, onChange }: Props) {
+  if (!node) {
+    return (
+      <section className="pane editor" aria-label="Customise">
+        <h2>
+          <span className="pane-number">5</span> Customise
+        </h2>
+        <p className="empty">Select a node in the tree.</p>
+      </section>
+    );
+  }
+  const frames = choices?.frame ?? ['world'];
+  const references = [...new Set([...frames, ...objects, ...(choices?.object_class ?? [])])];
+  const inputFor = (port: PortInfo) => {
+    const id = `port-${port.name}`;
+    const current = value(node, port.name);
+    const placeholder = port.default !== undefined ? `default: ${port.default === '' ? '(none)' : port.default}` : 'choose…';
+    if (node.id === 'SubTree' && port.name === 'ID') {
+      return <Select id={id} current={current} options={trees} placeholder="choose a tree…" disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;
+    }
+    if (node.id === 'CheckPredicate' && port.name === 'args') {
+      const predicate = value(node, 'predicate');
+      const arity = choices?.predicate.find((p) => p.name === predicate)?.arity ?? 0;
+      const args = (current ?? '').split(';').filter((a) => a !== '');
+      while (args.length < arity) args.push('');
+      return (
+        <div id={id} className="args">
+          {arity === 0 && <span className="hint">no arguments</span>}
+          {args.slice(0, arity).map((arg, i) => (
+            <Select
+              key={i}
+              id={`${id}-${i}`}
+              current={arg || undefined}
+              options={['?', ...references]}
+              placeholder="choose…"
+              disabled={readOnly}
+              onChange={(v) => {
+                const next = [...args.slice(0, arity)];
+                next[i] = v ?? '';
+                onChange(port.name, next.join(';'));
+              }}
+            />
+          ))}
+        </div>
+      );
+    }
+    if (port.choices_from === 'predicate' && choices) {
+      return <PredicateList id={id} text={current ?? ''} choices={choices} references={references} disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;
+    }
+    let list: string[] | undefined = port.choices;
+    if (port.choices_from === 'waypoint') list = choices?.waypoint ?? [];
+    if (port.choices_from === 'frame') list = frames;
+    if (port.choices_from === 'object_class') list = port.choices ?? choices?.object_class ?? [];
+    if (port.choices_from === 'grasp') {
+      const objectClass = value(node, 'object_class');
+      const grasps = choices?.grasp ?? {};
+      list = objectClass ? grasps[objectClass] ?? [] : [...new Set(Object.values(grasps).flat())];
+    }
+    if (list) {
+      return <Select id={id} current={current} options={list} placeholder={placeholder} disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;
+    }
+    if (port.type === 'int' || port.type === 'double') {
+      return (
+        <input
+          id={id}
+          type="number"
+          step={port.type === 'int' ? 1 : 'any'}
+          min={port.min}
+          max={port.max}
+          placeholder={placeholder}
+          value={current ?? ''}
+          disabled={readOnly}
+          onChange={(e) => onChange(port.name, e.target.value === '' ? undefined : e.target.value)}
+        />
+      );
+    }
+    return (
+      <input
+        id={id}
+        type="text"
+        placeholder={port.type === 'costar::Pose' ? 'x;y;z;roll;pitch;yaw (m, degrees)' : placeholder}
+        value={current ?? ''}
+        disabled={readOnly}
+        onChange={(e) => onChange(port.name, e.target.value === '' ? undefined : e.target.value)}
+      />
+    );
+  };
+  return (
+    <section className="pane editor" aria-label="Customise">
+      <h2>
+        <span className="pane-number">5</span> Customise: <span className={`cat-text cat-${info?.category}`}>{node.id}</span>
+      </h2>
+      {info && <p className="description">{info.description}</p>}
+      <div className="ports">
+        <label htmlFor="port-name">name</label>
+        <input
+          id="port-name"
+          type="text"
+          placeholder="(optional)"
+          value={value(node, 'name') ?? ''}
+          disabled={readOnly}
+          onChange={(e) => onChange('name', e.target.value === '' ? undefined : e.target.value)}
+        />
+        {(info?.ports ?? []).map((port) => (
+          <div className="port" key={port.name} title={port.description}>
+            <label htmlFor={`port-${port.name}`}>
+              {port.name}
+              {port.default === undefined && value(node, port.name) === undefined && <span className="required"> required</span>}
+            </label>
+            {inputFor(port)}
+          </div>
+        ))}
+      </div>
+      {!info && <p className="reason">Unknown node type '{node.id}' for this workcell.</p>}
+    </section>
+  );
+}

@@ -1,0 +1,111 @@
+// Pane 1: the objects the system knows (detected parts), and for a selected SmartMove node the
+// candidates it considered: each part x symmetry with its cost, or why it was rejected.
+
+import type { CellState } from '../api';
+
+export interface Candidate {
+  object: string;
+  symmetry: number;
+  goal: [number, number, number];
+  cost?: number;
+  rejected?: string;
+  chosen: boolean;
+}
+
+export interface SmartMoveData {
+  candidates?: Candidate[];
+  chosen?: string;
+  failure?: string;
+  seconds?: number;
+}
+
+export function candidatesOf(data: unknown): SmartMoveData | null {
+  if (!data || typeof data !== 'object') return null;
+  const d = data as SmartMoveData;
+  return Array.isArray(d.candidates) ? d : null;
+}
+
+interface Props {
+  state: CellState | null;
+  selectedType: string | null;
+  data: SmartMoveData | null;
+}
+
+export function ObjectsPane({ state, selectedType, data }: Props) {
+  const objects = state?.objects ?? [];
+  const smart = selectedType !== null && selectedType.startsWith('Smart');
+  return (
+    <section className="pane objects" aria-label="Objects and SmartMoves">
+      <h2>
+        <span className="pane-number">1</span> Objects{smart ? ` · ${selectedType} candidates` : ''}
+      </h2>
+      {objects.length === 0 ? (
+        <p className="empty">No objects known yet{state ? '' : ' (not connected)'}: run DetectObjects to see the parts.</p>
+      ) : (
+        <table className="objects-table">
+          <thead>
+            <tr>
+              <th>object</th>
+              <th>class</th>
+              <th>x, y, z (m)</th>
+            </tr>
+          </thead>
+          <tbody>
+            {objects.map((o) => (
+              <tr key={o.name}>
+                <td>{o.name}</td>
+                <td>{o.class}</td>
+                <td>{o.p.map((v) => v.toFixed(3)).join(', ')}</td>
+              </tr>
+            ))}
+          </tbody>
+        </table>
+      )}
+      {smart && !data && <p className="empty">Run the plan to see this SmartMove's candidates.</p>}
+      {smart && data && (
+        <div className="candidates">
+          <p>
+            {data.chosen ? (
+              <>
+                chose <b>{data.chosen}</b>
+              </>
+            ) : (
+              <span className="reason">{data.failure ?? 'no candidate chosen'}</span>
+            )}
+            {data.seconds !== undefined && ` in ${(data.seconds * 1000).toFixed(1)} ms`}
+          </p>
+          <table>
+            <thead>
+              <tr>
+                <th>object</th>
+                <th>sym.</th>
+                <th>cost</th>
+                <th>rejected because</th>
+              </tr>
+            </thead>
+            <tbody>
+              {(data.candidates ?? []).map((c, i) => (
+                <tr key={i} className={c.chosen ? 'chosen' : c.rejected ? 'rejected' : ''}>
+                  <td>{c.object}</td>
+                  <td>{c.symmetry}</td>
+                  <td>{c.cost !== undefined ? c.cost.toFixed(3) : ''}</td>
+                  <td>{c.rejected ?? (c.chosen ? '✓ chosen' : '')}</td>
+                </tr>
+              ))}
+            </tbody>
+          </table>
+        </div>
+      )}
+      {state && state.predicates.length > 0 && (
+        <details className="predicates">
+          <summary>{state.predicates.length} predicate(s) hold</summary>
+          <ul>
+            {state.predicates.slice(0, 300).map((p) => (
+              <li key={p}>{p}</li>
+            ))}
+          </ul>
+        </details>
+      )}
+    </section>
+  );
+}
