@@ -66,9 +66,14 @@ then echo "ok   trace"; else echo "FAIL trace"; failures=$((failures + 1)); fi
 cat > "$tmp/long.xml" <<'XML'
 <root BTCPP_format="4"><BehaviorTree ID="m"><Repeat num_cycles="-1"><Sleep msec="10"/></Repeat></BehaviorTree></root>
 XML
-"$costar" run "$tmp/long.xml" -w none -q >"$tmp/out" 2>&1 &
+# The handler is installed just before the first tick, so wait until the trace shows ticks (a loaded
+# machine may take seconds to start the binary) rather than sleeping a fixed time.
+"$costar" run "$tmp/long.xml" -w none -q --trace "$tmp/long.jsonl" >"$tmp/out" 2>&1 &
 pid=$!
-sleep 0.5
+for _ in $(seq 300); do
+  [[ -s "$tmp/long.jsonl" ]] && break
+  sleep 0.1
+done
 kill -INT $pid
 wait $pid
 code=$?
