@@ -10,6 +10,7 @@
 #include <map>
 #include <random>
 #include <regex>
+#include <string>
 
 #include "bt/builder.h"
 #include "bt/executor.h"
@@ -21,6 +22,14 @@
 using namespace costar;
 
 int main(int argc, char** argv) {
+  if (argc > 3 || (argc > 1 && std::string(argv[1]).find_first_not_of("0123456789") != std::string::npos) ||
+      (argc > 2 && std::string(argv[2]).find_first_not_of("0123456789") != std::string::npos)) {
+    std::fprintf(stderr,
+                 "usage: motion_safety [COUNT] [SEED]\n"
+                 "  sends COUNT (default 1000) random MoveToPose commands to the simulated UR5 and reports\n"
+                 "  joint limits, speeds, the lowest tool point and arm-table contacts seen in physics\n");
+    return 2;
+  }
   const int count = argc > 1 ? std::atoi(argv[1]) : 1000;
   const std::uint64_t seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 1;
   const auto cell = workcell::makeWorkcell(
