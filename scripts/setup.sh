@@ -24,6 +24,8 @@ PACKAGES=(
   libcairo2-dev
   # the editor's server (costar serve): SQLite store; Boost.Beast comes with libboost-dev
   libsqlite3-dev
+  # perception: point clouds and ObjRecRANSAC (PCL), ArUco (OpenCV contrib), the SVM (libsvm)
+  libpcl-dev libopencv-dev libopencv-contrib-dev libsvm-dev
 )
 
 SUDO=""

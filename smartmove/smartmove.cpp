@@ -578,8 +578,16 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
                 return (other.second.translation().head<2>() - spot.head<2>()).norm() > held_radius + radius + 0.02;
               });
           std::string failing;
+          const double m = config_.table_spot_margin;
           for (const auto& pattern : patterns) {
-            failing = spotFailsPattern(spot, pattern);
+            for (const Eigen::Vector3d& shift :
+                 {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(m, 0, 0), Eigen::Vector3d(-m, 0, 0),
+                  Eigen::Vector3d(0, m, 0), Eigen::Vector3d(0, -m, 0)}) {
+              failing = spotFailsPattern(spot + shift, pattern);
+              if (!failing.empty()) {
+                break;
+              }
+            }
             if (!failing.empty()) {
               break;
             }

@@ -50,6 +50,10 @@ struct SmartMoveConfig {
   Eigen::Vector2d table_min{0.30, -0.40};
   Eigen::Vector2d table_max{0.70, 0.40};
   double table_spot_step = 0.03;
+  /// A spot qualifies only if the predicates also hold this far from it in x and y, so that the
+  /// part, once put down and detected again (placement and perception error), still satisfies
+  /// them rather than sitting in the predicates' dead band.
+  double table_spot_margin = 0.02;
   /// Robot links that may touch the part being grasped (the gripper).
   std::vector<std::string> gripper_links = {"tool0", "wrist_3_link"};
   CostWeights weights;

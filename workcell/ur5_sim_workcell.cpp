@@ -3,6 +3,8 @@
 #include "arm/arm_component.h"
 #include "core/paths.h"
 #include "gripper/parallel_gripper.h"
+#include "perception/perception_component.h"
+#include "perception/pipeline.h"
 #include "planning/collision_world.h"
 #include "predicator/predicator.h"
 #include "sim/arm_driver.h"
@@ -69,8 +71,26 @@ class TestOraclePerception final : public component::LocalComponent {
   sim::Simulation& simulation_;
 };
 
+/// The perception pipeline (models and SVM loaded from the data files, about half a second),
+/// loaded once per thread and shared by the workcells that thread creates: trials create one
+/// workcell per trial, and a pipeline runs one detection at a time.
+std::shared_ptr<perception::Pipeline> threadPipeline(const world::Pose& table_center) {
+  thread_local std::shared_ptr<perception::Pipeline> pipeline;
+  if (!pipeline) {
+    perception::PipelineOptions options;
+    options.workspace.table_center = table_center;
+    pipeline = perception::Pipeline::load(perception::PipelineFiles::under(), options);
+  }
+  return pipeline;
+}
+
+/// The workspace centre as set up with the ArUco marker (`costar perception collect`).
+const world::Pose& tableCenter() {
+  static const world::Pose pose = perception::loadTableCenter(perception::PipelineFiles::under().workspace_file);
+  return pose;
+}
+
 const world::Pose kBaseInWorld(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
-const world::Pose kTableCenter(Eigen::Translation3d(0.5, 0.0, 0.0));
 
 class Ur5SimWorkcell final : public Workcell {
  public:
@@ -106,9 +126,15 @@ class Ur5SimWorkcell final : public Workcell {
     components().add(arm);
     components().add(gripper);
     components().add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
-        {"table_center", kTableCenter}, {"robot_base", kBaseInWorld}}));
+        {"table_center", tableCenter()}, {"robot_base", kBaseInWorld}}));
     if (options.test_oracle_perception) {
       components().add(std::make_shared<TestOraclePerception>(*simulation_));
+    } else {
+      // DetectObjects: the camera's frames only, never the simulator's true poses.
+      perception::PerceptionConfig perception_config;
+      perception_config.table_center = tableCenter();
+      components().add(std::make_shared<perception::PerceptionComponent>(
+          camera_, clock(), threadPipeline(tableCenter()), perception_config));
     }
     smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(*arm, *gripper, components().world(), collisions_,
                                                                  simulation_->objectClasses(), grasps_);

@@ -1,0 +1,211 @@
+#include "perception/perception_component.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace costar::perception {
+
+using component::OperationResult;
+using component::ParamSpec;
+using component::ValueType;
+
+namespace {
+
+std::shared_ptr<Pipeline> loadPipeline(const PerceptionConfig& config) {
+  PipelineOptions options = config.pipeline;
+  options.workspace.table_center =
+      config.table_center ? *config.table_center : loadTableCenter(config.files.workspace_file);
+  return Pipeline::load(config.files, options);
+}
+
+std::vector<world::ObjectClass> classesOf(const Pipeline& pipeline) {
+  std::vector<world::ObjectClass> classes;
+  for (const auto& model : pipeline.models()) {
+    classes.push_back(model.object_class);
+  }
+  return classes;
+}
+
+nlohmann::json poseJson(const world::Pose& pose) {
+  const Eigen::Vector3d p = pose.translation();
+  const Eigen::Vector3d rpy = world::rpyOf(pose.linear()) * 180.0 / M_PI;
+  const auto round = [](double value, double step) { return std::round(value / step) * step; };
+  return {{"xyz", {round(p.x(), 1e-5), round(p.y(), 1e-5), round(p.z(), 1e-5)}},
+          {"rpy_deg", {round(rpy.x(), 1e-3), round(rpy.y(), 1e-3), round(rpy.z(), 1e-3)}}};
+}
+
+}  // namespace
+
+/// Captures frames at the camera's rate across polls, then processes them.
+class DetectObjectsOperation final : public component::RunningOperation {
+ public:
+  DetectObjectsOperation(PerceptionComponent& component, int frames) : component_(component), wanted_(frames) {
+    capture();
+  }
+
+  OperationResult poll() override {
+    if (done_) {
+      return *done_;
+    }
+    const TimePoint now = component_.clock_.now();
+    if (static_cast<int>(frames_.size()) < wanted_ && now >= next_capture_) {
+      capture();
+    }
+    if (static_cast<int>(frames_.size()) < wanted_) {
+      return OperationResult::running();
+    }
+    try {
+      done_ = component_.process(frames_);
+    } catch (const std::exception& e) {
+      done_ = OperationResult::failure(std::string("DetectObjects: ") + e.what());
+    }
+    frames_.clear();
+    return *done_;
+  }
+
+  void cancel() override {
+    frames_.clear();
+    done_ = OperationResult::failure("DetectObjects was cancelled");
+  }
+
+ private:
+  void capture() {
+    frames_.push_back(component_.camera_.capture());
+    next_capture_ = component_.clock_.now() + component_.camera_.framePeriod();
+  }
+
+  PerceptionComponent& component_;
+  int wanted_;
+  std::vector<camera::RgbdFrame> frames_;
+  TimePoint next_capture_{};
+  std::optional<OperationResult> done_;
+};
+
+PerceptionComponent::PerceptionComponent(camera::RgbdCamera& camera, const Clock& clock, PerceptionConfig config)
+    : PerceptionComponent(camera, clock, loadPipeline(config), config) {}
+
+PerceptionComponent::PerceptionComponent(camera::RgbdCamera& camera, const Clock& clock,
+                                         std::shared_ptr<Pipeline> pipeline, PerceptionConfig config)
+    : camera_(camera),
+      clock_(clock),
+      config_(std::move(config)),
+      pipeline_(std::move(pipeline)),
+      persistence_(classesOf(*pipeline_), config_.persistence) {
+  description_.name = config_.name;
+  description_.type = "CostarPerception";
+  description_.inputs = {"rgbd_frames"};
+  description_.outputs = {"detections"};
+  ParamSpec frames{"frames", ValueType::kInt,
+                   "frames to capture at the camera's rate; their per-pixel median is processed",
+                   static_cast<long long>(config_.frames)};
+  frames.min = 1;
+  frames.max = 60;
+  description_.operations = {
+      {"DetectObjects",
+       "Looks at the workspace with the RGB-D camera and updates the known objects: a frame symbol per object "
+       "(names kept across detections), is_a(object, class) and visible(object).",
+       {frames},
+       component::OperationKind::kKnowledge}};
+  for (const auto& model : pipeline_->models()) {
+    description_.symbols.push_back({model.name(), world::SymbolKind::kObjectClass,
+                                    "object class " + model.name() + ": " + model.object_class.description});
+  }
+  description_.symbols.push_back({"<class>_<n>", world::SymbolKind::kFrame,
+                                  "a detected object's frame in the world (e.g. node_3), canonical orientation"});
+  description_.predicates = {{"is_a", 2, "is_a(object, class): the detected object is of that class"},
+                             {"visible", 1, "visible(object): the latest DetectObjects saw the object"}};
+}
+
+std::unique_ptr<component::RunningOperation> PerceptionComponent::begin(const std::string& operation,
+                                                                        const component::ParamMap& params) {
+  if (operation != "DetectObjects") {
+    return std::make_unique<component::FinishedOperation>(
+        OperationResult::failure(operation + ": not an operation of the perception component"));
+  }
+  const auto it = params.find("frames");
+  const int frames = it != params.end() ? static_cast<int>(it->second.asInt()) : config_.frames;
+  return std::make_unique<DetectObjectsOperation>(*this, std::clamp(frames, 1, 60));
+}
+
+OperationResult PerceptionComponent::process(const std::vector<camera::RgbdFrame>& frames) {
+  PipelineResult result = pipeline_->detect(frames);
+  std::lock_guard lock(mutex_);
+  std::vector<std::string> before;
+  for (const auto& object : persistence_.objects()) {
+    before.push_back(object.name);
+  }
+  const std::vector<TrackedObject>& objects = persistence_.update(result.detections);
+  last_stamp_ = clock_.now();
+  nlohmann::json list = nlohmann::json::array();
+  nlohmann::json fresh = nlohmann::json::array();
+  std::vector<std::string> now;
+  for (const auto& object : objects) {
+    now.push_back(object.name);
+    list.push_back({{"name", object.name},
+                    {"class", object.object_class},
+                    {"pose", poseJson(object.pose)},
+                    {"confidence", std::round(object.confidence * 1000.0) / 1000.0},
+                    {"visible", object.missed == 0}});
+    if (std::find(before.begin(), before.end(), object.name) == before.end()) {
+      fresh.push_back(object.name);
+    }
+  }
+  nlohmann::json dropped = nlohmann::json::array();
+  for (const auto& name : before) {
+    if (std::find(now.begin(), now.end(), name) == now.end()) {
+      dropped.push_back(name);
+    }
+  }
+  const StageTimes& t = result.times;
+  const auto ms = [](double seconds) { return std::round(seconds * 1e4) / 10.0; };
+  nlohmann::json data = {{"objects", list},
+                         {"new", fresh},
+                         {"dropped", dropped},
+                         {"frames", frames.size()},
+                         {"latency_ms",
+                          {{"median", ms(t.median)},
+                           {"crop", ms(t.crop)},
+                           {"normals", ms(t.normals)},
+                           {"features", ms(t.features)},
+                           {"classification", ms(t.classification)},
+                           {"pose", ms(t.pose)},
+                           {"total", ms(t.total)}}}};
+  last_result_ = std::move(result);
+  return OperationResult::success(std::move(data));
+}
+
+world::Report PerceptionComponent::report() const {
+  std::lock_guard lock(mutex_);
+  world::Report report;
+  for (const auto& model : pipeline_->models()) {
+    world::Symbol symbol;
+    symbol.name = model.name();
+    symbol.stamp = last_stamp_;
+    symbol.value = world::ObjectClassValue{model.object_class.description};
+    report.symbols.push_back(std::move(symbol));
+  }
+  for (const auto& object : persistence_.objects()) {
+    world::Symbol symbol;
+    symbol.name = object.name;
+    symbol.stamp = last_stamp_;
+    symbol.value = world::FrameValue{"world", object.pose};
+    report.symbols.push_back(std::move(symbol));
+    report.predicates.push_back({"is_a", {object.name, object.object_class}, true, ""});
+    if (object.missed == 0) {
+      report.predicates.push_back({"visible", {object.name}, true, ""});
+    }
+  }
+  return report;
+}
+
+std::vector<TrackedObject> PerceptionComponent::objects() const {
+  std::lock_guard lock(mutex_);
+  return persistence_.objects();
+}
+
+std::optional<PipelineResult> PerceptionComponent::lastResult() const {
+  std::lock_guard lock(mutex_);
+  return last_result_;
+}
+
+}  // namespace costar::perception

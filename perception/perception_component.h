@@ -1,0 +1,79 @@
+#pragma once
+// The perception component (the paper's Sec. IV): DetectObjects, a knowledge operation the
+// user places in a plan where the camera has a clear view. It captures N frames at the
+// camera's frame rate across polls (so it takes simulated time), then, in the poll that gets
+// the last frame, runs the pipeline (perception/pipeline.h), setCanonicalOrientation and
+// persistenceUpdate, and replaces its report:
+//   symbols     one frame per object ("node_3", parent "world", pose of the object frame in
+//               the robot base frame: camera calibration x camera pose), and one object-class
+//               symbol per class ("node", "link")
+//   predicates  is_a(object, class)    the object is of that class
+//               visible(object)        seen by the latest DetectObjects (objects kept by
+//                                      keep_for without being re-seen lack it)
+// The class symbol names the data file (data/objects/<class>.json) that gives SmartMove the
+// class's symmetries and axis priority. It reads camera frames only, never simulator ground
+// truth.
+
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include "camera/rgbd.h"
+#include "component/component.h"
+#include "core/clock.h"
+#include "perception/persistence.h"
+#include "perception/pipeline.h"
+
+namespace costar::perception {
+
+struct PerceptionConfig {
+  std::string name = "perception";
+  /// Data files (default: under dataRoot()).
+  PipelineFiles files = PipelineFiles::under();
+  /// The workspace centre in the world; when absent, read from files.workspace_file.
+  std::optional<world::Pose> table_center;
+  PipelineOptions pipeline;
+  PersistenceOptions persistence;
+  /// Frames per DetectObjects (the median filter's N); the operation's `frames` parameter
+  /// overrides it.
+  int frames = 15;
+};
+
+class PerceptionComponent final : public component::LocalComponent {
+ public:
+  /// Loads the pipeline's data files. The camera and clock must outlive the component.
+  /// @throws std::runtime_error naming a missing or inconsistent file.
+  PerceptionComponent(camera::RgbdCamera& camera, const Clock& clock, PerceptionConfig config = {});
+  /// Shares an already loaded pipeline (e.g. one per process); config.pipeline is then
+  /// ignored except for the workspace, which is applied to `pipeline`'s options only if set here.
+  PerceptionComponent(camera::RgbdCamera& camera, const Clock& clock, std::shared_ptr<Pipeline> pipeline,
+                      PerceptionConfig config = {});
+
+  const component::ComponentDescription& description() const override { return description_; }
+  world::Report report() const override;
+
+  /// The objects known after the latest detection (names, classes, world poses).
+  std::vector<TrackedObject> objects() const;
+  /// The latest detection's raw result (detections, stage times); empty before the first.
+  std::optional<PipelineResult> lastResult() const;
+  Pipeline& pipeline() { return *pipeline_; }
+
+ private:
+  friend class DetectObjectsOperation;
+  std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
+                                                     const component::ParamMap& params) override;
+  /// Runs the pipeline on `frames` and updates the state; returns the operation's result.
+  component::OperationResult process(const std::vector<camera::RgbdFrame>& frames);
+
+  component::ComponentDescription description_;
+  camera::RgbdCamera& camera_;
+  const Clock& clock_;
+  PerceptionConfig config_;
+  std::shared_ptr<Pipeline> pipeline_;
+  mutable std::mutex mutex_;
+  PersistenceFilter persistence_;
+  std::optional<PipelineResult> last_result_;
+  TimePoint last_stamp_{};
+};
+
+}  // namespace costar::perception

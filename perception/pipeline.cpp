@@ -1,0 +1,223 @@
+#include "perception/pipeline.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <stdexcept>
+#include <thread>
+
+#include "core/paths.h"
+#include "perception/median_filter.h"
+
+namespace costar::perception {
+
+namespace {
+
+double since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+PipelineFiles PipelineFiles::under(const std::filesystem::path& root) {
+  const std::filesystem::path base = root.empty() ? dataRoot() : root;
+  return {base / "data" / "objects", base / "data" / "perception" / "classes.json",
+          base / "data" / "perception" / "svm_model.json", base / "data" / "perception" / "workspace.json"};
+}
+
+/// One ClassPoseEstimator per class and worker thread.
+struct Pipeline::Workers {
+  std::vector<std::vector<std::unique_ptr<ClassPoseEstimator>>> estimators;  // [thread][model]
+};
+
+Pipeline::Pipeline(std::vector<ObjectModel> models, SvmClassifier classifier, PipelineOptions options)
+    : models_(std::move(models)),
+      classifier_(std::move(classifier)),
+      options_(options),
+      workers_(std::make_unique<Workers>()) {
+  if (models_.empty()) {
+    throw std::runtime_error("perception: no object classes");
+  }
+  if (classifier_.empty()) {
+    throw std::runtime_error("perception: the SVM is empty (train one with `costar perception train`)");
+  }
+  for (const auto& model : models_) {
+    const int label = classifier_.labelOf(model.name());
+    if (label <= 0) {
+      throw std::runtime_error("perception: the SVM was not trained on class '" + model.name() +
+                               "' (run `costar perception collect` and `costar perception train`)");
+    }
+    label_of_model_.push_back(label);
+  }
+  options_.threads = std::clamp(options_.threads, 1, 8);
+  workers_->estimators.resize(static_cast<std::size_t>(options_.threads));
+  for (auto& per_thread : workers_->estimators) {
+    for (const auto& model : models_) {
+      per_thread.push_back(std::make_unique<ClassPoseEstimator>(model, options_.pose));
+    }
+  }
+}
+
+Pipeline::~Pipeline() = default;
+
+std::unique_ptr<Pipeline> Pipeline::load(const PipelineFiles& files, PipelineOptions options) {
+  std::vector<ObjectModel> models = loadObjectModels(files.objects_dir, files.classes_file);
+  SvmClassifier classifier = SvmClassifier::load(files.svm_file);
+  return std::make_unique<Pipeline>(std::move(models), std::move(classifier), options);
+}
+
+const ObjectModel* Pipeline::model(const std::string& name) const {
+  for (const auto& model : models_) {
+    if (model.name() == name) {
+      return &model;
+    }
+  }
+  return nullptr;
+}
+
+PipelineResult Pipeline::detect(std::span<const camera::RgbdFrame> frames) {
+  if (frames.empty()) {
+    throw std::invalid_argument("DetectObjects needs at least one frame");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const camera::RgbdFrame& last = frames.back();
+  const std::vector<std::uint8_t> mask = workspaceMask(frames, options_.workspace);
+  auto filtered = std::make_shared<camera::RgbdFrame>(medianFrame(frames, mask, options_.threads));
+  // The depth check needs the surroundings too (the table around an object): outside the
+  // mask, the last frame's own readings.
+  camera::RgbdFrame reference = *filtered;
+  for (std::size_t pixel = 0; pixel < mask.size(); ++pixel) {
+    if (mask[pixel] == 0) {
+      reference.points[pixel] = last.points[pixel];
+    }
+  }
+  const double median = since(start);
+  PipelineResult result = detectFiltered(*filtered, &reference);
+  result.filtered = std::move(filtered);
+  result.times.median = median;
+  result.times.total = since(start);
+  return result;
+}
+
+PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const camera::RgbdFrame* depth_reference) {
+  const camera::RgbdFrame& reference = depth_reference != nullptr ? *depth_reference : frame;
+  PipelineResult result;
+  auto start = std::chrono::steady_clock::now();
+  const auto begin = start;
+  WorkspaceCloud workspace = cropWorkspace(frame, options_.workspace);
+  result.times.crop = since(start);
+  result.workspace_points = static_cast<int>(workspace.cloud.size());
+
+  start = std::chrono::steady_clock::now();
+  estimateNormals(frame, workspace.cloud, options_.normal_window, static_cast<float>(options_.normal_max_distance));
+  result.times.normals = since(start);
+
+  const SegmentationResult segmentation = segmentPoints(workspace.cloud, classifier_, options_.segmentation);
+  result.times.features = segmentation.feature_seconds;
+  result.times.classification = segmentation.classification_seconds;
+  for (const int label : classifier_.labels()) {
+    const auto count = std::count(segmentation.labels.begin(), segmentation.labels.end(), label);
+    result.points_per_label.emplace_back(label, static_cast<int>(count));
+  }
+
+  // Stage 4: one task per (class, cluster), biggest first over the worker threads.
+  start = std::chrono::steady_clock::now();
+  std::vector<Cloud> class_points(models_.size());
+  for (std::size_t i = 0; i < workspace.cloud.size(); ++i) {
+    for (std::size_t m = 0; m < models_.size(); ++m) {
+      if (segmentation.labels[i] == label_of_model_[m]) {
+        class_points[m].append(workspace.cloud, i);
+      }
+    }
+  }
+  struct Task {
+    std::size_t model = 0;
+    std::uint32_t index = 0;  // cluster number within the class: seeds the task
+    std::vector<int> cluster;
+    std::vector<Detection> found;
+    ClassPoseEstimator::Timing timing;
+  };
+  std::vector<Task> tasks;
+  for (std::size_t m = 0; m < models_.size(); ++m) {
+    const auto clusters = workers_->estimators[0][m]->clusters(class_points[m], frame.intrinsics);
+    for (std::size_t c = 0; c < clusters.size(); ++c) {
+      tasks.push_back({m, static_cast<std::uint32_t>(c), clusters[c], {}, {}});
+    }
+  }
+  std::vector<std::size_t> order(tasks.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    order[i] = i;
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return tasks[a].cluster.size() > tasks[b].cluster.size(); });
+  for (auto& per_thread : workers_->estimators) {
+    for (auto& estimator : per_thread) {
+      estimator->setSupportPlane(workspace.plane);
+    }
+  }
+  std::atomic<std::size_t> next{0};
+  const auto work = [&](std::size_t thread) {
+    for (std::size_t i = next++; i < order.size(); i = next++) {
+      Task& task = tasks[order[i]];
+      task.found = workers_->estimators[thread][task.model]->estimateCluster(class_points[task.model], task.cluster,
+                                                                             reference, task.index, &task.timing);
+    }
+  };
+  {
+    StdoutSilence silence;  // ObjRecRANSAC prints its progress
+    const std::size_t threads =
+        std::min<std::size_t>(workers_->estimators.size(), std::max<std::size_t>(1, tasks.size()));
+    std::vector<std::thread> helpers;
+    for (std::size_t t = 1; t < threads; ++t) {
+      helpers.emplace_back(work, t);
+    }
+    work(0);
+    for (auto& helper : helpers) {
+      helper.join();
+    }
+  }
+  std::vector<Detection> found;
+  for (std::size_t m = 0; m < models_.size(); ++m) {
+    std::vector<Detection> of_class;
+    for (const Task& task : tasks) {
+      if (task.model == m) {
+        of_class.insert(of_class.end(), task.found.begin(), task.found.end());
+      }
+    }
+    // Touching parts of a class: each refined on its own points.
+    workers_->estimators[0][m]->refineTouching(class_points[m], of_class, reference);
+    found.insert(found.end(), of_class.begin(), of_class.end());
+  }
+  for (const Task& task : tasks) {
+    result.times.recognition += task.timing.recognition;
+    result.times.refinement += task.timing.refinement;
+    result.pose_runs += task.timing.runs;
+    result.pose_candidates += task.timing.candidates;
+    result.pose_checked += task.timing.checked;
+  }
+  result.pose_clusters = static_cast<int>(tasks.size());
+  found = mergeDetections(std::move(found), models_);
+  // Class order, then best first.
+  std::stable_sort(found.begin(), found.end(), [this](const Detection& a, const Detection& b) {
+    const auto index = [this](const std::string& name) {
+      for (std::size_t m = 0; m < models_.size(); ++m) {
+        if (models_[m].name() == name) {
+          return m;
+        }
+      }
+      return models_.size();
+    };
+    return index(a.object_class) < index(b.object_class);
+  });
+  for (Detection& detection : found) {
+    detection.pose = frame.camera_pose * detection.pose_in_camera;
+  }
+  result.detections = std::move(found);
+  result.workspace = std::move(workspace.cloud);
+  result.labels = segmentation.labels;
+  result.times.pose = since(start);
+  result.times.total = since(begin);
+  return result;
+}
+
+}  // namespace costar::perception

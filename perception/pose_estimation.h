@@ -1,0 +1,204 @@
+#pragma once
+// Stage 4 of the pipeline: 6-DOF poses of a class's instances in the points the SVM gave that
+// class, with PCL's ObjRecRANSAC (Papazov & Burschka 2010; multi-instance), each hypothesis
+// refined by point-to-plane ICP onto the class model and scored against the organized depth
+// image; hypotheses below a confidence threshold are dropped.
+//
+// All poses here are object frame -> camera OPTICAL frame (x right, y down, z forward): that
+// is the frame ObjRecRANSAC needs its scene in (it projects the scene along z).
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "camera/rgbd.h"
+#include "perception/cloud.h"
+#include "perception/object_model.h"
+#include "perception/workspace.h"
+#include "world/pose.h"
+
+namespace costar::perception {
+
+struct PoseEstimationOptions {
+  /// ObjRecRANSAC's probability of finding every instance (sets its number of samples).
+  double success_probability = 0.995;
+  /// Seed of ObjRecRANSAC's sampling (PCL seeds it with the time; this project does not).
+  std::uint32_t seed = 1;
+  /// The class's points are split into connected clusters (neighbouring pixels closer than
+  /// this, m); ObjRecRANSAC runs on each cluster of at least min_cluster_points, with its
+  /// "relative object size" set from the cluster's size and the model's.
+  double cluster_tolerance = 0.01;
+  int min_cluster_points = 25;
+  /// Upper bound of the per-cluster relative object size (larger: fewer samples).
+  double max_relative_object_size = 0.6;
+  /// When a cluster has points left that no detection explains (at least this fraction of
+  /// a detected instance's points, or the whole cluster when nothing was found), ObjRecRANSAC
+  /// runs again on those points with another seed, up to max_attempts runs per cluster.
+  int max_attempts = 3;
+  double unexplained_fraction = 0.4;
+  /// ObjRecRANSAC's hypotheses are checked best first: a coarse ICP (10 iterations, the
+  /// correspondence distance shrinking from icp_initial_distance to icp_coarse_final_distance)
+  /// and a quick render-and-compare; a hypothesis that passes is refined with icp_iterations
+  /// more (down to icp_final_distance) and checked again in full. Metres.
+  double icp_initial_distance = 0.025;
+  double icp_coarse_final_distance = 0.008;
+  double icp_final_distance = 0.003;
+  int icp_iterations = 15;
+  /// Tolerance of the render-and-compare check against the depth image (m).
+  double depth_tolerance = 0.006;
+  /// A detection needs this agreement: of the model surface the camera should see, the
+  /// fraction seen where the model says (occluded parts do not count against it).
+  double min_confidence = 0.93;
+  /// ... and this fraction of the model's camera-facing surface seen at all.
+  double min_visible_fraction = 0.2;
+};
+
+/// One object instance found in a camera frame.
+struct Detection {
+  std::string object_class;
+  /// Object frame in the camera optical frame.
+  world::Pose pose_in_camera = world::Pose::Identity();
+  /// Object frame in the world (camera_pose * pose_in_camera), filled by the pipeline.
+  world::Pose pose = world::Pose::Identity();
+  /// Agreement of the refined pose with the depth image, in [0, 1] (see min_confidence).
+  double confidence = 0.0;
+  /// ObjRecRANSAC's own match confidence (fraction of the model surface it matched).
+  double recognition_score = 0.0;
+  /// Fraction of the model's camera-facing surface seen where the model predicts it.
+  double visible_fraction = 0.0;
+  /// RMS point-to-plane residual of ICP's inliers (m) and their number.
+  double fit_rms = 0.0;
+  int support = 0;
+};
+
+/// Result of refining a pose.
+struct IcpResult {
+  world::Pose pose = world::Pose::Identity();
+  int inliers = 0;
+  double rms = 0.0;
+  int iterations = 0;
+};
+
+/// Point-to-plane ICP of `scene` (points in the camera frame) onto the model's surface,
+/// starting from `initial` (object -> camera). Correspondences come from the model's grid of
+/// nearest surface samples; the gate shrinks from `initial_distance` to `final_distance` (m)
+/// and residuals are Huber-weighted. `point_to_point_weight` > 0 adds that much of a
+/// point-to-point term (pulls an object that slid along a face back over its points).
+IcpResult refinePose(const ObjectModel& model, const std::vector<Eigen::Vector3f>& scene, const world::Pose& initial,
+                     int iterations, double initial_distance, double final_distance,
+                     double point_to_point_weight = 0.0);
+
+/// Render-and-compare: of the model surface samples that face the camera under `pose`
+/// (object -> optical frame) and project into `frame`, how many the organized depth confirms
+/// (within `tolerance`), contradicts (the camera sees farther), or cannot judge (something is
+/// in front: occluded, or no reading).
+struct DepthAgreement {
+  int facing = 0;
+  int confirmed = 0;
+  int contradicted = 0;
+  double agreement() const {
+    return confirmed + contradicted == 0 ? 0.0 : double(confirmed) / (confirmed + contradicted);
+  }
+  double visibleFraction() const { return facing == 0 ? 0.0 : double(confirmed) / facing; }
+};
+/// `stride` > 1 checks every stride-th sample only (a quick score).
+DepthAgreement compareWithDepth(const ObjectModel& model, const world::Pose& pose, const camera::RgbdFrame& frame,
+                                double tolerance, int stride = 1);
+
+/// Fraction of `a`'s interior samples (under pose_a) that lie inside `b`'s boxes (under pose_b)
+/// shrunk by `margin` (m): how much of a's volume b claims too.
+double overlapFraction(const ObjectModel& a, const world::Pose& pose_a, const ObjectModel& b, const world::Pose& pose_b,
+                       double margin = 0.001);
+
+/// ObjRecRANSAC loaded with one class's model. Building it hashes the model's point pairs
+/// (milliseconds). One instance must not be used by two threads at once; distinct instances
+/// may run in parallel.
+class ClassPoseEstimator {
+ public:
+  /// `model` must outlive the estimator.
+  explicit ClassPoseEstimator(const ObjectModel& model, PoseEstimationOptions options = {});
+  ~ClassPoseEstimator();
+  ClassPoseEstimator(const ClassPoseEstimator&) = delete;
+  ClassPoseEstimator& operator=(const ClassPoseEstimator&) = delete;
+
+  const ObjectModel& model() const { return model_; }
+  const PoseEstimationOptions& options() const { return options_; }
+
+  /// The table the objects stand on (optical frame), for the next estimates: a hypothesis
+  /// that puts part of the object more than 4 mm below it is rejected (the depth check alone
+  /// cannot see that: the table hides what lies below it). Absent: no such test.
+  void setSupportPlane(std::optional<TablePlane> plane) { support_plane_ = plane; }
+
+  /// Time spent: ObjRecRANSAC, then verification (ICP and scoring), seconds.
+  struct Timing {
+    double recognition = 0.0;
+    double refinement = 0.0;
+    int runs = 0;        // ObjRecRANSAC runs
+    int candidates = 0;  // hypotheses it accepted
+    int checked = 0;     // hypotheses verified with the coarse ICP
+  };
+
+  /// The clusters estimateCluster() works on: connected groups of `points` (which carry
+  /// pixel indices into an image of `intrinsics`' size) of at least min_cluster_points.
+  std::vector<std::vector<int>> clusters(const Cloud& points, const camera::Intrinsics& intrinsics) const;
+
+  /// Finds the instances of the class in one cluster of `points` (optical frame, with normals
+  /// towards the camera and pixel indices), refining each with the class's points nearby and
+  /// checking it against the organized `frame` it came from. `task` seeds the sampling
+  /// (deterministic for the same input and task). ObjRecRANSAC writes to stdout: callers
+  /// silence it (StdoutSilence). Adds its time to `timing` when given.
+  std::vector<Detection> estimateCluster(const Cloud& points, const std::vector<int>& cluster,
+                                         const camera::RgbdFrame& frame, std::uint32_t task, Timing* timing = nullptr);
+
+  /// Refines detections of this class that touch each other: each refines on the points of
+  /// `points` nearer its own surface than its neighbours' (two rounds), so that touching
+  /// parts do not pull each other. Confidence and visible fraction are updated.
+  void refineTouching(const Cloud& points, std::vector<Detection>& detections, const camera::RgbdFrame& frame) const;
+
+  /// All clusters in turn, refineTouching(), then mergeDetections(): the instances of the
+  /// class in `points`.
+  std::vector<Detection> estimate(const Cloud& points, const camera::RgbdFrame& frame, Timing* timing = nullptr);
+
+ private:
+  /// Points of `cluster` farther than the depth tolerance from every detection's surface.
+  std::vector<int> unexplainedPoints(const Cloud& points, const std::vector<int>& cluster,
+                                     const std::vector<Detection>& detections) const;
+  static double meanSupport(const std::vector<Detection>& detections);
+  /// Start poses from the principal axes of `indices` of `points` (see estimateCluster).
+  std::vector<world::Pose> principalAxisSeeds(const Cloud& points, const std::vector<int>& indices) const;
+  /// For an elongated model: the shift along its long axes (up to 24 mm) that the depth image
+  /// agrees with best, if better than `pose`; nullopt otherwise.
+  std::optional<world::Pose> slideAlongLongAxes(const world::Pose& pose, const camera::RgbdFrame& frame) const;
+  /// Marks the points of `points` near `detection`'s surface in `taken`.
+  void markExplained(const Cloud& points, const Detection& detection, std::vector<bool>& taken) const;
+
+  /// True when the object under `pose` lies (almost) entirely above the support plane.
+  bool aboveSupport(const world::Pose& pose) const;
+
+  struct Impl;
+  const ObjectModel& model_;
+  PoseEstimationOptions options_;
+  std::optional<TablePlane> support_plane_;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Detections of the same space merged: best (confidence x visible fraction) first, a detection
+/// dropped when more than a fifth of its volume lies in a better one. `models` must hold every
+/// detection's class.
+std::vector<Detection> mergeDetections(std::vector<Detection> detections, const std::vector<ObjectModel>& models);
+
+/// While alive, the process's stdout (file descriptor 1) goes to /dev/null: PCL's ObjRecRANSAC
+/// prints its progress unconditionally (the installed library is built verbose). Nested and
+/// concurrent scopes share one redirection. Anything another thread prints to stdout
+/// meanwhile is lost too, so keep the scope short.
+class StdoutSilence {
+ public:
+  StdoutSilence();
+  ~StdoutSilence();
+  StdoutSilence(const StdoutSilence&) = delete;
+  StdoutSilence& operator=(const StdoutSilence&) = delete;
+};
+
+}  // namespace costar::perception

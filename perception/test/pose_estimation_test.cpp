@@ -1,0 +1,163 @@
+// Stage 4: ObjRecRANSAC + ICP + the depth check, on ray-cast scenes with depth noise.
+
+#include "perception/pose_estimation.h"
+
+#include <gtest/gtest.h>
+
+#include "core/paths.h"
+#include "perception/canonical_orientation.h"
+#include "perception/test/synthetic_scene.h"
+#include "perception/workspace.h"
+
+namespace costar::perception {
+namespace {
+
+class PoseEstimation : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    models_ = new std::vector<ObjectModel>(
+        loadObjectModels(dataRoot() / "data/objects", dataRoot() / "data/perception/classes.json"));
+  }
+  static void TearDownTestSuite() {
+    delete models_;
+    models_ = nullptr;
+  }
+  static const ObjectModel& model(const std::string& name) {
+    for (const auto& m : *models_) {
+      if (m.name() == name) {
+        return m;
+      }
+    }
+    throw std::runtime_error(name);
+  }
+  /// The points of the rendered frame above the table with the given colour.
+  static Cloud pointsOfColor(const camera::RgbdFrame& frame, const Rgb& color) {
+    WorkspaceCloud workspace = cropWorkspace(frame, {});
+    estimateNormals(frame, workspace.cloud);
+    Cloud out;
+    for (std::size_t i = 0; i < workspace.cloud.size(); ++i) {
+      if (workspace.cloud.colors[i] == color) {
+        out.append(workspace.cloud, i);
+      }
+    }
+    return out;
+  }
+  static std::vector<ObjectModel>* models_;
+};
+
+std::vector<ObjectModel>* PoseEstimation::models_ = nullptr;
+
+TEST_F(PoseEstimation, IcpConvergesFromAnOffsetPose) {
+  const ObjectModel& node = model("node");
+  const world::Pose truth = world::poseFromXyzRpy(0.02, -0.01, 1.1, 0.4, -0.3, 0.7);
+  // The camera-facing samples of the model, as a scene.
+  std::vector<Eigen::Vector3f> scene;
+  for (std::size_t i = 0; i < node.surface.size(); ++i) {
+    const Eigen::Vector3d p = truth * node.surface.points[i].cast<double>();
+    const Eigen::Vector3d n = truth.linear() * node.surface.normals[i].cast<double>();
+    if (n.dot(p) < 0) {
+      scene.push_back(p.cast<float>());
+    }
+  }
+  const world::Pose start = truth * world::poseFromXyzRpy(0.006, -0.004, 0.003, 0.08, 0.05, -0.1);
+  const IcpResult result = refinePose(node, scene, start, 30, 0.02, 0.003);
+  EXPECT_LT((result.pose.translation() - truth.translation()).norm(), 0.0005);
+  EXPECT_LT(symmetricRotationDistance(result.pose.linear(), truth.linear(), node.object_class), 0.5 * M_PI / 180);
+  EXPECT_GT(result.inliers, static_cast<int>(scene.size() * 0.9));
+}
+
+TEST_F(PoseEstimation, TheDepthCheckConfirmsTheTruePoseAndRejectsAShiftedOne) {
+  const ObjectModel& link = model("link");
+  const world::Pose pose = world::poseFromXyzRpy(0.5, 0.1, 0.0125, 0, 0, 0.4);
+  const camera::RgbdFrame frame = test::renderSynthetic({{&link.object_class, pose}});
+  const world::Pose in_camera = frame.camera_pose.inverse() * pose;
+  const DepthAgreement good = compareWithDepth(link, in_camera, frame, 0.004);
+  EXPECT_GT(good.agreement(), 0.98);
+  EXPECT_GT(good.visibleFraction(), 0.8);
+  // Slid 3 cm along its axis: the overhang sees the table behind it.
+  const DepthAgreement slid =
+      compareWithDepth(link, in_camera * world::Pose(Eigen::Translation3d(0.03, 0, 0)), frame, 0.004);
+  EXPECT_LT(slid.agreement(), 0.85);
+}
+
+TEST_F(PoseEstimation, OverlapMeasuresSharedVolume) {
+  const ObjectModel& node = model("node");
+  const world::Pose a(Eigen::Translation3d(0, 0, 1));
+  EXPECT_GT(overlapFraction(node, a, node, a), 0.95);
+  // Half a cube over (less than half its samples: the sockets are hollow).
+  EXPECT_NEAR(overlapFraction(node, a, node, a * world::Pose(Eigen::Translation3d(0.025, 0, 0))), 0.4, 0.1);
+  EXPECT_EQ(overlapFraction(node, a, node, a * world::Pose(Eigen::Translation3d(0.051, 0, 0))), 0.0);
+}
+
+TEST_F(PoseEstimation, FindsEveryInstanceOfAClassWithDepthNoise) {
+  const ObjectModel& node = model("node");
+  const ObjectModel& link = model("link");
+  const Rgb red{200, 30, 30};
+  const Rgb wood{184, 133, 77};
+  std::vector<world::Pose> nodes = {world::poseFromXyzRpy(0.45, -0.2, 0.025, 0, 0, 0.3),
+                                    world::poseFromXyzRpy(0.6, 0.15, 0.025, 0, 0, -1.1)};
+  nodes.push_back(nodes[0] * world::Pose(Eigen::Translation3d(0, 0.0505, 0)));  // touching the first
+  const world::Pose link_pose = world::poseFromXyzRpy(0.4, 0.2, 0.0125, 0, 0, 2.0);
+  std::vector<test::SyntheticObject> objects;
+  for (const auto& pose : nodes) {
+    objects.push_back({&node.object_class, pose, red});
+  }
+  objects.push_back({&link.object_class, link_pose, wood});
+  const camera::RgbdFrame frame = test::renderSynthetic(objects, 0.001, 7);
+
+  ClassPoseEstimator node_estimator(node);
+  std::vector<Detection> found;
+  {
+    StdoutSilence silence;
+    found = node_estimator.estimate(pointsOfColor(frame, red), frame);
+  }
+  ASSERT_EQ(found.size(), nodes.size());
+  for (const auto& truth : nodes) {
+    const auto best = std::min_element(found.begin(), found.end(), [&](const Detection& a, const Detection& b) {
+      return ((frame.camera_pose * a.pose_in_camera).translation() - truth.translation()).norm() <
+             ((frame.camera_pose * b.pose_in_camera).translation() - truth.translation()).norm();
+    });
+    const world::Pose world_pose = frame.camera_pose * best->pose_in_camera;
+    EXPECT_LT((world_pose.translation() - truth.translation()).norm(), 0.003);
+    EXPECT_LT(symmetricRotationDistance(world_pose.linear(), truth.linear(), node.object_class), 3 * M_PI / 180);
+    EXPECT_GE(best->confidence, 0.93);
+  }
+  ClassPoseEstimator link_estimator(link);
+  {
+    StdoutSilence silence;
+    found = link_estimator.estimate(pointsOfColor(frame, wood), frame);
+  }
+  ASSERT_EQ(found.size(), 1u);
+  const world::Pose world_pose = frame.camera_pose * found[0].pose_in_camera;
+  EXPECT_LT((world_pose.translation() - link_pose.translation()).norm(), 0.003);
+  EXPECT_LT(symmetricRotationDistance(world_pose.linear(), link_pose.linear(), link.object_class), 3 * M_PI / 180);
+}
+
+TEST_F(PoseEstimation, IsDeterministic) {
+  const ObjectModel& node = model("node");
+  const Rgb red{200, 30, 30};
+  const camera::RgbdFrame frame =
+      test::renderSynthetic({{&node.object_class, world::poseFromXyzRpy(0.55, 0.0, 0.025, 0, 0, 0.2), red}}, 0.001, 3);
+  const Cloud points = pointsOfColor(frame, red);
+  std::vector<Detection> first;
+  std::vector<Detection> second;
+  {
+    StdoutSilence silence;
+    ClassPoseEstimator a(node);
+    ClassPoseEstimator b(node);
+    first = a.estimate(points, frame);
+    second = b.estimate(points, frame);
+  }
+  ASSERT_EQ(first.size(), 1u);
+  ASSERT_EQ(second.size(), 1u);
+  EXPECT_TRUE(first[0].pose_in_camera.isApprox(second[0].pose_in_camera, 1e-12));
+}
+
+TEST_F(PoseEstimation, NoPointsNoDetections) {
+  ClassPoseEstimator estimator(model("node"));
+  const camera::RgbdFrame frame = test::renderSynthetic({});
+  EXPECT_TRUE(estimator.estimate(Cloud{}, frame).empty());
+}
+
+}  // namespace
+}  // namespace costar::perception
