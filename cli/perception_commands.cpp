@@ -1068,6 +1068,71 @@ int evaluate(const EvalOptions& options) {
   }
 }
 
+struct DetectOptions {
+  std::string scene;
+  std::optional<std::uint64_t> seed;
+  std::string out;
+  int frames = 15;
+};
+
+/// DetectObjects once on a scene, as a plan would run it; prints what it found next to the
+/// simulator's truth and draws it.
+int detectScene(const DetectOptions& options) {
+  try {
+    perception::PerceptionConfig config;
+    config.frames = options.frames;
+    perception::PipelineOptions pipeline_options;
+    pipeline_options.workspace.table_center = perception::loadTableCenter(config.files.workspace_file);
+    auto pipeline = std::shared_ptr<perception::Pipeline>(perception::Pipeline::load(config.files, pipeline_options));
+    const sim::Scene scene = sim::loadScene(options.scene);
+    sim::SimulationOptions sim_options;
+    sim_options.placement_seed = options.seed;
+    SimClock clock;
+    auto simulation = sim::Simulation::create(scene, sim_options);
+    simulation->attach(clock);
+    sim::SimRgbdCamera camera(*simulation, options.seed.value_or(scene.seed));
+    perception::PerceptionComponent component(camera, clock, pipeline, config);
+    const perception::PipelineResult result = detectOnce(component, clock, options.frames);
+    const std::vector<perception::TrackedObject> objects = component.objects();
+    const std::vector<PartTruth> truth = truthWithVisibility(*simulation, *result.filtered, *pipeline);
+    const RoundMatch match = matchToTruth(objects, truth, *pipeline);
+    std::printf("DetectObjects on %s: %zu object(s) in %.1f ms (%d frames; capture not included)\n",
+                options.scene.c_str(), objects.size(), millis(result.times.total), options.frames);
+    std::printf("  %-8s %-6s %24s %9s   %s\n", "name", "class", "position (m, world)", "yaw (deg)",
+                "error against the simulator's truth");
+    for (std::size_t d = 0; d < objects.size(); ++d) {
+      const auto& object = objects[d];
+      const Eigen::Vector3d p = object.pose.translation();
+      const double yaw = world::rpyOf(object.pose.linear()).z() * 180.0 / M_PI;
+      const int part = match.part_of_detection[d];
+      char error[96] = "no such part (false detection)";
+      if (part >= 0) {
+        std::snprintf(error, sizeof error, "%s: %.1f mm, %.1f deg",
+                      truth[static_cast<std::size_t>(part)].state.name.c_str(),
+                      match.translation_error[static_cast<std::size_t>(part)] * 1000.0,
+                      match.rotation_error[static_cast<std::size_t>(part)] * 180.0 / M_PI);
+      }
+      std::printf("  %-8s %-6s  (%6.3f, %6.3f, %6.3f) %9.1f   %s\n", object.name.c_str(), object.object_class.c_str(),
+                  p.x(), p.y(), p.z(), yaw, error);
+    }
+    for (std::size_t t = 0; t < truth.size(); ++t) {
+      if (match.detection_of_part[t] < 0) {
+        std::printf("  missed %s (%s), %.0f %% of it in view\n", truth[t].state.name.c_str(),
+                    truth[t].state.object_class.c_str(), truth[t].visible_fraction * 100.0);
+      }
+    }
+    if (!options.out.empty()) {
+      writePng(options.out, pictureOf(*result.filtered, objects, truth, match, *pipeline));
+      std::printf("picture: %s (green: within 5 mm / 5 deg, red: not, orange: false detection, yellow: missed)\n",
+                  options.out.c_str());
+    }
+    return kExitSuccess;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "costar perception detect: %s\n", e.what());
+    return kExitError;
+  }
+}
+
 }  // namespace
 
 void addPerceptionCommands(CLI::App& app, int& exit_code) {
@@ -1181,6 +1246,21 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
   eval_command->add_option("--min-found", eval_options->min_found,
                            "fail (exit 1) when fewer of the visible parts are found within 5 mm and 5 deg");
   eval_command->callback([eval_options, &exit_code] { exit_code = evaluate(*eval_options); });
+
+  auto detect_options = std::make_shared<DetectOptions>();
+  CLI::App* detect_command = perception->add_subcommand(
+      "detect",
+      "Run DetectObjects once on a simulated scene, as a plan would: list the objects found (names, poses) with "
+      "their error against the simulator's truth, and draw them over the camera image.");
+  detect_command->add_option("scene", detect_options->scene, "scene file (e.g. sim/scenes/assembly.json)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  detect_command->add_option("--seed", detect_options->seed, "seed of the part placement and the sensor noise");
+  detect_command->add_option("--out", detect_options->out, "write the picture to this PNG file");
+  detect_command->add_option("--frames", detect_options->frames, "frames per DetectObjects (median filter's N)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 60));
+  detect_command->callback([detect_options, &exit_code] { exit_code = detectScene(*detect_options); });
 }
 
 }  // namespace costar::cli

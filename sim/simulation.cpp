@@ -460,6 +460,30 @@ std::vector<PartState> Simulation::parts() const {
   return states;
 }
 
+void Simulation::movePart(const std::string& name, const world::Pose& pose) {
+  for (std::size_t i = 0; i < impl_->placements.size(); ++i) {
+    if (impl_->placements[i].name != name) {
+      continue;
+    }
+    const mjModel* m = impl_->model;
+    mjData* d = impl_->data;
+    const int joint = m->body_jntadr[impl_->part_bodies[i]];
+    mjtNum* q = d->qpos + m->jnt_qposadr[joint];
+    const Eigen::Quaterniond rotation(pose.linear());
+    q[0] = pose.translation().x();
+    q[1] = pose.translation().y();
+    q[2] = pose.translation().z();
+    q[3] = rotation.w();
+    q[4] = rotation.x();
+    q[5] = rotation.y();
+    q[6] = rotation.z();
+    std::fill_n(d->qvel + m->jnt_dofadr[joint], 6, 0.0);
+    mj_forward(m, d);
+    return;
+  }
+  throw std::invalid_argument("Simulation::movePart: no part '" + name + "'");
+}
+
 std::vector<std::pair<std::string, std::string>> Simulation::contacts() const {
   std::vector<std::pair<std::string, std::string>> pairs;
   const mjData* d = impl_->data;

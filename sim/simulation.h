@@ -115,6 +115,11 @@ class Simulation {
 
   // --- ground truth (tests and the trial judge only) ----------------------------------------
   std::vector<PartState> parts() const;
+  /// Puts a part elsewhere at rest, as a person who moves or takes away a part mid-task would
+  /// (scenario tests and evaluation; plans never call it). Takes effect at once (positions
+  /// are recomputed); physics carries on from there.
+  /// @throws std::invalid_argument for an unknown part.
+  void movePart(const std::string& name, const world::Pose& pose);
   /// Pairs of bodies in contact: part names, "table", "left_finger", "right_finger", "arm".
   std::vector<std::pair<std::string, std::string>> contacts() const;
   const std::vector<world::ObjectClass>& objectClasses() const;
