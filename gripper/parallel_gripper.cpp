@@ -105,14 +105,14 @@ ParallelGripper::ParallelGripper(GripperDriver& driver, const Clock& clock, Para
 world::Report ParallelGripper::report() const {
   const FingerReading reading = driver_.read();
   world::Report report;
-  const bool still = std::abs(reading.opening_speed) < 0.002;
   if (reading.opening >= driver_.maxOpening() - kOpenMargin) {
     report.predicates.push_back({"gripper_open", {}, true, ""});
   }
   if (reading.opening <= kClosedBelow) {
     report.predicates.push_back({"gripper_closed", {}, true, ""});
   }
-  if (still && reading.contact && reading.force > kHoldingForce && reading.opening > kClosedBelow) {
+  if (std::abs(reading.opening_speed) < kHoldingSpeed && reading.contact && reading.force > kHoldingForce &&
+      reading.opening > kClosedBelow) {
     report.predicates.push_back({"gripper_holding", {}, true, ""});
   }
   report.predicates.push_back({"gripper_mode", {"pinch"}, true, ""});

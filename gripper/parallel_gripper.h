@@ -31,10 +31,13 @@ class ParallelGripper final : public component::LocalComponent {
   world::Report report() const override;
 
   /// Thresholds of the predicates: within 2 mm of fully open / closed; holding when the
-  /// still fingers touch something and squeeze it with more than 2 N.
+  /// fingers touch something and squeeze it with more than 2 N while moving slower than
+  /// 2 cm/s (a held part shifting in the fingers as the arm stops moves them a few mm/s; a
+  /// closing stroke is faster).
   static constexpr double kOpenMargin = 0.002;
   static constexpr double kClosedBelow = 0.002;
   static constexpr double kHoldingForce = 2.0;
+  static constexpr double kHoldingSpeed = 0.02;
 
  private:
   std::unique_ptr<component::RunningOperation> begin(const std::string& operation,

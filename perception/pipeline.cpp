@@ -112,7 +112,14 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
   estimateNormals(frame, workspace.cloud, options_.normal_window, static_cast<float>(options_.normal_max_distance));
   result.times.normals = since(start);
 
-  const SegmentationResult segmentation = segmentPoints(workspace.cloud, classifier_, options_.segmentation);
+  SegmentationResult segmentation = segmentPoints(workspace.cloud, classifier_, options_.segmentation);
+  if (options_.segmentation.grow_reach > 0.0) {
+    const auto grow_start = std::chrono::steady_clock::now();
+    segmentation.labels =
+        growLabels(workspace.cloud, frame.intrinsics.width, frame.intrinsics.height, std::move(segmentation.labels),
+                   options_.segmentation.grow_step, options_.segmentation.grow_reach);
+    segmentation.classification_seconds += since(grow_start);
+  }
   result.times.features = segmentation.feature_seconds;
   result.times.classification = segmentation.classification_seconds;
   for (const int label : classifier_.labels()) {

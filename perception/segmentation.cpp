@@ -1,5 +1,8 @@
 #include "perception/segmentation.h"
 
+#include <array>
+#include <deque>
+
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -80,6 +83,54 @@ SegmentationResult segmentPoints(const Cloud& points, const SvmClassifier& class
   }
   result.classification_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+std::vector<int> growLabels(const Cloud& points, int width, int height, std::vector<int> labels, double step,
+                            double reach) {
+  if (labels.size() != points.size()) {
+    throw std::invalid_argument("growLabels: one label per point expected");
+  }
+  std::vector<int> at(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), -1);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    at[static_cast<std::size_t>(points.pixels[i])] = static_cast<int>(i);
+  }
+  const float step2 = static_cast<float>(step * step);
+  const float reach2 = static_cast<float>(reach * reach);
+  std::vector<int> origin(points.size(), -1);
+  std::deque<int> queue;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (labels[i] != 0) {
+      origin[i] = static_cast<int>(i);
+      queue.push_back(static_cast<int>(i));
+    }
+  }
+  while (!queue.empty()) {
+    const int p = queue.front();
+    queue.pop_front();
+    const int pixel = points.pixels[static_cast<std::size_t>(p)];
+    const int u = pixel % width;
+    const int v = pixel / width;
+    const std::array<std::pair<int, int>, 4> around = {{{u - 1, v}, {u + 1, v}, {u, v - 1}, {u, v + 1}}};
+    for (const auto& [nu, nv] : around) {
+      if (nu < 0 || nv < 0 || nu >= width || nv >= height) {
+        continue;
+      }
+      const int q = at[static_cast<std::size_t>(nv) * width + nu];
+      if (q < 0 || origin[static_cast<std::size_t>(q)] >= 0 || labels[static_cast<std::size_t>(q)] != 0) {
+        continue;
+      }
+      const Eigen::Vector3f& point = points.points[static_cast<std::size_t>(q)];
+      if ((point - points.points[static_cast<std::size_t>(p)]).squaredNorm() > step2 ||
+          (point - points.points[static_cast<std::size_t>(origin[static_cast<std::size_t>(p)])]).squaredNorm() >
+              reach2) {
+        continue;
+      }
+      labels[static_cast<std::size_t>(q)] = labels[static_cast<std::size_t>(p)];
+      origin[static_cast<std::size_t>(q)] = origin[static_cast<std::size_t>(p)];
+      queue.push_back(q);
+    }
+  }
+  return labels;
 }
 
 }  // namespace costar::perception

@@ -18,6 +18,13 @@ struct SegmentationOptions {
   /// Each voxel takes the most common label among the voxels within this distance (m; 0: no
   /// smoothing). Ties keep the voxel's own label.
   double smoothing_radius = 0.012;
+  /// Background-labelled points connected (neighbouring pixels closer than grow_step) to a
+  /// class's points, within grow_reach of where the growth entered the background, join that
+  /// class (nearest first; 0: no growth). A part's face the SVM confuses with background (a
+  /// grey link's flat top, a part seen at a grazing angle) then still reaches pose estimation,
+  /// whose depth-image check refuses what does not fit the class's model.
+  double grow_step = 0.008;
+  double grow_reach = 0.10;
 };
 
 struct SegmentationResult {
@@ -33,6 +40,13 @@ struct SegmentationResult {
 /// classifier's feature count is not kFeatureCount.
 SegmentationResult segmentPoints(const Cloud& points, const SvmClassifier& classifier,
                                  const SegmentationOptions& options = {});
+
+/// Grows class labels (non-zero) into connected background (0) points of an organized cloud
+/// (`pixels` index an image `width` pixels wide): a breadth-first search from every class point
+/// through 4-neighbouring pixels whose points are closer than `step`, up to `reach` from the
+/// class point it started at. Returns the new labels.
+std::vector<int> growLabels(const Cloud& points, int width, int height, std::vector<int> labels, double step,
+                            double reach);
 
 /// Majority vote of `labels` (one per point of `points`) among points within `radius` (m).
 std::vector<int> smoothLabels(const std::vector<Eigen::Vector3f>& points, const std::vector<int>& labels,

@@ -196,5 +196,30 @@ TEST(Segmentation, SmoothingTakesTheMajorityAround) {
   EXPECT_EQ(smoothLabels(points, labels, 0.0), labels);
 }
 
+TEST(Segmentation, ClassLabelsGrowIntoConnectedBackgroundWithinReach) {
+  // One row of 12 pixels, 5 mm apart at 1 m: class 2 at pixels 0-1, background 2-9, then a
+  // 5 cm depth jump at pixel 10 (another surface), background 10-11.
+  Cloud cloud;
+  std::vector<int> labels;
+  for (int u = 0; u < 12; ++u) {
+    cloud.points.emplace_back(0.005f * u, 0.0f, u < 10 ? 1.0f : 1.05f);
+    cloud.pixels.push_back(u);
+    labels.push_back(u < 2 ? 2 : 0);
+  }
+  // Reach 2.8 cm: pixels up to 2.8 cm from the class pixel the growth left from (pixel 1).
+  const std::vector<int> grown = growLabels(cloud, 12, 1, labels, 0.008, 0.028);
+  for (int u = 0; u <= 6; ++u) {
+    EXPECT_EQ(grown[static_cast<std::size_t>(u)], 2) << u;
+  }
+  EXPECT_EQ(grown[7], 0);
+  EXPECT_EQ(grown[9], 0);
+  // Long reach: all the connected surface, not across the depth jump.
+  const std::vector<int> far = growLabels(cloud, 12, 1, labels, 0.008, 1.0);
+  EXPECT_EQ(far[9], 2);
+  EXPECT_EQ(far[10], 0);
+  EXPECT_EQ(far[11], 0);
+  EXPECT_THROW(growLabels(cloud, 12, 1, {1, 2}, 0.008, 0.03), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace costar::perception
