@@ -173,7 +173,7 @@ void BM_PersistenceUpdate(benchmark::State& state) {
 }
 BENCHMARK(BM_PersistenceUpdate)
     ->RangeMultiplier(10)
-    ->Range(100, 10000)
+    ->Range(10, 10000)
     ->Unit(benchmark::kMillisecond)
     ->Complexity(benchmark::oNLogN);
 
@@ -203,7 +203,7 @@ void BM_PersistenceBruteForce(benchmark::State& state) {
     benchmark::DoNotOptimize(matched);
   }
 }
-BENCHMARK(BM_PersistenceBruteForce)->RangeMultiplier(10)->Range(100, 10000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PersistenceBruteForce)->RangeMultiplier(10)->Range(10, 10000)->Unit(benchmark::kMillisecond);
 
 void BM_CanonicalOrientationNode(benchmark::State& state) {
   const auto classes = benchmarkClasses();
