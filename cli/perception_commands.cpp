@@ -593,6 +593,13 @@ constexpr double kTranslationTolerance = 0.005;
 constexpr double kRotationTolerance = 5.0 * M_PI / 180.0;
 
 /// Runs DetectObjects on the component, stepping simulated time as the executor would.
+/// The objects the latest detection saw (not those only remembered by keep_for): what is scored.
+std::vector<perception::TrackedObject> seenObjects(const perception::PerceptionComponent& component) {
+  std::vector<perception::TrackedObject> seen = component.objects();
+  std::erase_if(seen, [](const perception::TrackedObject& object) { return object.missed > 0; });
+  return seen;
+}
+
 perception::PipelineResult detectOnce(perception::PerceptionComponent& component, SimClock& clock, int frames) {
   component::ParamMap params;
   params["frames"] = frames;
@@ -827,7 +834,7 @@ int evaluate(const EvalOptions& options) {
       recordLatency(total, result.times);
       std::vector<PartTruth> truth = truthWithVisibility(*simulation, *result.filtered, *pipeline);
       total_parts += static_cast<int>(truth.size());
-      std::vector<perception::TrackedObject> objects = component.objects();
+      std::vector<perception::TrackedObject> objects = seenObjects(component);
       RoundMatch first = scoreRound(objects, truth, *pipeline, total, label);
       if (!options.out.empty()) {
         char file[64];
@@ -855,7 +862,7 @@ int evaluate(const EvalOptions& options) {
       for (int r = 0; r < repeats; ++r) {
         result = detectOnce(component, *sim_clock, options.frames);
         recordLatency(total, result.times);
-        objects = component.objects();
+        objects = seenObjects(component);
         const RoundMatch match =
             scoreRound(objects, truth, *pipeline, total, label + " repeat " + std::to_string(r + 1));
         for (std::size_t p = 0; p < truth.size(); ++p) {
@@ -933,7 +940,7 @@ int evaluate(const EvalOptions& options) {
         recordLatency(total, result.times);
         // The re-created scene names its parts in the same order.
         truth = truthWithVisibility(*simulation, *result.filtered, *pipeline);
-        objects = component.objects();
+        objects = seenObjects(component);
         const RoundMatch match = scoreRound(objects, truth, *pipeline, total, where);
         bool all_same = true;
         for (std::size_t p = 0; p < truth.size(); ++p) {
@@ -1093,7 +1100,7 @@ int detectScene(const DetectOptions& options) {
     sim::SimRgbdCamera camera(*simulation, options.seed.value_or(scene.seed));
     perception::PerceptionComponent component(camera, clock, pipeline, config);
     const perception::PipelineResult result = detectOnce(component, clock, options.frames);
-    const std::vector<perception::TrackedObject> objects = component.objects();
+    const std::vector<perception::TrackedObject> objects = seenObjects(component);
     const std::vector<PartTruth> truth = truthWithVisibility(*simulation, *result.filtered, *pipeline);
     const RoundMatch match = matchToTruth(objects, truth, *pipeline);
     std::printf("DetectObjects on %s: %zu object(s) in %.1f ms (%d frames; capture not included)\n",

@@ -190,8 +190,8 @@ world::Report PerceptionComponent::report() const {
     symbol.stamp = last_stamp_;
     symbol.value = world::FrameValue{"world", object.pose};
     report.symbols.push_back(std::move(symbol));
-    report.predicates.push_back({"is_a", {object.name, object.object_class}, true, ""});
     if (object.missed == 0) {
+      report.predicates.push_back({"is_a", {object.name, object.object_class}, true, ""});
       report.predicates.push_back({"visible", {object.name}, true, ""});
     }
   }

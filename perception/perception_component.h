@@ -7,9 +7,10 @@
 //   symbols     one frame per object ("node_3", parent "world", pose of the object frame in
 //               the robot base frame: camera calibration x camera pose), and one object-class
 //               symbol per class ("node", "link")
-//   predicates  is_a(object, class)    the object is of that class
-//               visible(object)        seen by the latest DetectObjects (objects kept by
-//                                      keep_for without being re-seen lack it)
+//   predicates  is_a(object, class)    the object is of that class, and
+//               visible(object)        it was seen by the latest DetectObjects (objects kept
+//                                      by keep_for without being re-seen have neither: only
+//                                      their name and last frame are remembered)
 // The class symbol names the data file (data/objects/<class>.json) that gives SmartMove the
 // class's symmetries and axis priority. It reads camera frames only, never simulator ground
 // truth.
@@ -33,7 +34,10 @@ struct PerceptionConfig {
   /// The workspace centre in the world; when absent, read from files.workspace_file.
   std::optional<world::Pose> table_center;
   PipelineOptions pipeline;
-  PersistenceOptions persistence;
+  /// Persistence: an object missed by up to keep_for detections in a row keeps its name for
+  /// when it is seen again; meanwhile it is reported as a frame only (no is_a, no visible), so
+  /// SmartMove, the Predicator and the obstacles see only what the last detection saw.
+  PersistenceOptions persistence{.max_distance = 0.03, .keep_for = 2};
   /// Frames per DetectObjects (the median filter's N); the operation's `frames` parameter
   /// overrides it.
   int frames = 15;

@@ -141,6 +141,51 @@ TEST_F(PerceptionComponentTest, CanBeCancelledWhileCapturing) {
   EXPECT_EQ(detect().state, OperationState::kSuccess);
 }
 
+TEST_F(PerceptionComponentTest, APartMissedBrieflyKeepsItsNameAndIsReportedOnlyWhileSeen) {
+  ASSERT_EQ(detect().state, OperationState::kSuccess);
+  const sim::PartState red = simulation_->parts()[0];
+  const auto name_near = [this](const Eigen::Vector3d& at) {
+    for (const auto& object : component_->objects()) {
+      if ((object.pose.translation() - at).norm() < 0.01) {
+        return object.name;
+      }
+    }
+    return std::string();
+  };
+  const std::string name = name_near(red.pose.translation());
+  ASSERT_FALSE(name.empty());
+  const auto is_a_count = [this] {
+    world::WorldState world;
+    world.update("perception", component_->report());
+    return world.predicates("is_a").size();
+  };
+  ASSERT_EQ(is_a_count(), 3u);
+
+  // Out of view for keep_for (2) detections: remembered, reported as a frame only.
+  const world::Pose away(Eigen::Translation3d(0.4, -1.2, 0.026));
+  for (int i = 0; i < 2; ++i) {
+    simulation_->movePart(red.name, away);
+    ASSERT_EQ(detect().state, OperationState::kSuccess);
+    EXPECT_EQ(component_->objects().size(), 3u);
+    EXPECT_EQ(is_a_count(), 2u);
+    world::WorldState world;
+    world.update("perception", component_->report());
+    ASSERT_NE(world.symbol(name), nullptr);
+    EXPECT_FALSE(world.holds("visible", std::vector<std::string>{name}));
+  }
+  // Back where it was: the same name, seen again.
+  simulation_->movePart(red.name, red.pose);
+  ASSERT_EQ(detect().state, OperationState::kSuccess);
+  EXPECT_EQ(name_near(red.pose.translation()), name);
+  EXPECT_EQ(is_a_count(), 3u);
+  // Away for three detections: dropped at the third.
+  for (int i = 0; i < 3; ++i) {
+    simulation_->movePart(red.name, away);
+    ASSERT_EQ(detect().state, OperationState::kSuccess);
+  }
+  EXPECT_EQ(component_->objects().size(), 2u);
+}
+
 /// A camera whose frames show no table (it looks at the sky).
 class BlindCamera final : public camera::RgbdCamera {
  public:
