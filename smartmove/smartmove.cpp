@@ -422,6 +422,17 @@ std::string SmartMoveComponent::spotFailsPattern(const Eigen::Vector3d& spot,
   return holds ? std::string() : pattern.predicate + " is false there";
 }
 
+std::unique_ptr<RunningOperation> SmartMoveComponent::moveToFreeConfiguration(const world::Pose& pose,
+                                                                              const arm::JointVector& seed,
+                                                                              double speed, const std::string& what,
+                                                                              const std::string& none) {
+  std::string reason;
+  const auto configuration = freeConfiguration(arm_.solutions(pose, seed), collisions_, reason);
+  return arm_.execute(
+      configuration ? arm_.planToJoints(*configuration, speed) : arm::MotionPlan{nullptr, {}, none + ": " + reason},
+      what);
+}
+
 std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& operation,
                                                             const component::ParamMap& params) {
   const auto text = [&params](const char* name) { return params.at(name).asString(); };
@@ -478,12 +489,8 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
                      nullptr});
     steps.push_back({"move above " + object,
                      [this, pregrasp, chosen, speed] {
-                       std::string reason;
-                       const auto pre =
-                           freeConfiguration(arm_.solutions(pregrasp, chosen.solutions.front()), collisions_, reason);
-                       return arm_.execute(pre ? arm_.planToJoints(*pre, speed)
-                                               : arm::MotionPlan{nullptr, {}, "no collision-free pre-grasp: " + reason},
-                                           "pre-grasp");
+                       return moveToFreeConfiguration(pregrasp, chosen.solutions.front(), speed, "pre-grasp",
+                                                      "no collision-free pre-grasp");
                      },
                      nullptr});
     steps.push_back({"approach " + object,
@@ -668,13 +675,8 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
     std::vector<Script::Step> steps;
     steps.push_back({"move above " + support_object,
                      [this, chosen, approach, speed] {
-                       std::string reason;
-                       const auto pre = freeConfiguration(
-                           arm_.solutions(up(approach) * chosen.goal, chosen.solutions.front()), collisions_, reason);
-                       return arm_.execute(
-                           pre ? arm_.planToJoints(*pre, speed)
-                               : arm::MotionPlan{nullptr, {}, "no collision-free point above: " + reason},
-                           "above the place");
+                       return moveToFreeConfiguration(up(approach) * chosen.goal, chosen.solutions.front(), speed,
+                                                      "above the place", "no collision-free point above");
                      },
                      nullptr});
     steps.push_back({"lower onto " + support_object,

@@ -112,6 +112,12 @@ class SmartMoveComponent final : public component::LocalComponent {
   std::string spotFailsPattern(const Eigen::Vector3d& spot, const predicator::Pattern& pattern) const;
   ArmModel armModel() const;
   void allowGripperContact(const std::string& object, bool allowed);
+  /// Starts a joint-space motion to the collision-free IK solution for `pose` nearest `seed`
+  /// (the arm's operation named `what`), or an operation that fails with `none` and the reason.
+  std::unique_ptr<component::RunningOperation> moveToFreeConfiguration(const world::Pose& pose,
+                                                                       const arm::JointVector& seed, double speed,
+                                                                       const std::string& what,
+                                                                       const std::string& none);
 
   friend class SmartStep;
   component::ComponentDescription description_;
