@@ -12,6 +12,7 @@
 #include "perception/canonical_orientation.h"
 #include "perception/median_filter.h"
 #include "perception/persistence.h"
+#include "perception/perception_component.h"
 #include "perception/pipeline.h"
 #include "perception/segmentation.h"
 #include "perception/workspace.h"
@@ -25,7 +26,7 @@ using namespace costar::perception;
 /// The frames and the pipeline, made once.
 struct Fixture {
   std::vector<camera::RgbdFrame> frames;
-  std::unique_ptr<Pipeline> pipeline;
+  std::shared_ptr<Pipeline> pipeline;
 
   static Fixture& get() {
     static Fixture fixture;
@@ -34,10 +35,7 @@ struct Fixture {
 
  private:
   Fixture() {
-    PipelineOptions options;
-    const PipelineFiles files = PipelineFiles::under();
-    options.workspace.table_center = loadTableCenter(files.workspace_file);
-    pipeline = Pipeline::load(files, options);
+    pipeline = loadPipeline(PerceptionConfig{});
     const sim::Scene scene = sim::parseScene(R"({"seed": 5, "parts": [
         {"class": "node", "color": "red", "at": [0.42, -0.22, 15]},
         {"class": "node", "color": "green", "at": [0.40693, -0.17122, 15]},

@@ -792,9 +792,7 @@ int evaluate(const EvalOptions& options) {
   try {
     const auto started = std::chrono::steady_clock::now();
     perception::PerceptionConfig config;
-    perception::PipelineOptions pipeline_options;
-    pipeline_options.workspace.table_center = perception::loadTableCenter(config.files.workspace_file);
-    auto pipeline = std::shared_ptr<perception::Pipeline>(perception::Pipeline::load(config.files, pipeline_options));
+    const auto pipeline = perception::loadPipeline(config);
     config.frames = options.frames;
     std::vector<world::ObjectClass> classes;
     for (const auto& model : pipeline->models()) {
@@ -1088,9 +1086,7 @@ int detectScene(const DetectOptions& options) {
   try {
     perception::PerceptionConfig config;
     config.frames = options.frames;
-    perception::PipelineOptions pipeline_options;
-    pipeline_options.workspace.table_center = perception::loadTableCenter(config.files.workspace_file);
-    auto pipeline = std::shared_ptr<perception::Pipeline>(perception::Pipeline::load(config.files, pipeline_options));
+    const auto pipeline = perception::loadPipeline(config);
     const sim::Scene scene = sim::loadScene(options.scene);
     sim::SimulationOptions sim_options;
     sim_options.placement_seed = options.seed;

@@ -9,14 +9,14 @@ using component::OperationResult;
 using component::ParamSpec;
 using component::ValueType;
 
-namespace {
-
 std::shared_ptr<Pipeline> loadPipeline(const PerceptionConfig& config) {
   PipelineOptions options = config.pipeline;
   options.workspace.table_center =
       config.table_center ? *config.table_center : loadTableCenter(config.files.workspace_file);
   return Pipeline::load(config.files, options);
 }
+
+namespace {
 
 std::vector<world::ObjectClass> classesOf(const Pipeline& pipeline) {
   std::vector<world::ObjectClass> classes;

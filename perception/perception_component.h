@@ -43,6 +43,11 @@ struct PerceptionConfig {
   int frames = 15;
 };
 
+/// Loads the pipeline `config` describes: its files and options, the workspace centre from
+/// config.table_center or else the workspace file. Several components may share the result
+/// (one detection at a time). @throws std::runtime_error naming a missing or inconsistent file.
+std::shared_ptr<Pipeline> loadPipeline(const PerceptionConfig& config);
+
 class PerceptionComponent final : public component::LocalComponent {
  public:
   /// Loads the pipeline's data files. The camera and clock must outlive the component.

@@ -134,6 +134,19 @@ HttpResponse invalidPlan(const std::vector<bt::Diagnostic>& diagnostics, const b
   return jsonResponse(body, 422);
 }
 
+/// Starts a run: 202 with its id, 422 with the plan's problems, or the backend's refusal.
+HttpResponse startRun(Backend& backend, RunRequest run) {
+  const bt::PlanFile file = run.plan.file;
+  const StartResult started = backend.start(std::move(run));
+  if (!started.started()) {
+    if (!started.diagnostics.empty()) {
+      return invalidPlan(started.diagnostics, file);
+    }
+    return errorResponse(started.status != 0 ? started.status : 409, started.error);
+  }
+  return jsonResponse({{"run", started.run_id}}, 202);
+}
+
 json documentJson(const DocumentVersion& document) {
   json out = {
       {"name", document.name}, {"version", document.version}, {"saved_at", document.saved_at}, {"xml", document.xml}};
@@ -426,15 +439,7 @@ HttpResponse Api::route(const HttpRequest& request) {
       }
       run.start_paused = it->get<bool>();
     }
-    const bt::PlanFile file = run.plan.file;
-    const StartResult started = backend_.start(std::move(run));
-    if (!started.started()) {
-      if (!started.diagnostics.empty()) {
-        return invalidPlan(started.diagnostics, file);
-      }
-      return errorResponse(started.status != 0 ? started.status : 409, started.error);
-    }
-    return jsonResponse({{"run", started.run_id}}, 202);
+    return startRun(backend_, std::move(run));
   }
   if (is({"runs", "*"})) {
     if (!get) {
@@ -506,15 +511,7 @@ HttpResponse Api::route(const HttpRequest& request) {
     run.plan = std::move(parsed.plan);
     run.xml = std::move(parsed.xml);
     run.operation = true;
-    const bt::PlanFile file = run.plan.file;
-    const StartResult started = backend_.start(std::move(run));
-    if (!started.started()) {
-      if (!started.diagnostics.empty()) {
-        return invalidPlan(started.diagnostics, file);
-      }
-      return errorResponse(started.status != 0 ? started.status : 409, started.error);
-    }
-    return jsonResponse({{"run", started.run_id}}, 202);
+    return startRun(backend_, std::move(run));
   }
   if (is({"test", "ground_truth"})) {
     if (!options_.test_endpoints) {

@@ -32,17 +32,7 @@ class FastRandom {
     }
   }
   /// Uniform in (0, 1].
-  double uniform() {
-    const std::uint64_t result = state_[0] + state_[3];
-    const std::uint64_t t = state_[1] << 17;
-    state_[2] ^= state_[0];
-    state_[3] ^= state_[1];
-    state_[1] ^= state_[2];
-    state_[0] ^= state_[3];
-    state_[2] ^= t;
-    state_[3] = (state_[3] << 45) | (state_[3] >> 19);
-    return (static_cast<double>(result >> 11) + 1.0) * (1.0 / 9007199254740992.0);
-  }
+  double uniform() { return (static_cast<double>(next() >> 11) + 1.0) * (1.0 / 9007199254740992.0); }
   std::uint64_t next() {
     const std::uint64_t result = state_[0] + state_[3];
     const std::uint64_t t = state_[1] << 17;

@@ -74,12 +74,10 @@ class TestOraclePerception final : public component::LocalComponent {
 /// The perception pipeline (models and SVM loaded from the data files, about half a second),
 /// loaded once per thread and shared by the workcells that thread creates: trials create one
 /// workcell per trial, and a pipeline runs one detection at a time.
-std::shared_ptr<perception::Pipeline> threadPipeline(const world::Pose& table_center) {
+std::shared_ptr<perception::Pipeline> threadPipeline(const perception::PerceptionConfig& config) {
   thread_local std::shared_ptr<perception::Pipeline> pipeline;
   if (!pipeline) {
-    perception::PipelineOptions options;
-    options.workspace.table_center = table_center;
-    pipeline = perception::Pipeline::load(perception::PipelineFiles::under(), options);
+    pipeline = perception::loadPipeline(config);
   }
   return pipeline;
 }
@@ -134,7 +132,7 @@ class Ur5SimWorkcell final : public Workcell {
       perception::PerceptionConfig perception_config;
       perception_config.table_center = tableCenter();
       components().add(std::make_shared<perception::PerceptionComponent>(
-          camera_, clock(), threadPipeline(tableCenter()), perception_config));
+          camera_, clock(), threadPipeline(perception_config), perception_config));
     }
     smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(*arm, *gripper, components().world(), collisions_,
                                                                  simulation_->objectClasses(), grasps_);
