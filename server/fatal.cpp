@@ -80,7 +80,7 @@ int indexOf(int signal) noexcept {
   return -1;
 }
 
-void onSignal(int signal) {
+void onSignal(int signal, siginfo_t* info, void* /*context*/) {
   say("costar serve: fatal signal ");
   say(signal == SIGSEGV   ? "SIGSEGV"
       : signal == SIGBUS  ? "SIGBUS"
@@ -97,7 +97,11 @@ void onSignal(int signal) {
   } else {
     ::signal(signal, SIG_DFL);
   }
-  ::raise(signal);
+  if (info == nullptr || info->si_code <= 0) {
+    ::raise(signal);  // sent (kill, raise, abort): send it again
+  }
+  // A fault: returning runs the faulting instruction again, which the previous action sees
+  // with its true address.
 }
 
 void onTerminate() {
@@ -127,9 +131,9 @@ FatalStop::FatalStop(Engine& engine, std::chrono::milliseconds wait) {
   g_dying = false;
   g_previous_terminate = std::set_terminate(onTerminate);
   struct sigaction action {};
-  action.sa_handler = onSignal;
+  action.sa_sigaction = onSignal;
   sigemptyset(&action.sa_mask);
-  action.sa_flags = 0;
+  action.sa_flags = SA_SIGINFO;
   for (int i = 0; i < kSignalCount; ++i) {
     ::sigaction(kSignals[i], &action, &g_previous[i]);
   }
