@@ -19,6 +19,47 @@ bool isScriptAttribute(std::string_view key) {
   return std::find(std::begin(kScriptAttributes), std::end(kScriptAttributes), key) != std::end(kScriptAttributes);
 }
 
+// BehaviorTree.CPP built-ins that read or write the blackboard: refused by design, each with
+// what a CoSTAR plan uses instead.
+struct BlackboardNode {
+  std::string_view id;
+  std::string_view instead;
+};
+constexpr std::string_view kUseCondition = "test the world state with a condition (CheckPredicate) instead";
+constexpr std::string_view kUseBranch =
+    "branch on conditions instead: IfThenElse, WhileDoElse or a Fallback over CheckPredicate nodes";
+constexpr std::string_view kUseLoop = "loop with Repeat, RepeatRuns or RetryUntilSuccessful instead";
+constexpr std::string_view kUseParameters = "write each value as a parameter of the node that uses it instead";
+constexpr BlackboardNode kBlackboardNodes[] = {{"Script", kUseParameters},
+                                               {"ScriptCondition", kUseCondition},
+                                               {"Precondition", kUseBranch},
+                                               {"SetBlackboard", kUseParameters},
+                                               {"UnsetBlackboard", kUseParameters},
+                                               {"Switch2", kUseBranch},
+                                               {"Switch3", kUseBranch},
+                                               {"Switch4", kUseBranch},
+                                               {"Switch5", kUseBranch},
+                                               {"Switch6", kUseBranch},
+                                               {"LoopInt", kUseLoop},
+                                               {"LoopDouble", kUseLoop},
+                                               {"LoopString", kUseLoop},
+                                               {"LoopBool", kUseLoop},
+                                               {"WasEntryUpdated", kUseCondition},
+                                               {"SkipUnlessUpdated", kUseCondition},
+                                               {"WaitValueUpdate", kUseCondition}};
+
+const BlackboardNode* findBlackboardNode(std::string_view id) {
+  for (const BlackboardNode& node : kBlackboardNodes) {
+    if (node.id == id) {
+      return &node;
+    }
+  }
+  return nullptr;
+}
+
+constexpr std::string_view kByDesign =
+    "CoSTAR plans have no blackboard, by design (the paper: no user variables, no scope)";
+
 bool isBlackboardReference(std::string_view value) {
   const auto open = value.find('{');
   return open != std::string_view::npos && value.find('}', open) != std::string_view::npos;
@@ -165,7 +206,10 @@ class Validator {
     const NodeSpec* spec = registry_.find(node.id);
     if (spec == nullptr) {
       std::string message = "unknown node '" + node.id + "'";
-      if (const auto suggestion = registry_.suggest(node.id)) {
+      if (const BlackboardNode* blackboard = findBlackboardNode(node.id)) {
+        message = "'" + node.id + "' is a BehaviorTree.CPP node that works on the blackboard; " +
+                  std::string(kByDesign) + ": " + std::string(blackboard->instead);
+      } else if (const auto suggestion = registry_.suggest(node.id)) {
         message += " (did you mean '" + *suggestion + "'?)";
       }
       error(node.location, message);
@@ -177,6 +221,12 @@ class Validator {
       }
       if (node.id == "ReactiveSequence" || node.id == "ReactiveFallback") {
         checkReactive(node);
+      }
+      if (node.id == "WhileDoElse" && !node.children.empty() && mayRun(node.children.front())) {
+        error(node.children.front().location,
+              node.children.front().id +
+                  " can be RUNNING, but WhileDoElse re-checks its first child on every tick while a branch runs: "
+                  "the condition must complete at once (use a condition such as CheckPredicate)");
       }
     }
     for (const PlanNode& child : node.children) {
@@ -211,9 +261,9 @@ class Validator {
         continue;
       }
       if (isScriptAttribute(key)) {
-        error(node.location, "'" + key +
-                                 "' is a BehaviorTree.CPP script, which CoSTAR plans do not "
-                                 "support (no variables): use a Condition node instead");
+        error(node.location, "'" + key + "' is a BehaviorTree.CPP script; " + std::string(kByDesign) +
+                                 ": put a condition (CheckPredicate) before the node instead, in a "
+                                 "Sequence, IfThenElse or WhileDoElse");
         ports_valid = false;
         continue;
       }
@@ -224,7 +274,8 @@ class Validator {
       if (port == nullptr) {
         std::string message = node.id + " has no parameter '" + key + "'";
         if (spec.kind == NodeKind::kSubTree) {
-          message += ": SubTree port remapping needs a blackboard, which CoSTAR plans do not have";
+          message += ": SubTree port remapping needs a blackboard; " + std::string(kByDesign) +
+                     ": write the values as parameters of the nodes inside the subtree instead";
         } else {
           message += " (" + portList(spec) + ")";
         }
@@ -233,9 +284,8 @@ class Validator {
         continue;
       }
       if (isBlackboardReference(value)) {
-        error(node.location, "parameter '" + key + "' of " + node.id + " is '" + value +
-                                 "': blackboard references are not supported (no variables); "
-                                 "write the value itself");
+        error(node.location, "parameter '" + key + "' of " + node.id + " is '" + value + "', a blackboard reference; " +
+                                 std::string(kByDesign) + ": write the value itself instead");
         ports_valid = false;
         continue;
       }
