@@ -11,12 +11,28 @@ namespace costar::bt {
 namespace {
 
 // Attributes BehaviorTree.CPP evaluates as scripts: they need a blackboard, which CoSTAR
-// plans do not have (the paper: no user variables, no scope).
-constexpr std::string_view kScriptAttributes[] = {"_skipIf",    "_failureIf", "_successIf", "_while",
-                                                  "_onSuccess", "_onFailure", "_onHalted",  "_post"};
+// plans do not have (the paper: no user variables, no scope). Each with what to use instead.
+struct ScriptAttribute {
+  std::string_view key;
+  std::string_view instead;
+};
+constexpr std::string_view kUseConditionBefore =
+    "put a condition (CheckPredicate) before the node instead, in a Sequence, IfThenElse or WhileDoElse";
+constexpr std::string_view kUseResult =
+    "there are no variables to update: act on the node's result instead (Fallback, IfThenElse, TryCatch)";
+constexpr ScriptAttribute kScriptAttributes[] = {
+    {"_skipIf", kUseConditionBefore},    {"_failureIf", kUseConditionBefore},
+    {"_successIf", kUseConditionBefore}, {"_while", kUseConditionBefore},
+    {"_onSuccess", kUseResult},          {"_onFailure", kUseResult},
+    {"_onHalted", kUseResult},           {"_post", kUseResult}};
 
-bool isScriptAttribute(std::string_view key) {
-  return std::find(std::begin(kScriptAttributes), std::end(kScriptAttributes), key) != std::end(kScriptAttributes);
+const ScriptAttribute* findScriptAttribute(std::string_view key) {
+  for (const ScriptAttribute& attribute : kScriptAttributes) {
+    if (attribute.key == key) {
+      return &attribute;
+    }
+  }
+  return nullptr;
 }
 
 // BehaviorTree.CPP built-ins that read or write the blackboard: refused by design, each with
@@ -260,10 +276,9 @@ class Validator {
       if (key == "name" || key == "_description") {
         continue;
       }
-      if (isScriptAttribute(key)) {
-        error(node.location, "'" + key + "' is a BehaviorTree.CPP script; " + std::string(kByDesign) +
-                                 ": put a condition (CheckPredicate) before the node instead, in a "
-                                 "Sequence, IfThenElse or WhileDoElse");
+      if (const ScriptAttribute* script = findScriptAttribute(key)) {
+        error(node.location, "'" + key + "' is a BehaviorTree.CPP script; " + std::string(kByDesign) + ": " +
+                                 std::string(script->instead));
         ports_valid = false;
         continue;
       }
