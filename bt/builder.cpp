@@ -273,7 +273,7 @@ class Validator {
   void checkAttributes(const NodeSpec& spec, const PlanNode& node) {
     bool ports_valid = true;
     for (const auto& [key, value] : node.attributes) {
-      if (key == "name" || key == "_description") {
+      if (key == "name") {
         continue;
       }
       if (const ScriptAttribute* script = findScriptAttribute(key)) {
@@ -282,8 +282,10 @@ class Validator {
         ports_valid = false;
         continue;
       }
-      if (spec.kind == NodeKind::kSubTree && key == "_autoremap") {
-        continue;  // meaningless without a blackboard; accepted for Groot2's files
+      if (key.starts_with("_")) {
+        // BehaviorTree.CPP's own attributes (_description, _uid, _fullpath, _autoremap, ...):
+        // metadata for tools, not parameters; BehaviorTree.CPP accepts any, and so do we.
+        continue;
       }
       const PortSpec* port = spec.port(key);
       if (port == nullptr) {

@@ -77,11 +77,14 @@ class FileParser {
         }
       } else if (key == "main_tree_to_execute") {
         file_.main_tree = attribute->Value();
-      } else {
-        error(root.GetLineNum(), "unknown attribute '" + std::string(key) + "' on <root>");
       }
+      // Other attributes (Groot2's project_name, ...) are ignored, as BehaviorTree.CPP does.
     }
     std::set<std::string> tree_ids;
+    for (const auto* tree = root.FirstChildElement("BehaviorTree"); tree != nullptr;
+         tree = tree->NextSiblingElement("BehaviorTree")) {
+      ++tree_count_;
+    }
     for (const auto* element = root.FirstChildElement(); element != nullptr; element = element->NextSiblingElement()) {
       const std::string_view name = element->Name();
       if (name == "BehaviorTree") {
@@ -113,8 +116,12 @@ class FileParser {
     PlanTree tree;
     tree.location = {file_.path, element.GetLineNum()};
     const char* id = element.Attribute("ID");
-    if (id == nullptr) {
-      // BehaviorTree.CPP names a tree without an ID "BehaviorTree_<k>", k counting such trees.
+    if (id == nullptr && tree_count_ > 1) {
+      error(element.GetLineNum(), "<BehaviorTree> needs an ID attribute: the file has " + std::to_string(tree_count_) +
+                                      " trees (only a file's single tree may leave it out)");
+      return;
+    } else if (id == nullptr) {
+      // A file's single tree may leave the ID out; BehaviorTree.CPP then names it "BehaviorTree_<k>".
       tree.id = "BehaviorTree_" + std::to_string(unnamed_trees_++);
     } else if (*id == '\0') {
       error(element.GetLineNum(), "<BehaviorTree ID=\"\"> has an empty ID: name the tree, or leave ID out");
@@ -185,6 +192,7 @@ class FileParser {
   PlanFile file_;
   std::vector<Diagnostic> diagnostics_;
   int unnamed_trees_ = 0;
+  int tree_count_ = 0;
 };
 
 std::optional<std::string> readFile(const std::filesystem::path& path, std::size_t max_bytes,

@@ -224,6 +224,18 @@ TEST(Validation, NewControlNodesCheckTheirChildren) {
   EXPECT_TRUE(problems(planXml(R"(<WhileDoElse><TestCondition/><TestLeaf/><TestLeaf/></WhileDoElse>)")).empty());
 }
 
+TEST(PlanXml, AcceptsBehaviorTreeCppsPrivateAttributesAndUnknownRootAttributes) {
+  // Forms BehaviorTree.CPP 4.10 accepts (checked with the peer): underscore attributes are
+  // metadata, unknown <root> attributes (Groot2's project_name) are ignored.
+  EXPECT_TRUE(problems(R"(<root BTCPP_format="4" project_name="demo"><BehaviorTree ID="m" _description="x">)"
+                       R"(<Sequence _uid="3" _fullpath="m/seq"><AlwaysSuccess _description="y"/></Sequence>)"
+                       R"(</BehaviorTree></root>)")
+                  .empty());
+  EXPECT_TRUE(problems(R"(<root><BehaviorTree ID="m"><AlwaysSuccess/></BehaviorTree></root>)").empty());
+  // ... but not BehaviorTree.CPP's scripts.
+  EXPECT_NE(problem(planXml(R"(<AlwaysSuccess _skipIf="a"/>)")).find("by design"), std::string::npos);
+}
+
 TEST(PlanXml, ATreeWithoutAnIdIsNamedAsBehaviorTreeCppNamesIt) {
   const std::string xml = R"(<?xml version="1.0"?>
     <root BTCPP_format="4"><BehaviorTree><Sequence><AlwaysSuccess/></Sequence></BehaviorTree></root>)";
@@ -232,13 +244,11 @@ TEST(PlanXml, ATreeWithoutAnIdIsNamedAsBehaviorTreeCppNamesIt) {
   SimClock clock;
   Tree tree = buildTree(plan, builtinRegistry(), clock);
   EXPECT_EQ(tree.tick(), Status::kSuccess);
-  // Two unnamed trees are BehaviorTree_0 and BehaviorTree_1; which one runs must then be named.
-  EXPECT_EQ(problem(R"(<root BTCPP_format="4"><BehaviorTree><AlwaysSuccess/></BehaviorTree>)"
-                    R"(<BehaviorTree><AlwaysFailure/></BehaviorTree></root>)"),
-            "0: the file defines several BehaviorTrees but no main_tree_to_execute");
-  EXPECT_TRUE(problems(R"(<root BTCPP_format="4" main_tree_to_execute="BehaviorTree_1"><BehaviorTree>)"
-                       R"(<AlwaysSuccess/></BehaviorTree><BehaviorTree><AlwaysFailure/></BehaviorTree></root>)")
-                  .empty());
+  // As BehaviorTree.CPP: only a file's single tree may leave its ID out.
+  EXPECT_EQ(problem("<root BTCPP_format=\"4\"><BehaviorTree ID=\"a\"><AlwaysSuccess/></BehaviorTree>\n"
+                    "<BehaviorTree><AlwaysFailure/></BehaviorTree></root>"),
+            "2: <BehaviorTree> needs an ID attribute: the file has 2 trees (only a file's single tree may leave it "
+            "out)");
   EXPECT_EQ(problem(R"(<root BTCPP_format="4"><BehaviorTree ID=""><AlwaysSuccess/></BehaviorTree></root>)"),
             "1: <BehaviorTree ID=\"\"> has an empty ID: name the tree, or leave ID out");
 }
