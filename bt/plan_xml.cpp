@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <memory>
 #include <pugixml.hpp>
 #include <set>
 #include <sstream>
@@ -160,11 +161,14 @@ class FileParser {
         }
       } else if (key == "main_tree_to_execute") {
         file_.main_tree = attribute.value();
-      } else {
-        error(line(root), "unknown attribute '" + std::string(key) + "' on <root>");
       }
+      // Other attributes (Groot2's project_name, ...) are ignored, as BehaviorTree.CPP does.
     }
     std::set<std::string> tree_ids;
+    for (const pugi::xml_node tree : root.children("BehaviorTree")) {
+      static_cast<void>(tree);
+      ++tree_count_;
+    }
     for (const pugi::xml_node element : root.children()) {
       if (element.type() != pugi::node_element) {
         continue;
@@ -199,11 +203,19 @@ class FileParser {
     PlanTree tree;
     tree.location = {file_.path, line(element)};
     const pugi::xml_attribute id = element.attribute("ID");
-    if (!id || *id.value() == '\0') {
-      error(line(element), "<BehaviorTree> needs an ID attribute");
+    if (!id && tree_count_ > 1) {
+      error(line(element), "<BehaviorTree> needs an ID attribute: the file has " + std::to_string(tree_count_) +
+                               " trees (only a file's single tree may leave it out)");
       return;
+    } else if (!id) {
+      // A file's single tree may leave the ID out; BehaviorTree.CPP then names it "BehaviorTree_<k>".
+      tree.id = "BehaviorTree_" + std::to_string(unnamed_trees_++);
+    } else if (*id.value() == '\0') {
+      error(line(element), "<BehaviorTree ID=\"\"> has an empty ID: name the tree, or leave ID out");
+      return;
+    } else {
+      tree.id = id.value();
     }
-    tree.id = id.value();
     for (const pugi::xml_attribute attribute : element.attributes()) {
       const std::string_view key = attribute.name();
       if (key != "ID" && !key.starts_with("_")) {
@@ -283,6 +295,8 @@ class FileParser {
   std::vector<std::size_t> line_starts_;
   PlanFile file_;
   std::vector<Diagnostic> diagnostics_;
+  int unnamed_trees_ = 0;
+  int tree_count_ = 0;
 };
 
 std::optional<std::string> readFile(const std::filesystem::path& path, std::size_t max_bytes,
@@ -309,22 +323,39 @@ std::optional<std::string> readFile(const std::filesystem::path& path, std::size
 }
 
 /// Follows includes depth-first, each file once; a file already on the stack is a cycle.
+/// Iterative (an explicit stack of files), so a chain of any length cannot overflow the call
+/// stack. Included files are listed after the files they include.
 class IncludeLoader {
  public:
   explicit IncludeLoader(const LoadOptions& options) : options_(options) {}
 
-  void follow(const PlanFile& file, const std::filesystem::path& base_dir) {
-    stack_.push_back(file.path);
-    for (const PlanInclude& include : file.includes) {
+  void follow(const PlanFile& root, const std::filesystem::path& base_dir) {
+    std::vector<Frame> frames;
+    frames.push_back({&root, nullptr, base_dir});
+    stack_.push_back(root.path);
+    while (!frames.empty()) {
+      if (frames.back().next == frames.back().file->includes.size()) {
+        Frame done = std::move(frames.back());
+        frames.pop_back();
+        stack_.pop_back();
+        if (done.owned) {
+          on_stack_.erase(stack_keys_.back());
+          stack_keys_.pop_back();
+          files_.push_back(std::move(*done.owned));
+        }
+        continue;
+      }
+      Frame& frame = frames.back();
+      const PlanInclude& include = frame.file->includes[frame.next++];
       const SourceLocation& where = include.location;
       if (!options_.follow_includes) {
         diagnostics_.push_back({where, "includes are not allowed here ('" + include.path + "')"});
         continue;
       }
-      const std::filesystem::path target = base_dir / include.path;
+      const std::filesystem::path target = frame.base_dir / include.path;
       std::error_code ec;
       const std::string key = std::filesystem::weakly_canonical(target, ec).string();
-      if (std::find(stack_keys_.begin(), stack_keys_.end(), key) != stack_keys_.end()) {
+      if (on_stack_.contains(key)) {
         std::string cycle;
         for (const auto& step : stack_) {
           cycle += step + " -> ";
@@ -340,22 +371,23 @@ class IncludeLoader {
         continue;
       }
       try {
-        PlanFile included = parsePlanFile(*text, target.string());
+        auto included = std::make_unique<PlanFile>(parsePlanFile(*text, target.string()));
         stack_keys_.push_back(key);
-        follow(included, target.parent_path());
-        stack_keys_.pop_back();
-        files_.push_back(std::move(included));
+        on_stack_.insert(key);
+        stack_.push_back(included->path);
+        const PlanFile* file = included.get();
+        frames.push_back({file, std::move(included), target.parent_path()});  // `frame` is invalid now
       } catch (const PlanError& error) {
         diagnostics_.insert(diagnostics_.end(), error.diagnostics().begin(), error.diagnostics().end());
       }
     }
-    stack_.pop_back();
   }
 
   void markRoot(const std::filesystem::path& path) {
     std::error_code ec;
     const std::string key = std::filesystem::weakly_canonical(path, ec).string();
     stack_keys_.push_back(key);
+    on_stack_.insert(key);
     loaded_.insert(key);
   }
 
@@ -363,9 +395,17 @@ class IncludeLoader {
   std::vector<Diagnostic> diagnostics_;
 
  private:
+  struct Frame {
+    const PlanFile* file;
+    std::unique_ptr<PlanFile> owned;  // null for the root file, which the caller owns
+    std::filesystem::path base_dir;
+    std::size_t next = 0;  // the next of file->includes to follow
+  };
+
   const LoadOptions& options_;
-  std::vector<std::string> stack_;
-  std::vector<std::string> stack_keys_;
+  std::vector<std::string> stack_;       // paths of the files being followed, for messages
+  std::vector<std::string> stack_keys_;  // their canonical paths
+  std::set<std::string> on_stack_;       // the same, for lookup
   std::set<std::string> loaded_;
 };
 
