@@ -15,21 +15,6 @@ using component::ValueType;
 
 namespace {
 
-std::string trim(std::string text) {
-  const auto first = text.find_first_not_of(" \t\n");
-  if (first == std::string::npos) {
-    return {};
-  }
-  const auto last = text.find_last_not_of(" \t\n");
-  return text.substr(first, last - first + 1);
-}
-
-bool isName(const std::string& text) {
-  return !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '?';
-  });
-}
-
 /// An operation of another component, started now, as a step.
 class ComponentStep final : public RunningOperation {
  public:
@@ -118,53 +103,6 @@ world::Pose up(double metres) { return world::Pose(Eigen::Translation3d(0, 0, me
 
 }  // namespace
 
-std::vector<predicator::Pattern> parsePredicateList(const std::string& text) {
-  std::vector<predicator::Pattern> patterns;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t end = std::min(text.find(';', start), text.size());
-    const std::string item = trim(text.substr(start, end - start));
-    start = end + 1;
-    if (item.empty()) {
-      continue;
-    }
-    predicator::Pattern pattern;
-    const auto open = item.find('(');
-    if (open == std::string::npos) {
-      pattern.predicate = item;
-    } else {
-      if (item.back() != ')') {
-        throw std::invalid_argument("'" + item + "' must look like name(arg, ...)");
-      }
-      pattern.predicate = trim(item.substr(0, open));
-      const std::string inside = item.substr(open + 1, item.size() - open - 2);
-      std::size_t a = 0;
-      while (a <= inside.size()) {
-        const std::size_t b = std::min(inside.find(',', a), inside.size());
-        const std::string arg = trim(inside.substr(a, b - a));
-        if (!arg.empty() || b < inside.size()) {
-          if (!isName(arg)) {
-            throw std::invalid_argument("'" + arg + "' in '" + item + "' is not a symbol name");
-          }
-          pattern.args.push_back(arg);
-        }
-        a = b + 1;
-      }
-    }
-    if (!isName(pattern.predicate) || pattern.predicate.find('?') != std::string::npos) {
-      throw std::invalid_argument("'" + pattern.predicate + "' is not a predicate name");
-    }
-    const auto wildcards = std::count(pattern.args.begin(), pattern.args.end(), "?");
-    if (wildcards == 0) {
-      pattern.args.insert(pattern.args.begin(), "?");  // the object is the first argument
-    } else if (wildcards > 1) {
-      throw std::invalid_argument("'" + item + "' has more than one '?'");
-    }
-    patterns.push_back(std::move(pattern));
-  }
-  return patterns;
-}
-
 std::string partObstacle(const std::string& object) { return "part:" + object; }
 
 SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Component& gripper, world::WorldState& world,
@@ -188,19 +126,8 @@ SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Compon
   ParamSpec predicates{"predicates", ValueType::kString,
                        "conditions on the part, e.g. right_of(table_center); near(node_1)", std::string()};
   predicates.choices_from = "predicate";
-  predicates.validate = [check = pattern_check_](std::string_view text) -> std::string {
-    try {
-      for (const auto& pattern : parsePredicateList(std::string(text))) {
-        if (*check) {
-          if (std::string problem = (*check)(pattern); !problem.empty()) {
-            return problem;
-          }
-        }
-      }
-      return {};
-    } catch (const std::invalid_argument& e) {
-      return e.what();
-    }
+  predicates.validate = [check = pattern_check_](std::string_view text) {
+    return predicator::checkPatternList(text, *check);
   };
   ParamSpec grasp{"grasp", ValueType::kString, "a grasp taught for the class", std::string("top")};
   grasp.choices_from = "grasp";

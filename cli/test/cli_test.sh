@@ -79,4 +79,50 @@ wait $pid
 code=$?
 if [[ $code -eq 130 ]] && grep -q STOPPED "$tmp/out"; then echo "ok   ctrl-c"; else echo "FAIL ctrl-c: exit $code"; cat "$tmp/out"; failures=$((failures + 1)); fi
 
+# The light costar links no robot library; costar-robot (beside it) runs the commands that do.
+robot="$(dirname "$costar")/costar-robot"
+if ldd "$costar" | grep -qE 'libpcl|libvtk|libQt|libopencv|libmujoco|libompl|libfcl|liborocos|libEGL'; then
+  echo "FAIL light executable links robot libraries:"; ldd "$costar" | grep -E 'libpcl|libvtk|libQt|libopencv|libmujoco|libompl|libfcl|liborocos|libEGL' | head; failures=$((failures + 1))
+else
+  echo "ok   light executable ($(ldd "$costar" | wc -l) shared libraries)"
+fi
+# Both list the same commands, options and exit codes.
+"$costar" --help | sed "s|$costar|COSTAR|" >"$tmp/help.light"
+"$robot" --help | sed "s|$robot|COSTAR|" >"$tmp/help.robot"
+if diff -u "$tmp/help.robot" "$tmp/help.light" >"$tmp/help.diff"; then echo "ok   same help"; else echo "FAIL help differs"; cat "$tmp/help.diff"; failures=$((failures + 1)); fi
+check "misspelt command"    2 'subcommand is required' -- "$costar" rnu examples/test_workcell/demo.xml
+check "version"             0 '^costar 0\.1\.0' -- "$costar" --version
+# Validating against the UR5 cell's stored description gives what the cell itself gives, word
+# for word (exit code, every problem, the summary line), with and without taught waypoints.
+same() {  # same NAME ARGS...: costar and costar-robot print the same and exit the same
+  local name="$1"
+  shift
+  "$costar" "$@" >"$tmp/light.out" 2>&1
+  local light=$?
+  "$robot" "$@" >"$tmp/robot.out" 2>&1
+  local heavy=$?
+  if [[ $light -eq $heavy ]] && diff -u "$tmp/robot.out" "$tmp/light.out" >"$tmp/same.diff"; then
+    echo "ok   $name (exit $light)"
+  else
+    echo "FAIL $name: exit $light, costar-robot $heavy"; cat "$tmp/same.diff"; failures=$((failures + 1))
+  fi
+}
+for plan in examples/ur5/*.xml cli/test/fixtures/ur5_predicates.xml; do
+  same "validate $plan as costar-robot does" validate "$plan" --waypoints "$tmp/none.json"
+done
+same "validate with waypoints as costar-robot does" validate cli/test/fixtures/ur5_predicates.xml \
+  --waypoints examples/ur5/blind_waypoints.json
+same "nodes model as costar-robot writes it" nodes --waypoints "$tmp/none.json"
+same "nodes json as costar-robot writes it" nodes --format json --waypoints "$tmp/none.json"
+check "predicate problems named" 2 'ur5_predicates.xml:11: .*unknown reference frame .node_1.' \
+  -- "$costar" validate cli/test/fixtures/ur5_predicates.xml --waypoints examples/ur5/blind_waypoints.json
+# Without costar-robot beside it: a clear error for what needs it, the rest still works.
+mkdir -p "$tmp/alone"
+cp "$costar" "$tmp/alone/costar"
+check "no costar-robot: robot command" 2 "'costar sim' needs the robot libraries .*costar-robot.*cannot be started" \
+  -- "$tmp/alone/costar" sim snapshot sim/scenes/one_node.json --out "$tmp/x.png"
+check "no costar-robot: run on ur5-sim" 2 "needs the robot libraries" \
+  -- "$tmp/alone/costar" run examples/ur5/pick_up_node.xml
+check "no costar-robot: run -w none" 0 '^SUCCESS' -- "$tmp/alone/costar" run bench/plans/reference_1000_leaves.xml -w none -q
+
 exit $((failures > 0))
