@@ -18,6 +18,9 @@ Scene oneNode() {
   return parseScene(R"({"parts": [{"class": "node", "color": "red", "at": [0.5, -0.1, 30]}]})", "one node");
 }
 
+/// More parts than the region holds: Simulation::create fails to place them.
+Scene crowded() { return parseScene(R"({"parts": [{"class": "node", "count": 60, "region": "right"}]})", "crowded"); }
+
 bool sameImage(const RgbImage& a, const RgbImage& b) {
   return a.width == b.width && a.height == b.height && a.pixels == b.pixels;
 }
@@ -45,12 +48,19 @@ TEST(GlRendering, TwoThreadsMakeRenderAndDestroySimulationsAtOnce) {
   ASSERT_EQ(GlRenderer::liveCount(), 0);  // the display is terminated with the last renderer
   ASSERT_GT(colourfulPixels(alone), 100);
 
-  // Two threads each make a simulation, render, destroy it, and again, as `trials -j 2` does:
-  // creations, frames and teardowns of the two interleave. Every frame must come, equal to the
+  // Two threads each make a simulation, render, destroy it, and again, as `trials -j 2` does
+  // (with trials whose parts cannot be placed among them): creations, frames and teardowns of
+  // the two interleave. Every frame must come, equal to the
   // reference (the same scene at the same time).
   const auto cycles = [&alone](std::string& error, int& differing) {
     try {
       for (int cycle = 0; cycle < 3; ++cycle) {
+        // A trial whose parts cannot be placed ends at once, between the others' frames.
+        try {
+          Simulation::create(crowded());
+          error = "a crowded scene was placed";
+        } catch (const std::runtime_error&) {
+        }
         auto simulation = Simulation::create(oneNode());
         for (int frame = 0; frame < 2; ++frame) {
           differing += sameImage(simulation->renderImage("rgbd", 320, 240), alone) ? 0 : 1;
