@@ -294,8 +294,6 @@ int collect(const CollectOptions& options) {
     sim::Scene empty;
     empty.label = "clear table";
     empty.regions = sim::defaultRegions();
-    // One simulation at a time: destroying a Simulation ends the EGL display that every live
-    // renderer shares (sim/gl_context.cpp).
     camera::RgbdFrame clear;
     {
       auto simulation = sim::Simulation::create(empty);

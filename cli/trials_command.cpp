@@ -1,7 +1,7 @@
 #include "cli/trials_command.h"
 
 #include <cstdio>
-#include <fstream>
+#include <functional>
 #include <iostream>
 #include <thread>
 
@@ -23,6 +23,20 @@ struct Options {
 int run(Options options) {
   if (options.trials.scene.empty()) {
     options.trials.scene = "sim/scenes/assembly.json";
+  }
+  // Everything that can be checked is checked before the first trial: no result is lost to a
+  // bad option or an output that cannot be written at the end.
+  try {
+    trials::checkOptions(options.trials);
+    if (!options.json.empty()) {
+      trials::checkOutputFile(options.json, "--json");
+    }
+    if (!options.plot.empty()) {
+      trials::checkOutputFile(options.plot, "--plot");
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
   }
   std::printf("costar trials: %d trial(s) of %s on scene %s, judge '%s', seeds %llu.., %d at a time\n",
               options.trials.count, options.trials.plan.c_str(), options.trials.scene.c_str(),
@@ -51,16 +65,41 @@ int run(Options options) {
     return 2;
   }
   std::printf("\n%s", summary.text().c_str());
+  const double rate = summary.trials.empty() ? 0.0 : static_cast<double>(summary.successes()) / summary.trials.size();
+  int code = rate + 1e-12 >= options.require ? 0 : 1;
+  // Each output on its own: the JSON is written even when the plot cannot be.
+  const auto write = [&code](const std::string& file, const std::function<void()>& writer) {
+    try {
+      writer();
+      std::printf("wrote %s\n", file.c_str());
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      code = 2;
+    }
+  };
   if (!options.json.empty()) {
-    std::ofstream(options.json) << summary.toJson().dump(2) << "\n";
-    std::printf("wrote %s\n", options.json.c_str());
+    write(options.json, [&] { trials::writeJson(summary, options.json); });
   }
   if (!options.plot.empty()) {
-    trials::writePlot(summary, options.plot);
-    std::printf("wrote %s\n", options.plot.c_str());
+    write(options.plot, [&] { trials::writePlot(summary, options.plot); });
   }
-  const double rate = summary.trials.empty() ? 0.0 : static_cast<double>(summary.successes()) / summary.trials.size();
-  return rate + 1e-12 >= options.require ? 0 : 1;
+  return code;
+}
+
+/// A number from `low` (excluded when `low_open`) to `high`; unlike CLI::Range, nan is refused.
+CLI::Validator numberIn(double low, double high, bool low_open, const std::string& unit) {
+  char range[96];
+  std::snprintf(range, sizeof range, "%s %g%s and at most %g", low_open ? "above" : "from", low, unit.c_str(), high);
+  const std::string description = range;
+  return CLI::Validator(
+      [low, high, low_open, description](std::string& text) -> std::string {
+        double value = 0.0;
+        if (!CLI::detail::lexical_cast(text, value) || !(low_open ? value > low : value >= low) || !(value <= high)) {
+          return "must be a number " + description + ", not " + text;
+        }
+        return {};
+      },
+      "NUMBER " + description);
 }
 
 }  // namespace
@@ -89,13 +128,16 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
   command->add_option("--waypoints", options->trials.waypoints, "waypoint file the plan uses (read only)")
       ->check(CLI::ExistingFile);
   command->add_option("--time-limit", options->trials.time_limit_s, "simulated seconds allowed per trial")
+      ->check(numberIn(0.0, trials::kMaxTimeLimitSeconds, true, " s"))
       ->capture_default_str();
   command->add_option("--json", options->json, "write the summary and every trial as JSON");
   command->add_option("--plot", options->plot, "write a PNG: success rate, failures, cycle times");
   command->add_option("--require", options->require, "exit 1 when the success rate is below this (0..1)")
-      ->check(CLI::Range(0.0, 1.0));
-  command->footer("Judges:" + judges +
-                  "\nExit code: 0, or 1 when the success rate is below --require; 2 for an invalid plan or option.");
+      ->check(numberIn(0.0, 1.0, false, ""));
+  command->footer(
+      "Judges:" + judges +
+      "\nExit code: 0, or 1 when the success rate is below --require; 2 for an invalid plan or option (checked "
+      "before the first trial) or an output that could not be written.");
   command->callback([options, &exit_code] { exit_code = run(*options); });
 }
 

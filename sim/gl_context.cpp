@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -19,54 +20,121 @@ std::string eglError(const char* what) {
   }() + "); is Mesa's EGL (libegl-mesa0, libgl1-mesa-dri) installed?";
 }
 
+/// The process's one EGL display (EGL gives every caller the same one for a platform) and the
+/// number of renderers using it. Made on first use and never destroyed, so that a renderer
+/// destroyed during static destruction at exit still finds the lock.
+struct SharedDisplay {
+  /// Held while a renderer is created or destroyed: the display's initialization and
+  /// termination, and MuJoCo's loading of GL functions into its globals (mjr_makeContext).
+  std::mutex mutex;
+  int users = 0;
+  EGLDisplay display = EGL_NO_DISPLAY;
+  EGLConfig config = nullptr;
+};
+
+SharedDisplay& sharedDisplay() {
+  static auto* shared = new SharedDisplay;  // never destroyed, see above
+  return *shared;
+}
+
+/// One more user of the display: initializes it for the first. The caller holds the mutex.
+void acquireDisplay(SharedDisplay& shared) {
+  if (shared.users == 0) {
+    // Mesa's surfaceless platform: no display server, no GPU needed.
+    const auto get_platform_display =
+        reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    if (get_platform_display == nullptr) {
+      throw std::runtime_error("headless rendering: eglGetPlatformDisplayEXT is not available");
+    }
+    const EGLDisplay display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    EGLint major = 0;
+    EGLint minor = 0;
+    if (display == EGL_NO_DISPLAY || eglInitialize(display, &major, &minor) != EGL_TRUE) {
+      throw std::runtime_error(eglError("eglInitialize"));
+    }
+    const EGLint config_attributes[] = {EGL_RED_SIZE,
+                                        8,
+                                        EGL_GREEN_SIZE,
+                                        8,
+                                        EGL_BLUE_SIZE,
+                                        8,
+                                        EGL_ALPHA_SIZE,
+                                        8,
+                                        EGL_DEPTH_SIZE,
+                                        24,
+                                        EGL_STENCIL_SIZE,
+                                        8,
+                                        EGL_COLOR_BUFFER_TYPE,
+                                        EGL_RGB_BUFFER,
+                                        EGL_SURFACE_TYPE,
+                                        EGL_PBUFFER_BIT,
+                                        EGL_RENDERABLE_TYPE,
+                                        EGL_OPENGL_BIT,
+                                        EGL_NONE};
+    EGLConfig config = nullptr;
+    EGLint count = 0;
+    if (eglChooseConfig(display, config_attributes, &config, 1, &count) != EGL_TRUE || count < 1) {
+      const std::string error = eglError("eglChooseConfig");
+      eglTerminate(display);
+      throw std::runtime_error(error);
+    }
+    shared.display = display;
+    shared.config = config;
+  }
+  ++shared.users;
+}
+
+/// One user fewer: the last terminates the display (no context is left on it then). The
+/// caller holds the mutex.
+void releaseDisplay(SharedDisplay& shared) {
+  if (--shared.users == 0) {
+    eglTerminate(shared.display);
+    shared.display = EGL_NO_DISPLAY;
+    shared.config = nullptr;
+  }
+}
+
 }  // namespace
 
-GlRenderer::GlRenderer(const mjModel* model) {
-  // Mesa's surfaceless platform: no display server, no GPU needed.
-  const auto get_platform_display =
-      reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-  if (get_platform_display == nullptr) {
-    throw std::runtime_error("headless rendering: eglGetPlatformDisplayEXT is not available");
+/// Makes a renderer's context current on this thread for a scope, then gives the thread back
+/// what it had (normally no context), so that the context is current nowhere between scopes.
+class GlRenderer::Current {
+ public:
+  Current(EGLDisplay display, EGLContext context)
+      : display_(display),
+        api_(eglQueryAPI()),
+        previous_display_(eglGetCurrentDisplay()),
+        previous_context_(eglGetCurrentContext()),
+        previous_draw_(eglGetCurrentSurface(EGL_DRAW)),
+        previous_read_(eglGetCurrentSurface(EGL_READ)) {
+    eglBindAPI(EGL_OPENGL_API);  // the bound API is per thread
+    if (eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context) != EGL_TRUE) {
+      const std::string error = eglError("eglMakeCurrent");
+      eglBindAPI(api_);
+      throw std::runtime_error(error);
+    }
   }
-  display_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-  EGLint major = 0;
-  EGLint minor = 0;
-  if (display_ == EGL_NO_DISPLAY || eglInitialize(display_, &major, &minor) != EGL_TRUE) {
-    throw std::runtime_error(eglError("eglInitialize"));
+  ~Current() {
+    if (previous_context_ != EGL_NO_CONTEXT) {
+      eglMakeCurrent(previous_display_, previous_draw_, previous_read_, previous_context_);
+    } else {
+      eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    }
+    eglBindAPI(api_);
   }
-  const EGLint config_attributes[] = {EGL_RED_SIZE,
-                                      8,
-                                      EGL_GREEN_SIZE,
-                                      8,
-                                      EGL_BLUE_SIZE,
-                                      8,
-                                      EGL_ALPHA_SIZE,
-                                      8,
-                                      EGL_DEPTH_SIZE,
-                                      24,
-                                      EGL_STENCIL_SIZE,
-                                      8,
-                                      EGL_COLOR_BUFFER_TYPE,
-                                      EGL_RGB_BUFFER,
-                                      EGL_SURFACE_TYPE,
-                                      EGL_PBUFFER_BIT,
-                                      EGL_RENDERABLE_TYPE,
-                                      EGL_OPENGL_BIT,
-                                      EGL_NONE};
-  EGLConfig config;
-  EGLint count = 0;
-  if (eglChooseConfig(display_, config_attributes, &config, 1, &count) != EGL_TRUE || count < 1) {
-    eglTerminate(display_);
-    throw std::runtime_error(eglError("eglChooseConfig"));
-  }
-  eglBindAPI(EGL_OPENGL_API);
-  context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, nullptr);
-  if (context_ == EGL_NO_CONTEXT) {
-    eglTerminate(display_);
-    throw std::runtime_error(eglError("eglCreateContext"));
-  }
-  makeCurrent();
+  Current(const Current&) = delete;
+  Current& operator=(const Current&) = delete;
 
+ private:
+  EGLDisplay display_;
+  EGLenum api_;
+  EGLDisplay previous_display_;
+  EGLContext previous_context_;
+  EGLSurface previous_draw_;
+  EGLSurface previous_read_;
+};
+
+GlRenderer::GlRenderer(const mjModel* model) {
   mjv_defaultScene(&scene_);
   mjv_defaultOption(&option_);
   mjv_defaultPerturb(&perturb_);
@@ -74,28 +142,62 @@ GlRenderer::GlRenderer(const mjModel* model) {
   for (int group = 0; group < mjNGROUP; ++group) {
     option_.sitegroup[group] = 0;  // sites are markers for people, not surfaces a camera sees
   }
-  mjv_makeScene(model, &scene_, 4000);
-  mjr_makeContext(model, &render_context_, mjFONTSCALE_100);
-  mjr_setBuffer(mjFB_OFFSCREEN, &render_context_);
-  if (render_context_.currentBuffer != mjFB_OFFSCREEN) {
-    throw std::runtime_error("headless rendering: MuJoCo's offscreen buffer is not supported");
+  SharedDisplay& shared = sharedDisplay();
+  const std::lock_guard lock(shared.mutex);
+  acquireDisplay(shared);
+  display_ = shared.display;
+  try {
+    eglBindAPI(EGL_OPENGL_API);
+    context_ = eglCreateContext(display_, shared.config, EGL_NO_CONTEXT, nullptr);
+    if (context_ == EGL_NO_CONTEXT) {
+      throw std::runtime_error(eglError("eglCreateContext"));
+    }
+    const Current current(display_, context_);
+    mjv_makeScene(model, &scene_, 4000);
+    mjr_makeContext(model, &render_context_, mjFONTSCALE_100);
+    mujoco_context_ = true;
+    mjr_setBuffer(mjFB_OFFSCREEN, &render_context_);
+    if (render_context_.currentBuffer != mjFB_OFFSCREEN) {
+      throw std::runtime_error("headless rendering: MuJoCo's offscreen buffer is not supported");
+    }
+  } catch (...) {
+    if (context_ != EGL_NO_CONTEXT) {
+      if (mujoco_context_) {
+        try {
+          const Current current(display_, context_);
+          mjr_freeContext(&render_context_);
+        } catch (const std::exception&) {
+          // Not current: its GL objects go with the context.
+        }
+      }
+      eglDestroyContext(display_, context_);
+    }
+    mjv_freeScene(&scene_);
+    releaseDisplay(shared);
+    throw;
   }
 }
 
 GlRenderer::~GlRenderer() {
-  makeCurrent();
-  mjr_freeContext(&render_context_);
+  SharedDisplay& shared = sharedDisplay();
+  const std::lock_guard lock(shared.mutex);
+  try {
+    const Current current(display_, context_);
+    mjr_freeContext(&render_context_);
+  } catch (const std::exception& e) {
+    // Only when the context is current on another thread, which this class never leaves it:
+    // its GL objects go with the context.
+    std::fprintf(stderr, "warning: %s (while freeing a renderer)\n", e.what());
+  }
   mjv_freeScene(&scene_);
-  eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   eglDestroyContext(display_, context_);
-  eglTerminate(display_);
+  releaseDisplay(shared);
 }
 
-void GlRenderer::makeCurrent() {
-  if (eglGetCurrentContext() != context_ &&
-      eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_) != EGL_TRUE) {
-    throw std::runtime_error(eglError("eglMakeCurrent"));
-  }
+int GlRenderer::liveCount() {
+  SharedDisplay& shared = sharedDisplay();
+  const std::lock_guard lock(shared.mutex);
+  return shared.users;
 }
 
 void GlRenderer::render(const mjModel* model, mjData* data, int camera_id, int width, int height, RgbImage& rgb,
@@ -105,7 +207,7 @@ void GlRenderer::render(const mjModel* model, mjData* data, int camera_id, int w
                              ": the largest image is " + std::to_string(render_context_.offWidth) + "x" +
                              std::to_string(render_context_.offHeight));
   }
-  makeCurrent();
+  const Current current(display_, context_);
   mjvCamera camera;
   mjv_defaultCamera(&camera);
   camera.type = mjCAMERA_FIXED;

@@ -1,7 +1,11 @@
 #include "sim/scene.h"
 
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
@@ -15,51 +19,200 @@ std::map<std::string, Region> defaultRegions() {
           {"left", {{0.3, 0.06}, {0.7, 0.4}}}};
 }
 
+Region tableTop() { return {{-0.3, -0.6}, {1.1, 0.6}}; }
+
 namespace {
 
-Region parseRegion(const nlohmann::json& json) {
-  const auto& x = json.at("x");
-  const auto& y = json.at("y");
-  Region region{{x.at(0).get<double>(), y.at(0).get<double>()}, {x.at(1).get<double>(), y.at(1).get<double>()}};
-  if ((region.max - region.min).minCoeff() <= 0) {
-    throw std::runtime_error("a region's x and y ranges must be [low, high] with low < high");
+using nlohmann::json;
+
+/// A problem with one field of a scene file: "parts[2].count: must be ...".
+[[noreturn]] void fail(const std::string& field, const std::string& problem) {
+  throw std::runtime_error(field + ": " + problem);
+}
+
+/// The value as the file has it, shortened: for "must be ..., not VALUE".
+std::string shown(const json& value) {
+  std::string text = value.dump();
+  return text.size() <= 40 ? text : text.substr(0, 37) + "...";
+}
+
+void onlyKnownFields(const json& object, const std::string& field, std::initializer_list<const char*> known) {
+  for (const auto& [key, value] : object.items()) {
+    if (std::none_of(known.begin(), known.end(), [&key](const char* name) { return key == name; })) {
+      std::string list;
+      for (const char* name : known) {
+        list += (list.empty() ? "" : ", ") + std::string(name);
+      }
+      fail(field.empty() ? key : field + "." + key, "unknown field (known: " + list + ")");
+    }
+  }
+}
+
+const json& object(const json& value, const std::string& field) {
+  if (!value.is_object()) {
+    fail(field, "must be an object {...}, not " + shown(value));
+  }
+  return value;
+}
+
+std::string stringField(const json& value, const std::string& field) {
+  if (!value.is_string()) {
+    fail(field, "must be a string, not " + shown(value));
+  }
+  return value.get<std::string>();
+}
+
+double number(const json& value, const std::string& field) {
+  // JSON has no nan; a number too large for a double is read as infinity.
+  if (!value.is_number() || !std::isfinite(value.get<double>())) {
+    fail(field, "must be a finite number, not " + shown(value));
+  }
+  return value.get<double>();
+}
+
+/// A whole number in [low, high]; 4294967297 or 2.5 is an error, never truncated.
+std::uint64_t whole(const json& value, const std::string& field, std::uint64_t low, std::uint64_t high) {
+  const std::string range = "a whole number from " + std::to_string(low) + " to " + std::to_string(high);
+  if (!value.is_number_unsigned() || value.get<std::uint64_t>() < low || value.get<std::uint64_t>() > high) {
+    fail(field, "must be " + range + ", not " + shown(value));
+  }
+  return value.get<std::uint64_t>();
+}
+
+std::vector<double> numbers(const json& value, const std::string& field, std::size_t min_size, std::size_t max_size,
+                            const std::string& what) {
+  if (!value.is_array() || value.size() < min_size || value.size() > max_size) {
+    fail(field, "must be " + what + ", not " + shown(value));
+  }
+  std::vector<double> out;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    out.push_back(number(value[i], field + "[" + std::to_string(i) + "]"));
+  }
+  return out;
+}
+
+bool inside(const Region& outer, const Eigen::Vector2d& point) {
+  return (point.array() >= outer.min.array()).all() && (point.array() <= outer.max.array()).all();
+}
+
+std::string format(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+std::string describeTable() {
+  const Region table = tableTop();
+  std::ostringstream out;
+  out << "x from " << table.min.x() << " to " << table.max.x() << " m, y from " << table.min.y() << " to "
+      << table.max.y() << " m";
+  return out.str();
+}
+
+Region parseRegion(const json& value, const std::string& field) {
+  onlyKnownFields(object(value, field), field, {"x", "y"});
+  Region region;
+  for (int axis = 0; axis < 2; ++axis) {
+    const std::string key = axis == 0 ? "x" : "y";
+    if (!value.contains(key)) {
+      fail(field + "." + key, "missing (a region has \"x\": [low, high] and \"y\": [low, high], in m)");
+    }
+    const auto range = numbers(value.at(key), field + "." + key, 2, 2, "[low, high] in m");
+    if (range[0] >= range[1]) {
+      fail(field + "." + key, "must be [low, high] with low < high, not " + shown(value.at(key)));
+    }
+    region.min[axis] = range[0];
+    region.max[axis] = range[1];
+  }
+  if (!inside(tableTop(), region.min) || !inside(tableTop(), region.max)) {
+    fail(field, "lies off the table top (" + describeTable() + ")");
   }
   return region;
+}
+
+std::string knownRegions(const std::map<std::string, Region>& regions) {
+  std::string list;
+  for (const auto& [name, region] : regions) {
+    list += (list.empty() ? "" : ", ") + name;
+  }
+  return list;
+}
+
+PartRequest parsePart(const json& item, const std::string& field, const std::map<std::string, Region>& regions) {
+  onlyKnownFields(object(item, field), field, {"class", "color", "count", "at", "region"});
+  PartRequest request;
+  if (!item.contains("class")) {
+    fail(field + ".class", "missing (the object class, e.g. \"node\")");
+  }
+  request.object_class = stringField(item.at("class"), field + ".class");
+  if (item.contains("color")) {
+    request.color = stringField(item.at("color"), field + ".color");
+  }
+  if (item.contains("count")) {
+    request.count = static_cast<int>(whole(item.at("count"), field + ".count", 1, 100));
+  }
+  if (item.contains("at")) {
+    if (item.contains("region")) {
+      fail(field, "has both \"at\" (a fixed place) and \"region\" (a random place); give one");
+    }
+    if (request.count != 1) {
+      fail(field + ".count", "a part placed with \"at\" must have count 1");
+    }
+    const auto at = numbers(item.at("at"), field + ".at", 2, 3, "[x, y] or [x, y, yaw] (m, m, degrees)");
+    request.at = Eigen::Vector3d(at[0], at[1], at.size() > 2 ? at[2] : 0.0);
+    if (!inside(tableTop(), request.at->head<2>())) {
+      fail(field + ".at", "lies off the table top (" + describeTable() + ")");
+    }
+  } else {
+    request.region = item.contains("region") ? stringField(item.at("region"), field + ".region") : "table";
+    if (!regions.contains(request.region)) {
+      fail(field + ".region", "unknown region '" + request.region + "' (known: " + knownRegions(regions) + ")");
+    }
+  }
+  return request;
 }
 
 }  // namespace
 
 Scene parseScene(const std::string& text, const std::string& label) {
   try {
-    const nlohmann::json json = nlohmann::json::parse(text);
+    const json file = json::parse(text);
+    onlyKnownFields(object(file, "the file"), "", {"description", "seed", "min_gap", "regions", "parts"});
     Scene scene;
     scene.label = label;
-    scene.description = json.value("description", "");
-    scene.seed = json.value("seed", std::uint64_t{0});
-    scene.min_gap = json.value("min_gap", 0.02);
-    scene.regions = defaultRegions();
-    for (const auto& [name, region] : json.value("regions", nlohmann::json::object()).items()) {
-      scene.regions[name] = parseRegion(region);
+    if (file.contains("description")) {
+      scene.description = stringField(file.at("description"), "description");
     }
-    for (const auto& item : json.at("parts")) {
-      PartRequest request;
-      request.object_class = item.at("class").get<std::string>();
-      request.color = item.value("color", "");
-      request.count = item.value("count", 1);
-      if (request.count < 1 || request.count > 100) {
-        throw std::runtime_error("part count must be between 1 and 100");
+    if (file.contains("seed")) {
+      scene.seed = whole(file.at("seed"), "seed", 0, std::numeric_limits<std::uint64_t>::max());
+    }
+    if (file.contains("min_gap")) {
+      scene.min_gap = number(file.at("min_gap"), "min_gap");
+      if (scene.min_gap < 0.0 || scene.min_gap > 0.5) {
+        fail("min_gap", "must be from 0 to 0.5 (m), not " + shown(file.at("min_gap")));
       }
-      if (item.contains("at")) {
-        const auto& at = item.at("at");
-        request.at = Eigen::Vector3d(at.at(0).get<double>(), at.at(1).get<double>(),
-                                     at.size() > 2 ? at.at(2).get<double>() : 0.0);
-        if (request.count != 1) {
-          throw std::runtime_error("a part placed with \"at\" must have count 1");
+    }
+    scene.regions = defaultRegions();
+    if (file.contains("regions")) {
+      // A named object: file.at() returns a reference into `file`, which outlives the loop.
+      // (Iterating items() of a temporary, such as value("regions", {}), reads freed memory.)
+      const json& regions = object(file.at("regions"), "regions");
+      for (const auto& [name, region] : regions.items()) {
+        if (name.empty()) {
+          fail("regions", "a region needs a name");
         }
-      } else {
-        request.region = item.value("region", "table");
+        scene.regions[name] = parseRegion(region, "regions." + name);
       }
-      scene.parts.push_back(std::move(request));
+    }
+    if (!file.contains("parts")) {
+      fail("parts", "missing (a list of parts: [{\"class\": \"node\", ...}, ...])");
+    }
+    const json& parts = file.at("parts");
+    if (!parts.is_array()) {
+      fail("parts", "must be a list [...], not " + shown(parts));
+    }
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      scene.parts.push_back(parsePart(parts[i], "parts[" + std::to_string(i) + "]", scene.regions));
     }
     return scene;
   } catch (const std::exception& e) {
@@ -68,12 +221,19 @@ Scene parseScene(const std::string& text, const std::string& label) {
 }
 
 Scene loadScene(const std::filesystem::path& file) {
+  std::error_code error;
+  if (std::filesystem::is_directory(file, error)) {
+    throw std::runtime_error("cannot read scene file '" + file.string() + "': it is a folder");
+  }
   std::ifstream stream(file);
   if (!stream) {
-    throw std::runtime_error("cannot open scene file '" + file.string() + "'");
+    throw std::runtime_error("cannot read scene file '" + file.string() + "': " + std::strerror(errno));
   }
   std::stringstream text;
   text << stream.rdbuf();
+  if (stream.bad()) {
+    throw std::runtime_error("cannot read scene file '" + file.string() + "': " + std::strerror(errno));
+  }
   return parseScene(text.str(), file.string());
 }
 
@@ -85,17 +245,22 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
   std::vector<PartPlacement> placed;
   std::vector<std::pair<Eigen::Vector2d, double>> footprints;  // centre, radius
 
-  const auto findClass = [&](const std::string& name) -> const world::ObjectClass& {
+  const auto findClass = [&](const std::string& name, const std::string& field) -> const world::ObjectClass& {
+    std::string known;
     for (const auto& object : classes) {
       if (object.name == name) {
         return object;
       }
+      known += (known.empty() ? "" : ", ") + object.name;
     }
-    throw std::runtime_error("scene '" + scene.label + "': unknown object class '" + name + "'");
+    throw std::runtime_error("scene '" + scene.label + "': " + field + ".class: unknown object class '" + name +
+                             "' (known: " + known + ")");
   };
 
-  for (const PartRequest& request : scene.parts) {
-    const world::ObjectClass& object = findClass(request.object_class);
+  for (std::size_t r = 0; r < scene.parts.size(); ++r) {
+    const PartRequest& request = scene.parts[r];
+    const std::string field = "parts[" + std::to_string(r) + "]";
+    const world::ObjectClass& object = findClass(request.object_class, field);
     const Eigen::Vector3d extent = object.bounds().sizes();
     const double radius = 0.5 * std::hypot(extent.x(), extent.y());
     for (int i = 0; i < request.count; ++i) {
@@ -107,7 +272,7 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
       try {
         object.color(part.color);
       } catch (const std::out_of_range& e) {
-        throw std::runtime_error("scene '" + scene.label + "': " + e.what());
+        throw std::runtime_error("scene '" + scene.label + "': " + field + ".color: " + e.what());
       }
       Eigen::Vector2d xy;
       double yaw = 0.0;
@@ -117,7 +282,8 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
       } else {
         const auto region = scene.regions.find(request.region);
         if (region == scene.regions.end()) {
-          throw std::runtime_error("scene '" + scene.label + "': unknown region '" + request.region + "'");
+          throw std::runtime_error("scene '" + scene.label + "': " + field + ".region: unknown region '" +
+                                   request.region + "' (known: " + knownRegions(scene.regions) + ")");
         }
         bool fits = false;
         for (int attempt = 0; attempt < 2000 && !fits; ++attempt) {
@@ -133,8 +299,10 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
           }
         }
         if (!fits) {
-          throw std::runtime_error("scene '" + scene.label + "': cannot fit " + part.name + " in region '" +
-                                   request.region + "' without touching another part");
+          throw std::runtime_error("scene '" + scene.label + "': " + field + ": cannot fit " + part.name +
+                                   " in region '" + request.region + "' " + format(scene.min_gap) +
+                                   " m or more from every other part (fewer parts, a larger region or a smaller "
+                                   "min_gap)");
         }
       }
       footprints.emplace_back(xy, radius);

@@ -7,6 +7,11 @@
 //              {"class": "node", "count": 2, "region": "right"},
 //              {"class": "link", "region": "right"}]}
 // "at" is x, y (m, world frame: the robot's base, table top z = 0) and yaw (degrees).
+// Optional: "min_gap" (m, 0 to 0.5, default 0.02) between randomly placed parts. Custom
+// regions add to (or replace) the default ones. A field the format does not know, a value of
+// the wrong type or out of range (a count of 4294967297, a negative min_gap, a region or an
+// "at" off the table) is an error naming the file and the field, e.g.
+//   scene 'my.json': parts[1].count: must be a whole number from 1 to 100, not 0
 
 #include <cstdint>
 #include <filesystem>
@@ -48,11 +53,15 @@ struct Scene {
   double min_gap = 0.02;
 };
 
+/// The table top (x, y in m), as sim/models/ur5_workcell.xml has it; regions and fixed
+/// placements must lie on it.
+Region tableTop();
+
 /// The regions every scene knows: "table" (the reachable part of the table), "right" and
 /// "left" halves (y < 0 and y > 0, the robot's right and left).
 std::map<std::string, Region> defaultRegions();
 
-/// Reads a scene file. @throws std::runtime_error naming the file and the problem.
+/// Reads a scene file. @throws std::runtime_error naming the file, the field and the problem.
 Scene loadScene(const std::filesystem::path& file);
 Scene parseScene(const std::string& json_text, const std::string& label);
 

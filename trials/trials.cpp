@@ -1,9 +1,14 @@
 #include "trials/trials.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <mutex>
 #include <regex>
 #include <stdexcept>
@@ -12,6 +17,7 @@
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
+#include "core/files.h"
 #include "sim/simulation.h"
 #include "trials/judge.h"
 #include "workcell/workcell.h"
@@ -69,9 +75,73 @@ double percentile(std::vector<double> values, double p) {
   return values[low] + (values[high] - values[low]) * (position - low);
 }
 
+std::string shown(double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+
 }  // namespace
 
+void checkOptions(const TrialOptions& options) {
+  if (options.count < 1) {
+    throw std::invalid_argument("the number of trials must be at least 1, not " + std::to_string(options.count));
+  }
+  if (options.jobs < 1) {
+    throw std::invalid_argument("the number of trials run at once must be at least 1, not " +
+                                std::to_string(options.jobs));
+  }
+  // nan compares false with everything: the conditions are written so that it fails them.
+  if (!(options.time_limit_s > 0.0 && options.time_limit_s <= kMaxTimeLimitSeconds)) {
+    throw std::invalid_argument("the time limit must be a number of simulated seconds above 0 and at most " +
+                                shown(kMaxTimeLimitSeconds) + ", not " + shown(options.time_limit_s));
+  }
+  if (!(options.settle_s >= 0.0 && options.settle_s <= kMaxTimeLimitSeconds)) {
+    throw std::invalid_argument("the settle time must be a number of simulated seconds from 0 to " +
+                                shown(kMaxTimeLimitSeconds) + ", not " + shown(options.settle_s));
+  }
+}
+
+void checkOutputFile(const std::filesystem::path& file, const std::string& what) {
+  const std::string label = what + " '" + file.string() + "'";
+  if (file.empty()) {
+    throw std::invalid_argument(what + ": the file name is empty");
+  }
+  std::error_code error;
+  const auto status = std::filesystem::status(file, error);
+  if (std::filesystem::is_directory(status)) {
+    throw std::invalid_argument("cannot write " + label + ": it is a folder");
+  }
+  const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : ".";
+  if (!std::filesystem::is_directory(folder, error)) {
+    throw std::invalid_argument("cannot write " + label + ": there is no folder '" + folder.string() + "'");
+  }
+  // A regular file is replaced by a new one written in its folder; a device is written to.
+  const bool exists = std::filesystem::exists(status);
+  const std::filesystem::path written = exists && !std::filesystem::is_regular_file(status) ? file : folder;
+  if (::access(written.c_str(), W_OK) != 0) {
+    throw std::invalid_argument("cannot write " + label + ": " + std::strerror(errno));
+  }
+}
+
+void writeJson(const Summary& summary, const std::filesystem::path& file) {
+  const std::string text = summary.toJson().dump(2) + "\n";
+  std::error_code error;
+  const auto status = std::filesystem::status(file, error);
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status) &&
+      !std::filesystem::is_directory(status)) {
+    std::ofstream stream(file);
+    stream << text << std::flush;
+    if (!stream) {
+      throw std::runtime_error("cannot write '" + file.string() + "': " + std::strerror(errno));
+    }
+    return;
+  }
+  writeFileAtomically(file, text);
+}
+
 Summary runTrials(const TrialOptions& options, const std::function<void(const TrialResult&, int)>& progress) {
+  checkOptions(options);
   const Judge judge = trials::judge(options.judge);
   const bt::Plan plan = bt::loadPlan(options.plan);
   {

@@ -50,12 +50,29 @@ struct Summary {
   std::string text() const;
 };
 
+/// Checks the numbers: count and jobs at least 1, time limit a finite number of seconds above 0
+/// (at most kMaxTimeLimitSeconds), settle time finite and not negative.
+/// @throws std::invalid_argument naming the option and the problem.
+void checkOptions(const TrialOptions& options);
+inline constexpr double kMaxTimeLimitSeconds = 1e6;
+
+/// Checks, before any trial runs, that `file` can be written at the end: its folder exists, it
+/// is not a folder itself, and it may be written. `what` names it in the error ("--json").
+/// @throws std::invalid_argument naming the file and the problem.
+void checkOutputFile(const std::filesystem::path& file, const std::string& what);
+
 /// Runs the trials; `progress` is called as each one ends (from the trial's thread, one at a
-/// time). @throws std::runtime_error before the first trial when the plan is invalid or a file
-/// is missing.
+/// time). @throws std::invalid_argument or std::runtime_error before the first trial when an
+/// option is out of range (checkOptions), the plan is invalid or a file is missing.
 Summary runTrials(const TrialOptions& options, const std::function<void(const TrialResult&, int done)>& progress = {});
 
+/// Writes Summary::toJson() to `file`: atomically for a regular file (a crash leaves the old
+/// file or the new one), straight through for a device such as /dev/stdout.
+/// @throws std::runtime_error naming the file and the system error.
+void writeJson(const Summary& summary, const std::filesystem::path& file);
+
 /// A PNG a person can read: success rate, failures by reason, cycle-time histogram.
+/// @throws std::runtime_error naming the file when it cannot be written.
 void writePlot(const Summary& summary, const std::filesystem::path& png);
 
 }  // namespace costar::trials

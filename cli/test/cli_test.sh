@@ -62,6 +62,38 @@ assert fails[-1]["origin"].endswith('TestAction "grasp link"'), fails[-1]
 PY
 then echo "ok   trace"; else echo "FAIL trace"; failures=$((failures + 1)); fi
 
+# Trials: options, scene and waypoint files and output paths are checked before the first trial
+# (issue 10); the errors name the option or the file and the field. No trial runs in these.
+trials=(trials examples/ur5/blind_pick_place.xml --judge blind_place --scene sim/scenes/one_node.json
+        --waypoints examples/ur5/blind_waypoints.json -n 1)
+no_trial() {  # no_trial NAME: the last check's output shows no trial ran
+  if grep -qE '^\[ *1/1\]' "$tmp/out"; then echo "FAIL $1: a trial ran"; failures=$((failures + 1)); fi
+}
+for bad in nan 0 -5 inf; do
+  check "trials --time-limit $bad" 2 "--time-limit: must be a number above 0 s and at most 1e\+06, not $bad" \
+    -- "$costar" "${trials[@]}" --time-limit "$bad"
+  no_trial "trials --time-limit $bad"
+done
+check "trials --require nan" 2 '--require: must be a number from 0 and at most 1, not nan' \
+  -- "$costar" "${trials[@]}" --require nan
+check "trials --plot in a missing folder" 2 "error: cannot write --plot '/nonexistent/p.png': there is no folder '/nonexistent'" \
+  -- "$costar" "${trials[@]}" --plot /nonexistent/p.png
+no_trial "trials --plot in a missing folder"
+check "trials --json to a folder" 2 "error: cannot write --json '$tmp': it is a folder" \
+  -- "$costar" "${trials[@]}" --json "$tmp"
+no_trial "trials --json to a folder"
+check "trials --json in a missing folder" 2 "error: cannot write --json '$tmp/no/r.json': there is no folder '$tmp/no'" \
+  -- "$costar" "${trials[@]}" --json "$tmp/no/r.json"
+printf '{"parts": [{"class": "node", "count": 4294967297}]}\n' >"$tmp/count.json"
+check "trials: scene count out of range" 2 \
+  "error: scene '$tmp/count.json': parts\[0\]\.count: must be a whole number from 1 to 100, not 4294967297" \
+  -- "$costar" trials examples/ur5/blind_pick_place.xml --judge blind_place --scene "$tmp/count.json" -n 1
+no_trial "trials: scene count out of range"
+printf '{"waypoints": [{"name": "pick", "position": [0.45, -0.25, 0.03], "orientation": [0, 0, 0, 0]}]}\n' >"$tmp/zero.json"
+check "run: zero quaternion in a waypoint" 2 \
+  "waypoint file '$tmp/zero.json': waypoints\[0\]\.orientation: must be a unit quaternion \[w, x, y, z\], not \[0,0,0,0\]" \
+  -- "$costar" run examples/ur5/blind_pick_place.xml -q --scene sim/scenes/one_node.json --waypoints "$tmp/zero.json"
+
 # Ctrl-C stops the run, cancels the operation and exits 130.
 cat > "$tmp/long.xml" <<'XML'
 <root BTCPP_format="4"><BehaviorTree ID="m"><Repeat num_cycles="-1"><Sleep msec="10"/></Repeat></BehaviorTree></root>

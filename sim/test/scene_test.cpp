@@ -45,23 +45,103 @@ TEST(Scene, PlacementIsDeterministicForASeedAndVariesWithIt) {
   EXPECT_FALSE(a[0].pose.isApprox(c[0].pose));
 }
 
+std::string problem(const std::string& json) {
+  try {
+    placeParts(parseScene(json, "bad.json"), classes());
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
 TEST(Scene, ProblemsAreNamed) {
-  const auto problem = [](const std::string& json) {
+  EXPECT_EQ(problem(R"({"parts": [{"class": "gear"}]})"),
+            "scene 'bad.json': parts[0].class: unknown object class 'gear' (known: link, node)");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node"}, {"class": "node", "region": "moon"}]})"),
+            "scene 'bad.json': parts[1].region: unknown region 'moon' (known: left, right, table)");
+  EXPECT_NE(problem(R"({"parts": [{"class": "node", "count": 60, "region": "right"}]})").find("parts[0]: cannot fit"),
+            std::string::npos);
+  EXPECT_NE(problem(R"({"parts": [{"class": "node", "color": "purple"}]})").find("parts[0].color: "),
+            std::string::npos);
+  EXPECT_EQ(problem(R"({"parts": 3})"), "scene 'bad.json': parts: must be a list [...], not 3");
+  EXPECT_THROW(loadScene("/nonexistent.json"), std::runtime_error);
+}
+
+// Issue 10, bug 2: the regions loop iterated items() of a temporary (freed memory; valgrind and
+// AddressSanitizer report it) and failed with "cannot use at() with null".
+TEST(Scene, CustomRegionsAreReadAndUsed) {
+  const Scene scene = parseScene(R"({"seed": 4,
+      "regions": {"corner": {"x": [0.55, 0.7], "y": [0.2, 0.35]}, "strip": {"x": [0.3, 0.35], "y": [-0.3, 0.3]}},
+      "parts": [{"class": "node", "count": 2, "region": "corner"}, {"class": "link", "region": "strip"}]})",
+                                 "regions.json");
+  ASSERT_EQ(scene.regions.size(), 5u);  // table, left, right and the two custom ones
+  EXPECT_EQ(scene.regions.at("corner").min, Eigen::Vector2d(0.55, 0.2));
+  EXPECT_EQ(scene.regions.at("corner").max, Eigen::Vector2d(0.7, 0.35));
+  EXPECT_EQ(scene.regions.at("strip").min, Eigen::Vector2d(0.3, -0.3));
+  const auto parts = placeParts(scene, classes());
+  ASSERT_EQ(parts.size(), 3u);
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const Region& region = scene.regions.at(i < 2 ? "corner" : "strip");
+    const Eigen::Vector2d xy = parts[i].pose.translation().head<2>();
+    EXPECT_TRUE((xy.array() >= region.min.array()).all() && (xy.array() <= region.max.array()).all())
+        << parts[i].name << " at " << xy.transpose();
+  }
+}
+
+// Issue 10, bug 6: values that were silently accepted (or truncated) are errors naming the field.
+TEST(Scene, BadValuesAreErrorsNamingTheField) {
+  const std::string prefix = "scene 'bad.json': ";
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "count": 4294967297}]})"),
+            prefix + "parts[0].count: must be a whole number from 1 to 100, not 4294967297");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "count": 2.5}]})"),
+            prefix + "parts[0].count: must be a whole number from 1 to 100, not 2.5");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "count": -1}]})"),
+            prefix + "parts[0].count: must be a whole number from 1 to 100, not -1");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "count": "3"}]})"),
+            prefix + "parts[0].count: must be a whole number from 1 to 100, not \"3\"");
+  EXPECT_EQ(problem(R"({"min_gap": -0.01, "parts": []})"), prefix + "min_gap: must be from 0 to 0.5 (m), not -0.01");
+  EXPECT_EQ(problem(R"({"min_gap": "wide", "parts": []})"), prefix + "min_gap: must be a finite number, not \"wide\"");
+  EXPECT_EQ(problem(R"({"seed": -3, "parts": []})").substr(0, prefix.size() + 6), prefix + "seed: ");
+  EXPECT_EQ(problem(R"({"parts": [{"class": 7}]})"), prefix + "parts[0].class: must be a string, not 7");
+  EXPECT_EQ(problem(R"({"parts": [{"colour": "red", "class": "node"}]})"),
+            prefix + "parts[0].colour: unknown field (known: class, color, count, at, region)");
+  EXPECT_EQ(problem(R"({"regoins": {}, "parts": []})"),
+            prefix + "regoins: unknown field (known: description, seed, min_gap, regions, parts)");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5]}]})"),
+            prefix + "parts[0].at: must be [x, y] or [x, y, yaw] (m, m, degrees), not [0.5]");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, null]}]})"),
+            prefix + "parts[0].at[1]: must be a finite number, not null");
+  EXPECT_NE(problem(R"({"parts": [{"class": "node", "at": [9, 0]}]})").find("parts[0].at: lies off the table top"),
+            std::string::npos);
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, 0], "region": "left"}]})"),
+            prefix + "parts[0]: has both \"at\" (a fixed place) and \"region\" (a random place); give one");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, 0], "count": 2}]})"),
+            prefix + "parts[0].count: a part placed with \"at\" must have count 1");
+  EXPECT_EQ(problem(R"({"parts": [{}]})"), prefix + "parts[0].class: missing (the object class, e.g. \"node\")");
+  EXPECT_EQ(problem(R"({"regions": {"a": {"x": [0.6, 0.4], "y": [0, 0.1]}}, "parts": []})"),
+            prefix + "regions.a.x: must be [low, high] with low < high, not [0.6,0.4]");
+  EXPECT_EQ(problem(R"({"regions": {"a": {"x": [0.4, 0.6]}}, "parts": []})").substr(0, prefix.size() + 21),
+            prefix + "regions.a.y: missing ");
+  EXPECT_NE(problem(R"({"regions": {"a": {"x": [0.4, 3], "y": [0, 0.1]}}, "parts": []})")
+                .find("regions.a: lies off the table top"),
+            std::string::npos);
+  EXPECT_EQ(problem(R"({"regions": [], "parts": []})"), prefix + "regions: must be an object {...}, not []");
+  EXPECT_EQ(problem(R"({"parts": []})"), "no error");
+}
+
+TEST(Scene, UnreadableFilesAreNamedAsSuch) {
+  const auto message = [](const std::filesystem::path& file) {
     try {
-      placeParts(parseScene(json, "bad.json"), classes());
+      loadScene(file);
     } catch (const std::runtime_error& e) {
       return std::string(e.what());
     }
     return std::string("no error");
   };
-  EXPECT_EQ(problem(R"({"parts": [{"class": "gear"}]})"), "scene 'bad.json': unknown object class 'gear'");
-  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "region": "moon"}]})"), "scene 'bad.json': unknown region 'moon'");
-  EXPECT_NE(problem(R"({"parts": [{"class": "node", "count": 60, "region": "right"}]})").find("cannot fit"),
-            std::string::npos);
-  EXPECT_NE(problem(R"({"parts": [{"class": "node", "color": "purple"}]})").find("no colour 'purple'"),
-            std::string::npos);
-  EXPECT_NE(problem(R"({"parts": 3})").find("scene 'bad.json'"), std::string::npos);
-  EXPECT_THROW(loadScene("/nonexistent.json"), std::runtime_error);
+  EXPECT_EQ(message("/nonexistent/scene.json"),
+            "cannot read scene file '/nonexistent/scene.json': No such file or directory");
+  const std::filesystem::path folder = std::filesystem::temp_directory_path();
+  EXPECT_EQ(message(folder), "cannot read scene file '" + folder.string() + "': it is a folder");
 }
 
 TEST(Scene, TheSceneFilesInTheRepositoryLoad) {

@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include "bt/plan.h"
 #include "core/paths.h"
@@ -67,6 +69,78 @@ TEST(Trials, BadInputIsRefusedBeforeAnyTrial) {
   options = blind(1, "blind_place");
   options.plan = dataRoot() / "cli/test/fixtures/invalid.xml";
   EXPECT_THROW(runTrials(options), bt::PlanError);
+}
+
+// Issue 10: a time limit of nan, 0 or below failed every trial (nan printed -9223372036.85 s).
+TEST(Trials, NumbersOutOfRangeAreRefusedBeforeAnyTrial) {
+  const auto message = [](const TrialOptions& options) {
+    try {
+      runTrials(options);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  for (const double bad : {-5.0, 0.0, std::nan(""), std::numeric_limits<double>::infinity(), 2e6}) {
+    TrialOptions options = blind(1, "blind_place");
+    options.time_limit_s = bad;
+    EXPECT_EQ(message(options).rfind(
+                  "the time limit must be a number of simulated seconds above 0 and at most 1e+06, not ", 0),
+              0u)
+        << bad;
+  }
+  TrialOptions options = blind(1, "blind_place");
+  options.time_limit_s = std::nan("");
+  EXPECT_EQ(message(options),
+            "the time limit must be a number of simulated seconds above 0 and at most 1e+06, not nan");
+  options = blind(0, "blind_place");
+  EXPECT_EQ(message(options), "the number of trials must be at least 1, not 0");
+  options = blind(1, "blind_place");
+  options.jobs = 0;
+  EXPECT_EQ(message(options), "the number of trials run at once must be at least 1, not 0");
+  options = blind(1, "blind_place");
+  options.settle_s = -1;
+  EXPECT_EQ(message(options), "the settle time must be a number of simulated seconds from 0 to 1e+06, not -1");
+}
+
+// Issue 10: `--plot /nonexistent/p.png` aborted after every trial had run, and `--json` to a
+// folder printed "wrote" and wrote nothing.
+TEST(Trials, OutputFilesAreCheckedBeforehandAndWrittenAfterwards) {
+  const auto message = [](const std::filesystem::path& file) {
+    try {
+      checkOutputFile(file, "--json");
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const auto folder = std::filesystem::temp_directory_path() / "costar_trials_output_test";
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  EXPECT_EQ(message("/nonexistent/p.png"),
+            "cannot write --json '/nonexistent/p.png': there is no folder '/nonexistent'");
+  EXPECT_EQ(message(folder), "cannot write --json '" + folder.string() + "': it is a folder");
+  EXPECT_EQ(message(""), "--json: the file name is empty");
+  EXPECT_EQ(message(folder / "results.json"), "no error");
+  EXPECT_FALSE(std::filesystem::exists(folder / "results.json"));  // checking creates nothing
+  EXPECT_EQ(message("/dev/null"), "no error");
+
+  Summary summary;
+  summary.options = blind(2, "blind_place");
+  summary.trials.resize(2);
+  summary.trials[0].success = true;
+  summary.trials[0].cycle_time_s = 7.5;
+  summary.trials[1].index = 1;
+  summary.trials[1].failure_path = "judge";
+  summary.trials[1].reason = "no node is held";
+  writeJson(summary, folder / "results.json");
+  EXPECT_EQ(nlohmann::json::parse(contents(folder / "results.json")), summary.toJson());
+  // A device is written to, not replaced by a file.
+  writeJson(summary, "/dev/null");
+  EXPECT_TRUE(std::filesystem::is_character_file("/dev/null"));
+  EXPECT_THROW(writeJson(summary, folder / "missing" / "results.json"), std::runtime_error);
+  EXPECT_THROW(writePlot(summary, folder / "missing" / "plot.png"), std::runtime_error);
+  std::filesystem::remove_all(folder);
 }
 
 /// The paper's three UR5 tasks, with perception (DetectObjects on the simulated camera), one
