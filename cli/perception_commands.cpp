@@ -65,7 +65,8 @@ std::vector<camera::RgbdFrame> captureFrames(sim::Simulation& simulation, int co
   std::vector<camera::RgbdFrame> frames;
   for (int i = 0; i < count; ++i) {
     simulation.stepTo(simulation.time() + std::chrono::nanoseconds(33'333'333));
-    frames.push_back(simulation.captureRgbd(seed + static_cast<std::uint64_t>(i)));
+    // Colour only for the last frame: the median filter takes its colour from that one.
+    frames.push_back(simulation.captureRgbd(seed + static_cast<std::uint64_t>(i), i + 1 == count));
   }
   return frames;
 }
@@ -476,6 +477,7 @@ class SwitchableCamera final : public camera::RgbdCamera {
   const camera::Intrinsics& intrinsics() const override { return camera_->intrinsics(); }
   Duration framePeriod() const override { return camera_->framePeriod(); }
   camera::RgbdFrame capture() override { return camera_->capture(); }
+  camera::RgbdFrame captureDepth() override { return camera_->captureDepth(); }
 
  private:
   std::unique_ptr<sim::SimRgbdCamera> camera_;

@@ -200,7 +200,7 @@ int GlRenderer::liveCount() {
   return shared.users;
 }
 
-void GlRenderer::render(const mjModel* model, mjData* data, int camera_id, int width, int height, RgbImage& rgb,
+void GlRenderer::render(const mjModel* model, mjData* data, int camera_id, int width, int height, RgbImage* rgb,
                         std::vector<float>* depth) {
   if (width > render_context_.offWidth || height > render_context_.offHeight || width <= 0 || height <= 0) {
     throw std::runtime_error("cannot render " + std::to_string(width) + "x" + std::to_string(height) +
@@ -213,17 +213,32 @@ void GlRenderer::render(const mjModel* model, mjData* data, int camera_id, int w
   camera.type = mjCAMERA_FIXED;
   camera.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, &perturb_, &camera, mjCAT_ALL, &scene_);
+  // Depth alone: the same surfaces drawn flat, without what only colour needs (shadow maps are
+  // a second render of the scene from the light, reflections a third; the skybox, lighting
+  // and textures). Depth is the same either way.
+  const bool colour = rgb != nullptr;
+  scene_.flags[mjRND_SHADOW] = colour ? 1 : 0;
+  scene_.flags[mjRND_REFLECTION] = colour ? 1 : 0;
+  scene_.flags[mjRND_SKYBOX] = colour ? 1 : 0;
+  scene_.flags[mjRND_SEGMENT] = colour ? 0 : 1;
   const mjrRect viewport{0, 0, width, height};
   mjr_render(viewport, &scene_, &render_context_);
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
-  rgb_buffer_.resize(pixels * 3);
-  depth_buffer_.resize(pixels);
-  mjr_readPixels(rgb_buffer_.data(), depth != nullptr ? depth_buffer_.data() : nullptr, viewport, &render_context_);
+  if (colour) {
+    rgb_buffer_.resize(pixels * 3);
+  }
+  if (depth != nullptr) {
+    depth_buffer_.resize(pixels);
+  }
+  mjr_readPixels(colour ? rgb_buffer_.data() : nullptr, depth != nullptr ? depth_buffer_.data() : nullptr, viewport,
+                 &render_context_);
 
   // OpenGL's rows go bottom-up; images go top-down.
-  rgb = RgbImage(width, height);
-  for (int y = 0; y < height; ++y) {
-    std::copy_n(&rgb_buffer_[static_cast<std::size_t>(height - 1 - y) * width * 3], width * 3, rgb.at(0, y));
+  if (colour) {
+    *rgb = RgbImage(width, height);
+    for (int y = 0; y < height; ++y) {
+      std::copy_n(&rgb_buffer_[static_cast<std::size_t>(height - 1 - y) * width * 3], width * 3, rgb->at(0, y));
+    }
   }
   if (depth != nullptr) {
     // Depth buffer value d -> distance along the optical axis.
@@ -233,10 +248,10 @@ void GlRenderer::render(const mjModel* model, mjData* data, int camera_id, int w
     depth->resize(pixels);
     for (int y = 0; y < height; ++y) {
       const float* row = &depth_buffer_[static_cast<std::size_t>(height - 1 - y) * width];
+      float* out = depth->data() + static_cast<std::size_t>(y) * width;
       for (int x = 0; x < width; ++x) {
         const double d = row[x];
-        (*depth)[static_cast<std::size_t>(y) * width + x] =
-            d >= 1.0 ? 0.0f : static_cast<float>(near / (1.0 - d * (1.0 - near / far)));
+        out[x] = d >= 1.0 ? 0.0f : static_cast<float>(near / (1.0 - d * (1.0 - near / far)));
       }
     }
   }

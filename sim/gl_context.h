@@ -33,9 +33,11 @@ class GlRenderer {
   GlRenderer& operator=(const GlRenderer&) = delete;
 
   /// Renders camera `camera_id` at width x height (at most the model's offscreen size).
-  /// `depth`, if given, receives metric depth along the optical axis, row-major, top row
-  /// first. The image rows are top first too. Not for two threads at once on one renderer.
-  void render(const mjModel* model, mjData* data, int camera_id, int width, int height, RgbImage& rgb,
+  /// `rgb`, if given, receives the colour image; `depth`, if given, metric depth along the
+  /// optical axis, row-major, top row first. The image rows are top first too. Without `rgb`
+  /// only depth is rendered (flat, no shadows: faster, the same depth). Not for two threads at
+  /// once on one renderer.
+  void render(const mjModel* model, mjData* data, int camera_id, int width, int height, RgbImage* rgb,
               std::vector<float>* depth);
 
   /// Renderers alive in this process (tests: the display is terminated when it is 0).

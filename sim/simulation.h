@@ -114,7 +114,9 @@ class Simulation {
   /// Pose of the RGB-D camera's optical frame (x right, y down, z forward) in the world.
   world::Pose rgbdPose() const;
   /// Renders the RGB-D camera now and applies the depth noise model with `noise_seed`.
-  camera::RgbdFrame captureRgbd(std::uint64_t noise_seed);
+  /// Without `colour` the frame's colour image is left empty and only depth is rendered
+  /// (faster; the points are the same).
+  camera::RgbdFrame captureRgbd(std::uint64_t noise_seed, bool colour = true);
   /// Renders a named camera ("rgbd", "overview") at any size up to 1280 x 960.
   RgbImage renderImage(const std::string& camera, int width, int height);
 
