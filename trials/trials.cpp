@@ -308,8 +308,8 @@ std::string Summary::text() const {
   char line[256];
   std::string out;
   if (options.shard_count > 1) {
-    std::snprintf(line, sizeof line, "shard %d/%d (every %d-th of %d trials): ", options.shard_index,
-                  options.shard_count, options.shard_count, options.count);
+    std::snprintf(line, sizeof line, "shard %d/%d (trials %d, %d, ... of %d): ", options.shard_index,
+                  options.shard_count, options.shard_index, options.shard_index + options.shard_count, options.count);
     out += line;
   }
   std::snprintf(line, sizeof line, "%d of %zu trials succeeded (%.1f %%)\n", successes(), trials.size(),
