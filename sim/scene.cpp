@@ -1,5 +1,6 @@
 #include "sim/scene.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -237,13 +238,49 @@ Scene loadScene(const std::filesystem::path& file) {
   return parseScene(text.str(), file.string());
 }
 
+namespace {
+
+/// A part's footprint on the table: the rectangle of its bounding box, turned by its yaw.
+struct Footprint {
+  Eigen::Vector2d centre;
+  Eigen::Vector2d half_size;  // along the part's own x and y
+  double yaw = 0.0;
+
+  Eigen::Matrix2d axes() const { return Eigen::Rotation2Dd(yaw).toRotationMatrix(); }
+};
+
+/// True when the two rectangles, each grown by `gap` / 2 on every side, overlap (separating
+/// axis test over the four edge normals).
+bool closerThan(const Footprint& a, const Footprint& b, double gap) {
+  const Eigen::Matrix2d axes_a = a.axes();
+  const Eigen::Matrix2d axes_b = b.axes();
+  const Eigen::Vector2d half_a = a.half_size.array() + 0.5 * gap;
+  const Eigen::Vector2d half_b = b.half_size.array() + 0.5 * gap;
+  const Eigen::Vector2d between = b.centre - a.centre;
+  for (const Eigen::Matrix2d* axes : {&axes_a, &axes_b}) {
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::Vector2d axis = axes->col(k);
+      const double reach_a =
+          half_a.x() * std::abs(axis.dot(axes_a.col(0))) + half_a.y() * std::abs(axis.dot(axes_a.col(1)));
+      const double reach_b =
+          half_b.x() * std::abs(axis.dot(axes_b.col(0))) + half_b.y() * std::abs(axis.dot(axes_b.col(1)));
+      if (std::abs(between.dot(axis)) >= reach_a + reach_b) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<world::ObjectClass>& classes,
                                       std::optional<std::uint64_t> seed) {
   std::mt19937_64 random(seed.value_or(scene.seed));
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::map<std::string, int> counts;
   std::vector<PartPlacement> placed;
-  std::vector<std::pair<Eigen::Vector2d, double>> footprints;  // centre, radius
+  std::vector<Footprint> footprints;
 
   const auto findClass = [&](const std::string& name, const std::string& field) -> const world::ObjectClass& {
     std::string known;
@@ -261,8 +298,9 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
     const PartRequest& request = scene.parts[r];
     const std::string field = "parts[" + std::to_string(r) + "]";
     const world::ObjectClass& object = findClass(request.object_class, field);
-    const Eigen::Vector3d extent = object.bounds().sizes();
-    const double radius = 0.5 * std::hypot(extent.x(), extent.y());
+    const Eigen::AlignedBox3d bounds = object.bounds();
+    const Eigen::Vector2d half_size = 0.5 * bounds.sizes().head<2>();
+    const Eigen::Vector2d offset = bounds.center().head<2>();  // of the box centre from the part's origin
     for (int i = 0; i < request.count; ++i) {
       PartPlacement part;
       part.object_class = object.name;
@@ -290,13 +328,9 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
           xy = region->second.min +
                (region->second.max - region->second.min).cwiseProduct(Eigen::Vector2d(unit(random), unit(random)));
           yaw = 2.0 * M_PI * unit(random);
-          fits = true;
-          for (const auto& [centre, other_radius] : footprints) {
-            if ((centre - xy).norm() < radius + other_radius + scene.min_gap) {
-              fits = false;
-              break;
-            }
-          }
+          const Footprint candidate{xy + Eigen::Rotation2Dd(yaw) * offset, half_size, yaw};
+          fits = std::none_of(footprints.begin(), footprints.end(),
+                              [&](const Footprint& other) { return closerThan(candidate, other, scene.min_gap); });
         }
         if (!fits) {
           throw std::runtime_error("scene '" + scene.label + "': " + field + ": cannot fit " + part.name +
@@ -305,7 +339,7 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
                                    "min_gap)");
         }
       }
-      footprints.emplace_back(xy, radius);
+      footprints.push_back({xy + Eigen::Rotation2Dd(yaw) * offset, half_size, yaw});
       part.pose = world::poseFromXyzRpy(xy.x(), xy.y(), object.rest_height + 0.0005, 0, 0, yaw);
       placed.push_back(std::move(part));
     }

@@ -74,7 +74,8 @@ struct PartPlacement {
 };
 
 /// Places every requested part resting on the table: fixed ones where asked, random ones
-/// uniformly in their region with a uniform yaw, keeping `min_gap` between footprints.
+/// uniformly in their region with a uniform yaw, keeping `min_gap` between footprints (each
+/// part's bounding rectangle turned by its yaw, so long parts can lie side by side).
 /// Deterministic for a given `seed` (the scene's seed unless overridden).
 /// @throws std::runtime_error for an unknown class, colour or region, or when the parts do
 /// not fit.

@@ -25,6 +25,10 @@ struct TrialOptions {
   double time_limit_s = 600.0;      // simulated seconds per trial
   double settle_s = 2.0;            // simulated after the plan, before judging
   int jobs = 1;                     // trials run at once (threads)
+  /// This run's slice of the trials, for spreading them over machines: trials i with
+  /// i % shard_count == shard_index (trial i keeps seed + i whichever shard runs it).
+  int shard_index = 0;
+  int shard_count = 1;
 };
 
 struct TrialResult {
@@ -40,6 +44,7 @@ struct TrialResult {
 
 struct Summary {
   TrialOptions options;
+  /// The trials this summary holds, by index (a shard holds every shard_count-th).
   std::vector<TrialResult> trials;
   int successes() const;
   /// Failures grouped by node path and reason, numbers masked ("# candidates"), most first.
@@ -48,6 +53,8 @@ struct Summary {
   std::map<std::string, double> cycleTimes() const;
   nlohmann::json toJson() const;
   std::string text() const;
+  /// Reads what toJson wrote. @throws std::runtime_error naming the field and the problem.
+  static Summary fromJson(const nlohmann::json& json);
 };
 
 /// Checks the numbers: count and jobs at least 1, time limit a finite number of seconds above 0
@@ -60,6 +67,11 @@ inline constexpr double kMaxTimeLimitSeconds = 1e6;
 /// is not a folder itself, and it may be written. `what` names it in the error ("--json").
 /// @throws std::invalid_argument naming the file and the problem.
 void checkOutputFile(const std::filesystem::path& file, const std::string& what);
+
+/// Combines shard summaries of one batch (same plan, scene, judge, first seed and count) into
+/// the summary a single run would give. @throws std::runtime_error when they do not belong
+/// together, a trial appears twice, or trials are missing (listing the first missing ones).
+Summary mergeShards(const std::vector<Summary>& shards);
 
 /// Runs the trials; `progress` is called as each one ends (from the trial's thread, one at a
 /// time). @throws std::invalid_argument or std::runtime_error before the first trial when an

@@ -36,6 +36,18 @@ check "nodes json"          0 '"category": "knowledge"' -- "$costar" nodes -w te
 check "help"                0 'Exit code: 0 SUCCESS' -- "$costar" run --help
 check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit 0.1
 
+# Trials spread over machines: shards' JSON results merge into one summary (no simulation here:
+# two hand-written shard files of a 3-trial batch).
+shard_json() {  # shard_json INDEX RESULTS
+  printf '{"plan": "p.xml", "scene": "s.json", "judge": "lift", "seed": 5, "count": 3, "trials": 3, "shard": {"index": %s, "count": 2}, "results": [%s]}' "$1" "$2"
+}
+shard_json 0 '{"index": 0, "seed": 5, "success": true, "cycle_time_s": 6.0}, {"index": 2, "seed": 7, "success": false, "cycle_time_s": 9.0, "failure_path": "main/SmartGrasp", "reason": "no feasible node"}' >"$tmp/s0.json"
+shard_json 1 '{"index": 1, "seed": 6, "success": true, "cycle_time_s": 7.0}' >"$tmp/s1.json"
+check "trials merge"        0 '^2 of 3 trials succeeded' -- "$costar" trials merge "$tmp/s0.json" "$tmp/s1.json" --json "$tmp/merged.json"
+check "trials merge: missing" 2 '1 of 3 trials are missing \(a shard not merged\?\): 1' -- "$costar" trials merge "$tmp/s0.json"
+check "trials merge: twice" 2 'trial 1 appears twice' -- "$costar" trials merge "$tmp/s0.json" "$tmp/s1.json" "$tmp/s1.json"
+check "trials: bad shard"   2 "needs 0 <= I < N" -- "$costar" trials examples/ur5/pick_up_node.xml --judge lift --shard 4/4
+
 # Teaching: jog, teach, move back, rename; waypoints persist in the file.
 printf 'jog z 0.05\nteach up\nhome\nmove up\nrename up lifted\nmove nowhere\nquit\n' |
   "$costar" teach --scene sim/scenes/one_node.json --waypoints "$tmp/waypoints.json" >"$tmp/teach.out" 2>&1

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
+
 #include "core/paths.h"
 
 namespace costar::sim {
@@ -52,6 +55,63 @@ std::string problem(const std::string& json) {
     return e.what();
   }
   return "no error";
+
+/// Corners of a part's footprint (its class's bounding rectangle turned by its yaw).
+std::vector<Eigen::Vector2d> corners(const PartPlacement& part, const world::ObjectClass& object) {
+  const Eigen::AlignedBox3d bounds = object.bounds();
+  std::vector<Eigen::Vector2d> points;
+  for (const auto& corner :
+       {Eigen::Vector2d(-1, -1), Eigen::Vector2d(1, -1), Eigen::Vector2d(1, 1), Eigen::Vector2d(-1, 1)}) {
+    const Eigen::Vector3d local(bounds.center().x() + 0.5 * corner.x() * bounds.sizes().x(),
+                                bounds.center().y() + 0.5 * corner.y() * bounds.sizes().y(), 0.0);
+    points.push_back((part.pose * local).head<2>());
+  }
+  return points;
+}
+
+double pointToSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+  return (a + t * (b - a) - p).norm();
+}
+
+/// Distance between two disjoint convex polygons: the nearest vertex-to-edge pair.
+double polygonDistance(const std::vector<Eigen::Vector2d>& p, const std::vector<Eigen::Vector2d>& q) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int pass = 0; pass < 2; ++pass) {
+    const auto& points = pass == 0 ? p : q;
+    const auto& edges = pass == 0 ? q : p;
+    for (const auto& point : points) {
+      for (std::size_t i = 0; i < edges.size(); ++i) {
+        nearest = std::min(nearest, pointToSegment(point, edges[i], edges[(i + 1) % edges.size()]));
+      }
+    }
+  }
+  return nearest;
+}
+
+TEST(Scene, CrowdedPartsKeepTheGapBetweenTheirFootprintsNotTheirBoundingCircles) {
+  // 8 nodes and 3 links in the right half with 5 mm gaps: too many for bounding circles
+  // (a link's circle is 15 cm across), room enough for the parts' turned rectangles.
+  const Scene scene = parseScene(R"({"seed": 5, "min_gap": 0.005, "parts": [
+      {"class": "link", "count": 3, "region": "right"}, {"class": "node", "count": 8, "region": "right"}]})",
+                                 "test");
+  const auto all = classes();
+  const auto find = [&](const std::string& name) {
+    return *std::find_if(all.begin(), all.end(), [&](const world::ObjectClass& c) { return c.name == name; });
+  };
+  const auto parts = placeParts(scene, all);
+  ASSERT_EQ(parts.size(), 11u);
+  double closest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      const double gap = polygonDistance(corners(parts[i], find(parts[i].object_class)),
+                                         corners(parts[j], find(parts[j].object_class)));
+      EXPECT_GE(gap, 0.005 - 1e-9) << parts[i].name << " and " << parts[j].name;
+      closest = std::min(closest, gap);
+    }
+  }
+  // Crowded indeed: some pair is closer than a finger is thick.
+  EXPECT_LT(closest, 0.02);
 }
 
 TEST(Scene, ProblemsAreNamed) {

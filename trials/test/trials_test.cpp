@@ -141,6 +141,51 @@ TEST(Trials, OutputFilesAreCheckedBeforehandAndWrittenAfterwards) {
   EXPECT_THROW(writeJson(summary, folder / "missing" / "results.json"), std::runtime_error);
   EXPECT_THROW(writePlot(summary, folder / "missing" / "plot.png"), std::runtime_error);
   std::filesystem::remove_all(folder);
+
+TEST(Trials, ShardsRunTheirSliceAndMergeIntoTheWholeBatch) {
+  TrialOptions options = blind(3, "blind_place");
+  options.jobs = 1;
+  options.shard_count = 2;
+  options.shard_index = 1;
+  const Summary odd = runTrials(options);
+  ASSERT_EQ(odd.trials.size(), 1u);
+  EXPECT_EQ(odd.trials[0].index, 1);
+  EXPECT_EQ(odd.trials[0].seed, 6u);  // trial i keeps seed + i whichever shard runs it
+  EXPECT_NE(odd.text().find("shard 1/2"), std::string::npos);
+  options.shard_index = 0;
+  const Summary even = runTrials(options);
+  ASSERT_EQ(even.trials.size(), 2u);
+  EXPECT_EQ(even.trials[1].index, 2);
+
+  // Through JSON files, as a batch scheduler's jobs would hand them over.
+  const Summary merged =
+      mergeShards({Summary::fromJson(nlohmann::json::parse(odd.toJson().dump())), Summary::fromJson(even.toJson())});
+  ASSERT_EQ(merged.trials.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(merged.trials[i].index, i);
+    EXPECT_EQ(merged.trials[i].seed, 5u + i);
+  }
+  EXPECT_EQ(merged.successes(), odd.successes() + even.successes());
+  EXPECT_EQ(merged.toJson().at("shard").at("count"), 1);
+  EXPECT_NE(merged.text().find("of 3 trials succeeded"), std::string::npos);
+
+  // Results that do not add up are refused with the reason.
+  const auto refused = [](const std::vector<Summary>& shards) {
+    try {
+      mergeShards(shards);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("merged");
+  };
+  EXPECT_NE(refused({even}).find("1 of 3 trials are missing (a shard not merged?): 1"), std::string::npos);
+  EXPECT_NE(refused({even, odd, odd}).find("trial 1 appears twice"), std::string::npos);
+  Summary other = odd;
+  other.options.judge = "lift";
+  EXPECT_NE(refused({even, other}).find("another batch: judge 'lift'"), std::string::npos);
+  EXPECT_THROW(Summary::fromJson(nlohmann::json::parse(R"({"plan": "p.xml"})")), std::runtime_error);
+  options.shard_index = 2;
+  EXPECT_THROW(runTrials(options), std::invalid_argument);
 }
 
 /// The paper's three UR5 tasks, with perception (DetectObjects on the simulated camera), one
