@@ -363,6 +363,12 @@ nlohmann::json toJson(const ParamSpec& spec) {
   if (!spec.choices_from.empty()) {
     json["choices_from"] = spec.choices_from;
   }
+  if (!spec.extra_choices.empty()) {
+    json["extra_choices"] = spec.extra_choices;
+  }
+  if (!spec.excludes.empty()) {
+    json["excludes"] = spec.excludes;
+  }
   return json;
 }
 

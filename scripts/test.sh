@@ -73,8 +73,9 @@ if [[ "$FUZZ_RUNS" -gt 0 ]]; then
 fi
 
 # The task editor's page (web/): Vitest unit tests, the production build, then the end-to-end
-# test in Debian's Chromium (headless, driven by playwright-core): the "pick up node" plan
-# built by clicks, saved, run in the simulated cell, judged from the simulator's true state.
+# test in Debian's Chromium (headless, driven by playwright-core): the paper's structure
+# assembly built by clicks and keys (at most 30 UI actions), saved, run in the simulated cell,
+# judged from the simulator's true state; screenshots at 1600x1000 and 1280x800.
 # EDITOR_E2E=0 skips the browser test.
 echo
 echo "test: the editor's page (npm ci, Vitest, vite build)"
@@ -91,7 +92,7 @@ if [[ "${EDITOR_E2E:-1}" != "0" ]]; then
   fi
   echo
   echo "test: the editor end to end in Chromium (artifacts in $BUILD_DIR/test-artifacts)"
-  node web/e2e/pick_up_node.mjs --costar "$BUILD_DIR/cli/costar" --artifacts "$BUILD_DIR/test-artifacts"
+  node web/e2e/assemble_by_clicks.mjs --costar "$BUILD_DIR/cli/costar" --artifacts "$BUILD_DIR/test-artifacts"
 fi
 echo
 echo "test: all passed in $(( $(date +%s) - start )) s"

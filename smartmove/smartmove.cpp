@@ -129,7 +129,9 @@ SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Compon
   predicates.validate = [check = pattern_check_](std::string_view text) {
     return predicator::checkPatternList(text, *check);
   };
-  ParamSpec grasp{"grasp", ValueType::kString, "a grasp taught for the class", std::string("top")};
+  ParamSpec grasp{"grasp", ValueType::kString,
+                  "a grasp taught for the class (default: the first taught for it, e.g. 'top' for a node)",
+                  std::string()};
   grasp.choices_from = "grasp";
   ParamSpec approach{"approach", ValueType::kDouble, "distance of the straight approach and retreat (m)",
                      config_.approach};
@@ -147,15 +149,53 @@ SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Compon
                    "satisfies the predicates",
                    std::string()};
   target.choices_from = "frame";
+  target.extra_choices = {"table"};
+  target.excludes = {"target_class"};
+  target_class.excludes = {"target"};
+  // What would fail at once, caught when the plan is checked (the editor's Check, costar run).
+  const auto check_grasp = [this](const component::ParamMap& params) -> std::string {
+    const std::string& object_class = params.at("object_class").asString();
+    const std::string& name = params.at("grasp").asString();
+    if (name.empty() || grasps_.find(object_class, name)) {
+      return {};
+    }
+    std::string taught;
+    for (const auto& known : grasps_.forClass(object_class)) {
+      taught += (taught.empty() ? "" : ", ") + known.name;
+    }
+    return "no grasp '" + name + "' is taught for class '" + object_class + "'" +
+           (taught.empty() ? std::string(" (none is)") : " (taught: " + taught + ")");
+  };
+  const auto check_release = [](const component::ParamMap& params) -> std::string {
+    const std::string& target_class = params.at("target_class").asString();
+    const std::string& target = params.at("target").asString();
+    if (target_class.empty() && target.empty()) {
+      return "give target_class (put the part on such a part) or target (a frame, or 'table')";
+    }
+    if (!target_class.empty() && !target.empty()) {
+      return "give target_class or target, not both (target '" + target + "' would be ignored)";
+    }
+    if (!target.empty() && target != "table" && !params.at("predicates").asString().empty()) {
+      return "the conditions cannot apply: the part goes to frame '" + target +
+             "' itself (conditions choose among parts with target_class, or spots with target 'table')";
+    }
+    return {};
+  };
   description_.operations = {{"SmartMove",
                               "Moves the tool to the best reachable part that satisfies the conditions.",
-                              {object_class, predicates, grasp, speed}},
+                              {object_class, predicates, grasp, speed},
+                              component::OperationKind::kRobotAction,
+                              check_grasp},
                              {"SmartGrasp",
                               "Picks up the best reachable part that satisfies the conditions.",
-                              {object_class, predicates, grasp, approach, speed}},
+                              {object_class, predicates, grasp, approach, speed},
+                              component::OperationKind::kRobotAction,
+                              check_grasp},
                              {"SmartRelease",
                               "Puts the part held on a part that satisfies the conditions, or at a frame.",
-                              {target_class, predicates, target, approach, speed}},
+                              {target_class, predicates, target, approach, speed},
+                              component::OperationKind::kRobotAction,
+                              check_release},
                              {"TeachGrasp",
                               "Saves how the gripper holds the nearest part of a class as a named grasp.",
                               {object_class, {"grasp", ValueType::kString, "name of the new grasp", {}}},
@@ -377,7 +417,11 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
   if (operation == "SmartMove" || operation == "SmartGrasp") {
     const bool grasping = operation == "SmartGrasp";
     const std::string object_class = text("object_class");
-    const auto grasp = grasps_.find(object_class, text("grasp"));
+    const auto grasp =
+        text("grasp").empty() ? grasps_.defaultFor(object_class) : grasps_.find(object_class, text("grasp"));
+    if (!grasp && text("grasp").empty()) {
+      return failed("no grasp is taught for class '" + object_class + "'");
+    }
     if (!grasp) {
       return failed("no grasp '" + text("grasp") + "' is taught for class '" + object_class + "'");
     }

@@ -55,6 +55,7 @@ std::string problem(const std::string& json) {
     return e.what();
   }
   return "no error";
+}
 
 /// Corners of a part's footprint (its class's bounding rectangle turned by its yaw).
 std::vector<Eigen::Vector2d> corners(const PartPlacement& part, const world::ObjectClass& object) {
