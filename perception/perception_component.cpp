@@ -70,7 +70,14 @@ class DetectObjectsOperation final : public component::RunningOperation {
 
  private:
   void capture() {
-    frames_.push_back(component_.camera_.capture());
+    camera::RgbdFrame frame = component_.camera_.capture();
+    // A camera whose stream stopped hands out its last frame again: its stamp does not advance.
+    const bool stamped = frame.stamp != TimePoint{} || (!frames_.empty() && frames_.back().stamp != TimePoint{});
+    if (stamped && !frames_.empty() && frame.stamp <= frames_.back().stamp && !done_) {
+      done_ = OperationResult::failure("DetectObjects: the camera stopped sending new frames (the frame's stamp did "
+                                       "not advance)");
+    }
+    frames_.push_back(std::move(frame));
     next_capture_ = component_.clock_.now() + component_.camera_.framePeriod();
   }
 

@@ -25,6 +25,9 @@ struct TrialOptions {
   double time_limit_s = 600.0;      // simulated seconds per trial
   double settle_s = 2.0;            // simulated after the plan, before judging
   int jobs = 1;                     // trials run at once (threads)
+  /// Faults to inject in every trial (faults/fault.h grammar); random moments are drawn from
+  /// the trial's seed.
+  std::vector<std::string> inject;
 };
 
 struct TrialResult {

@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 
+#include "faults/injector.h"
 #include "testing/test_components.h"
 #include "workcell/ur5_sim_workcell.h"
 
@@ -50,17 +51,30 @@ class BareWorkcell final : public Workcell {
 /// without a robot) on a simulated clock.
 class TestWorkcell final : public Workcell {
  public:
-  TestWorkcell() : Workcell(std::make_unique<SimClock>()) {
-    components().add(std::make_shared<testing::TestLogger>());
-    components().add(std::make_shared<testing::TestActions>());
-    components().add(std::make_shared<testing::TestCounter>());
-    components().add(std::make_shared<testing::TestArm>());
+  explicit TestWorkcell(std::shared_ptr<faults::Injector> faults = {})
+      : Workcell(std::make_unique<SimClock>()), faults_(std::move(faults)) {
+    if (faults_) {
+      faults_->attach(clock());
+    }
+    const auto add = [this](std::shared_ptr<component::Component> component) {
+      components().add(faults_ ? faults_->wrap(std::move(component)) : std::move(component));
+    };
+    add(std::make_shared<testing::TestLogger>());
+    add(std::make_shared<testing::TestActions>());
+    add(std::make_shared<testing::TestCounter>());
+    add(std::make_shared<testing::TestArm>());
+    if (faults_) {
+      faults_->checkTargets();
+    }
     registerNodes();
   }
   std::string name() const override { return "test"; }
   std::string description() const override {
     return "TEST ONLY: test components (logger, scripted actions, counter, an arm without a robot)";
   }
+
+ private:
+  std::shared_ptr<faults::Injector> faults_;
 };
 
 }  // namespace
@@ -77,9 +91,12 @@ std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& options) {
     return makeUr5SimWorkcell(options);
   }
   if (name == "test") {
-    return std::make_unique<TestWorkcell>();
+    return std::make_unique<TestWorkcell>(options.faults);
   }
   if (name == "none") {
+    if (options.faults) {
+      options.faults->checkTargets();  // it has nothing that can fail
+    }
     return std::make_unique<BareWorkcell>();
   }
   std::string known;

@@ -17,6 +17,9 @@
 namespace costar::sim {
 class Simulation;
 }
+namespace costar::faults {
+class Injector;
+}
 
 namespace costar::workcell {
 
@@ -35,6 +38,9 @@ struct WorkcellOptions {
   /// TEST ONLY: report the simulator's true part poses as object symbols in place of
   /// perception, to test SmartMove apart from perception. Never set by the CLI.
   bool test_oracle_perception = false;
+  /// Faults to inject (faults/injector.h): the cell wraps its drivers and components with
+  /// it. Keep the pointer to read what happened. Null: nothing is broken on purpose.
+  std::shared_ptr<faults::Injector> faults;
 };
 
 class Workcell {
