@@ -75,13 +75,13 @@ FaultTrial runOne(const CampaignOptions& options, const CampaignTask& task, cons
   try {
     auto injector = Injector::fromText({trial.fault}, trial.seed);
     const auto cell = workcell::makeWorkcell(
-        {.name = "ur5-sim",
+        {.name = options.workcell,
          .scene = options.scene.empty() ? dataRoot() / "sim/scenes/assembly.json" : options.scene,
          .seed = trial.seed,
          .waypoints = options.waypoints,
          .memory_only = options.waypoints.empty(),
          .faults = injector});
-    sim::Simulation& simulation = *cell->simulation();
+    sim::Simulation* simulation = cell->simulation();
     auto& clock = dynamic_cast<SimClock&>(cell->clock());
     bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
     bt::Executor executor(tree, cell->clock(), {.time_limit = fromSeconds(options.time_limit_s)});
@@ -99,16 +99,16 @@ FaultTrial runOne(const CampaignOptions& options, const CampaignTask& task, cons
       trial.latency_s = trial.end_s - trial.effect_s;
     }
     // The arm after the run, from the simulator's true state.
-    for (TimePoint t = clock.now(); clock.now() < end + fromSeconds(options.settle_s);) {
+    for (TimePoint t = clock.now(); simulation != nullptr && clock.now() < end + fromSeconds(options.settle_s);) {
       t += std::chrono::milliseconds(10);
       clock.advanceTo(t);
-      if (trial.rest_after_s < 0 && largestSpeed(simulation) < options.rest_speed) {
+      if (trial.rest_after_s < 0 && largestSpeed(*simulation) < options.rest_speed) {
         trial.rest_after_s = toSeconds(clock.now() - end);
-      } else if (largestSpeed(simulation) >= options.rest_speed) {
+      } else if (largestSpeed(*simulation) >= options.rest_speed) {
         trial.rest_after_s = -1;  // moving again
       }
     }
-    trial.final_speed = largestSpeed(simulation);
+    trial.final_speed = simulation != nullptr ? largestSpeed(*simulation) : 0.0;
     if (!options.waypoints.empty()) {
       trial.waypoints_intact = readAll(options.waypoints) == waypoints_before;
       try {
@@ -123,7 +123,12 @@ FaultTrial runOne(const CampaignOptions& options, const CampaignTask& task, cons
     if (timed_out) {
       trial.outcome = "hang";
     } else if (run.status == bt::Status::kSuccess) {
-      trial.outcome = !record.activated ? "not-due" : !record.first_effect ? "no-effect" : "missed";
+      trial.outcome = !record.activated      ? "not-due"
+                      : !record.first_effect ? "no-effect"
+                      : record.spec.kind == FaultKind::kThrow && record.spec.target != "arm-driver" &&
+                              record.spec.target != "gripper-driver" && record.spec.target != "camera"
+                          ? "recovered"
+                          : "missed";
     } else if (!record.first_effect) {
       trial.outcome = "other-failure";
     } else if (trial.failure_path.empty() || trial.reason.empty()) {
@@ -175,9 +180,21 @@ std::vector<std::string> allFaults() {
   return faults;
 }
 
+std::vector<std::string> testCellFaults() {
+  std::vector<std::string> faults;
+  for (const char* component : {"test_logger", "test_actions", "test_counter", "test_arm"}) {
+    for (const char* kind : {"throw", "hang", "die"}) {
+      faults.push_back(std::string(kind) + ":" + component);
+    }
+  }
+  return faults;
+}
+
 CampaignSummary runCampaign(const CampaignOptions& options,
                             const std::function<void(const FaultTrial&, int)>& progress) {
-  const std::vector<std::string> faults = options.faults.empty() ? allFaults() : options.faults;
+  const std::vector<std::string> faults = !options.faults.empty()      ? options.faults
+                                          : options.workcell == "test" ? testCellFaults()
+                                                                       : allFaults();
   for (const std::string& fault : faults) {
     parseFault(fault + "@t=0");  // @throws FaultSpecError for a bad one, before any run
   }

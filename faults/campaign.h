@@ -30,6 +30,8 @@ struct CampaignTask {
 std::vector<CampaignTask> paperTasks();
 
 struct CampaignOptions {
+  /// "ur5-sim", or "test" (components only, no robot: the arm checks are skipped).
+  std::string workcell = "ur5-sim";
   std::vector<CampaignTask> tasks = paperTasks();
   /// Fault specs to cycle through, "KIND:TARGET" (the moment is drawn); default: every kind on
   /// every target of the UR5 cell.
@@ -49,6 +51,8 @@ struct CampaignOptions {
 
 /// Every fault of the UR5 cell: each driver's and component's kinds.
 std::vector<std::string> allFaults();
+/// Every fault of the test cell (its components' kinds).
+std::vector<std::string> testCellFaults();
 
 struct FaultTrial {
   int index = 0;
@@ -59,7 +63,8 @@ struct FaultTrial {
   /// late / not-at-rest / lost-data / no-reason: FAILURE, but a criterion missed;
   /// not-due: the plan ended before the fault's moment; no-effect: due, but the broken
   /// device was not used again and the plan succeeded; missed: the fault took effect and
-  /// the plan still succeeded; hang: the time limit ended the run; error: an exception
+  /// the plan still succeeded; recovered: an operation threw and the plan recovered from
+  /// its FAILURE (a Fallback) and succeeded; hang: the time limit ended the run; error: an exception
   /// escaped; other-failure: the run failed before the fault took effect.
   std::string outcome;
   std::string failure_path;
