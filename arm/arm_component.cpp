@@ -39,8 +39,7 @@ std::string problemWith(const ArmState& state, TimePoint now, Duration timeout) 
     }
   }
   if (state.stamp != TimePoint{} && now - state.stamp > timeout) {
-    return "arm driver: the joint state stopped updating (" + format("%.3f", toSeconds(now - state.stamp)) +
-           " s old)";
+    return "arm driver: the joint state stopped updating (" + format("%.3f", toSeconds(now - state.stamp)) + " s old)";
   }
   return {};
 }

@@ -127,8 +127,9 @@ void ComponentRegistry::registerNodes(bt::NodeRegistry& nodes) {
         spec.ports.push_back(portOf(param));
       }
       spec.build = [this, target, operation](const bt::NodeArgs& args) {
-        return std::make_unique<OperationNode>(operation.name, args.name(), *target, parseParams(operation, args),
-                                               [this] { refreshWorld(); }, [this] { return stop_reason_; });
+        return std::make_unique<OperationNode>(
+            operation.name, args.name(), *target, parseParams(operation, args), [this] { refreshWorld(); },
+            [this] { return stop_reason_; });
       };
       nodes.add(std::move(spec));
     }

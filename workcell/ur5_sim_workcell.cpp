@@ -135,16 +135,16 @@ class Ur5SimWorkcell final : public Workcell {
     auto gripper = std::make_shared<gripper::ParallelGripper>(gripper_driver, clock());
     add(arm);
     add(gripper);
-    add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
-        {"table_center", tableCenter()}, {"robot_base", kBaseInWorld}}));
+    add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{{"table_center", tableCenter()},
+                                                                                       {"robot_base", kBaseInWorld}}));
     if (options.test_oracle_perception) {
       add(std::make_shared<TestOraclePerception>(*simulation_));
     } else {
       // DetectObjects: the camera's frames only, never the simulator's true poses.
       perception::PerceptionConfig perception_config;
       perception_config.table_center = tableCenter();
-      add(std::make_shared<perception::PerceptionComponent>(
-          camera, clock(), threadPipeline(perception_config), perception_config));
+      add(std::make_shared<perception::PerceptionComponent>(camera, clock(), threadPipeline(perception_config),
+                                                            perception_config));
     }
     smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(*arm, *gripper, components().world(), collisions_,
                                                                  simulation_->objectClasses(), grasps_);
