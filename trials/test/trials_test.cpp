@@ -141,6 +141,7 @@ TEST(Trials, OutputFilesAreCheckedBeforehandAndWrittenAfterwards) {
   EXPECT_THROW(writeJson(summary, folder / "missing" / "results.json"), std::runtime_error);
   EXPECT_THROW(writePlot(summary, folder / "missing" / "plot.png"), std::runtime_error);
   std::filesystem::remove_all(folder);
+}
 
 TEST(Trials, ShardsRunTheirSliceAndMergeIntoTheWholeBatch) {
   TrialOptions options = blind(3, "blind_place");
