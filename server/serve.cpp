@@ -100,9 +100,10 @@ int runServe(const ServeOptions& options, std::ostream& out, std::ostream& err) 
   if (!options.token_file.empty()) {
     out << "  token from " << options.token_file.string() << "\n";
   }
-  out << "listening on " << server->url() << "\n" << std::flush;
-  // From here on, a crash stops the arm before the process dies.
+  // From here on, a crash stops the arm before the process dies. Installed before the address
+  // is announced, so that whoever reads it (a person, a test) finds the handlers in place.
   const FatalStop fatal_stop(server->engine());
+  out << "listening on " << server->url() << "\n" << std::flush;
   int signal = 0;
   sigwait(&signals, &signal);
   out << "costar serve: stopping (signal " << signal << ")\n" << std::flush;

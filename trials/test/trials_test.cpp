@@ -220,7 +220,12 @@ INSTANTIATE_TEST_SUITE_P(Ur5, PaperTask,
 /// seed) and the physics buffers' size changes no step, so the robot sees, decides and moves
 /// the same, to the 10 ms tick. A change here means a frame or a physics step differs: find
 /// out why before recording new figures.
-TEST(Trials, TheSameSeedsGiveTheSameAssemblyTrialsAsBeforeTheCameraWasMadeFaster) {
+// Pins the whole trial (scene from the seed, rendering, perception, planning, physics) to values
+// recorded with this build's placement: a change that moves any of it shows here. Recorded first
+// when the camera was made faster (33.63 s, 33.78 s, unchanged by it); re-recorded after oriented part
+// footprints (which change where a seed puts the parts) and per-class grasp defaults were merged
+// (33.83 s, 33.89 s; the same in every run and build since).
+TEST(Trials, TheSameSeedsGiveTheSameAssemblyTrials) {
   TrialOptions options;
   options.plan = dataRoot() / "examples/ur5/assemble_structure.xml";
   options.scene = dataRoot() / "sim/scenes/assembly.json";
@@ -230,7 +235,7 @@ TEST(Trials, TheSameSeedsGiveTheSameAssemblyTrialsAsBeforeTheCameraWasMadeFaster
   options.jobs = 2;
   const Summary summary = runTrials(options);
   ASSERT_EQ(summary.trials.size(), 2u);
-  const double recorded[] = {33.63, 33.78};
+  const double recorded[] = {33.83, 33.89};
   for (std::size_t i = 0; i < 2; ++i) {
     const TrialResult& trial = summary.trials[i];
     EXPECT_TRUE(trial.success) << "seed " << trial.seed << ": " << trial.failure_path << ": " << trial.reason;
