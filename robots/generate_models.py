@@ -15,7 +15,7 @@ Conventions (those of sim/models/ur5_workcell.xml and sim/models/ur5.urdf):
   simulation runs computed-torque control); joint damping 0.5, armature 0.1; a keyframe "home";
   the tool frame is a body with a site of the same name.
 - URDF: capsules become a cylinder and two spheres (the same solid); the tool frame is a link
-  on a fixed joint.
+  on a fixed joint; the base link carries no inertia (KDL does not accept one on the root).
 Bad input stops with a message naming the file, the field and the problem (exit status 1)."""
 import json
 import math
@@ -291,8 +291,10 @@ def write_urdf(robot, path, source):
     for link in robot["links"]:
         ixx, iyy, izz = link["inertia"]
         lines.append(f'  <link name="{link["name"]}">')
-        lines.append(f'    <inertial><origin xyz="{fmt(link["com"])}" rpy="0 0 0"/><mass value="{link["mass"]:.12g}"/>'
-                     f'<inertia ixx="{ixx:.12g}" ixy="0" ixz="0" iyy="{iyy:.12g}" iyz="0" izz="{izz:.12g}"/></inertial>')
+        # The base is fixed to the world: KDL rejects (warns about) an inertia on the root link.
+        if link is not robot["links"][0]:
+            lines.append(f'    <inertial><origin xyz="{fmt(link["com"])}" rpy="0 0 0"/><mass value="{link["mass"]:.12g}"/>'
+                         f'<inertia ixx="{ixx:.12g}" ixy="0" ixz="0" iyy="{iyy:.12g}" iyz="0" izz="{izz:.12g}"/></inertial>')
         for shape in link["collision"]:
             for xyz, rpy, geometry in urdf_shapes(shape):
                 lines.append(f'    <collision><origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/><geometry>{geometry}</geometry></collision>')
