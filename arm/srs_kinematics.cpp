@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 namespace costar::arm {
 
@@ -69,8 +70,34 @@ bool zyz(const Sinusoid& r, double s, double co, int sign, double preferred_firs
   return false;
 }
 
+/// A list of at most N values on the stack (inverseNearest() does not allocate): at most
+/// 6 joints x 2 limits x 2 roots = 24 arm angles per elbow branch, and as many intervals.
+template <typename T, std::size_t N>
+class FixedList {
+ public:
+  void push_back(const T& value) { items_[size_++] = value; }
+  template <typename... Args>
+  void emplace_back(Args&&... args) {
+    items_[size_++] = T{std::forward<Args>(args)...};
+  }
+  void clear() { size_ = 0; }
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  const T& operator[](std::size_t i) const { return items_[i]; }
+  const T& front() const { return items_[0]; }
+  T* begin() { return items_.data(); }
+  T* end() { return items_.data() + size_; }
+  const T* begin() const { return items_.data(); }
+  const T* end() const { return items_.data() + size_; }
+
+ private:
+  std::array<T, N> items_{};
+  std::size_t size_ = 0;
+};
+using Roots = FixedList<double, 32>;
+
 /// Roots psi of a sin(psi) + b cos(psi) + c = 0, appended to `roots`.
-void addRoots(double a, double b, double c, std::vector<double>& roots) {
+void addRoots(double a, double b, double c, Roots& roots) {
   const double r = std::hypot(a, b);
   if (r < 1e-14) {
     return;
@@ -86,8 +113,7 @@ void addRoots(double a, double b, double c, std::vector<double>& roots) {
 }
 
 /// Where the hinge angle atan2(g n, g d) (n, d entries of `r`) crosses `limit` (or limit +/- pi).
-void addHingeRoots(const Sinusoid& r, int ni, int nj, int di, int dj, double d_sign, double limit,
-                   std::vector<double>& roots) {
+void addHingeRoots(const Sinusoid& r, int ni, int nj, int di, int dj, double d_sign, double limit, Roots& roots) {
   const double sl = std::sin(limit);
   const double cl = std::cos(limit);
   addRoots(sl * d_sign * r.a(di, dj) - cl * r.a(ni, nj), sl * d_sign * r.b(di, dj) - cl * r.b(ni, nj),
@@ -509,13 +535,13 @@ std::optional<Joints7> SrsKinematics::inverseNearest(const world::Pose& flange, 
   // 2. Every branch: the feasible arm angles in closed form, nearest to the seed's first.
   std::optional<Joints7> best;
   double best_distance = 0.0;
-  std::vector<double> roots;
-  std::vector<std::pair<double, double>> feasible;  // intervals [begin, end] of psi, end may exceed pi
+  Roots roots;
+  FixedList<std::pair<double, double>, 32> feasible;  // intervals [begin, end] of psi, end may exceed pi
   struct Interval {
     double begin, end;
     unsigned feasible_on;
   };
-  std::vector<Interval> intervals;
+  FixedList<Interval, 32> intervals;
   auto within = [&](double value, int joint) { return hasEquivalentWithin(value, lower_c[joint], upper_c[joint]); };
   for (int k = 0; k < prepared.elbow_branches; ++k) {
     const double psi_seed = psi_seeds[k];
@@ -567,7 +593,7 @@ std::optional<Joints7> SrsKinematics::inverseNearest(const world::Pose& flange, 
         }
       }
       if (feasible_on != 0) {
-        intervals.push_back({begin, end, feasible_on});
+        intervals.push_back(Interval{begin, end, feasible_on});
       }
     }
     for (int sign2 : {1, -1}) {

@@ -375,6 +375,14 @@ TEST(SrsKinematics, AcceptableCallbackChoosesAmongSolutions) {
   EXPECT_GT(calls, 1);
   EXPECT_TRUE(limits.contains(*solution));
   expectSamePose(kinematics.forward(*solution), pose, 1e-9);
+  // Joint 4 (which turns about -y) does not depend on the arm angle: wanting it positive means
+  // the other elbow branch; the callback sees the same angles the caller gets.
+  const auto wants_elbow_positive = [](const Joints7& candidate) { return candidate[3] > 0.0; };
+  const std::optional<Joints7> other_elbow = kinematics.inverseNearest(pose, q, limits, wants_elbow_positive);
+  ASSERT_TRUE(other_elbow.has_value());
+  EXPECT_NEAR((*other_elbow)[3], 70 * kDegree, 1e-9);
+  EXPECT_TRUE(limits.contains(*other_elbow));
+  expectSamePose(kinematics.forward(*other_elbow), pose, 1e-9);
   // A callback that accepts nothing: no solution, not garbage.
   EXPECT_FALSE(kinematics.inverseNearest(pose, q, limits, [](const Joints7&) { return false; }).has_value());
 }
