@@ -293,16 +293,243 @@ SrsArmDescription readSrsArmDescription(const std::filesystem::path& file) {
 // ----------------------------------------------------------------------------------------------
 // Kinematics
 
-/// Everything about one target pose that does not depend on the arm angle.
-struct SrsKinematics::Prepared {
-  Eigen::Vector3d shoulder_to_wrist;
-  // Per elbow branch (q4 > 0, q4 < 0 in canonical angles): q4, and the shoulder rotation
-  // R03(psi) and wrist rotation R47(psi) as sinusoids of psi.
+namespace {
+
+/// Everything about one target pose that does not depend on the arm angle, in canonical angles.
+struct PoseTerms {
+  // Per elbow branch (q4 > 0, q4 < 0): q4, and the shoulder rotation R03(psi) and wrist rotation
+  // R47(psi) as sinusoids of psi. One branch only when the elbow is straight.
   int elbow_branches = 0;
   std::array<double, 2> q4{};
   std::array<Sinusoid, 2> shoulder;
   std::array<Sinusoid, 2> wrist;
 };
+
+/// Shoulder rotation R03 in the reference plane (joint 3 = 0) for the wrist at `shoulder_to_wrist`
+/// with elbow angle q4 (canonical).
+Eigen::Matrix3d referenceShoulder(const Eigen::Vector3d& shoulder_to_wrist, double q4, double upper, double lower) {
+  const double r = std::hypot(shoulder_to_wrist.x(), shoulder_to_wrist.y());
+  const double q1 = r > 1e-12 ? std::atan2(shoulder_to_wrist.y(), shoulder_to_wrist.x()) : 0.0;
+  const double beta = std::atan2(r, shoulder_to_wrist.z());
+  const double phi = std::atan2(lower * std::sin(q4), upper + lower * std::cos(q4));
+  return rotZ(q1) * rotY(beta - phi);
+}
+
+/// The terms of `flange`; false when it is not finite or out of reach.
+bool poseTerms(const SrsGeometry& geometry, const world::Pose& flange_to_wrist, const world::Pose& flange,
+               PoseTerms& terms) {
+  if (!flange.matrix().allFinite()) {
+    return false;
+  }
+  const world::Pose wrist_pose = flange * flange_to_wrist;
+  const Eigen::Matrix3d r07 = wrist_pose.linear();
+  const Eigen::Vector3d shoulder_to_wrist =
+      wrist_pose.translation() - Eigen::Vector3d(0.0, 0.0, geometry.base_to_shoulder);
+  const double upper = geometry.shoulder_to_elbow;
+  const double lower = geometry.elbow_to_wrist;
+  const double distance = shoulder_to_wrist.norm();
+  if (distance > upper + lower + kReachTolerance || distance < std::abs(upper - lower) - kReachTolerance ||
+      distance == 0.0) {
+    return false;
+  }
+  const double elbow =
+      std::acos(clampUnit((distance * distance - upper * upper - lower * lower) / (2.0 * upper * lower)));
+  terms.elbow_branches = elbow < kStraightThreshold ? 1 : 2;
+  const Eigen::Vector3d u = shoulder_to_wrist / distance;
+  const Eigen::Matrix3d ux = skew(u);
+  const Eigen::Matrix3d uut = u * u.transpose();
+  for (int k = 0; k < terms.elbow_branches; ++k) {
+    const double q4 = k == 0 ? elbow : -elbow;
+    terms.q4[k] = q4;
+    // R03(psi) = Rot(u, psi) R03_ref = ux R03_ref sin(psi) - ux^2 R03_ref cos(psi) + u u^T R03_ref.
+    const Eigen::Matrix3d reference = referenceShoulder(shoulder_to_wrist, q4, upper, lower);
+    Sinusoid& shoulder = terms.shoulder[k];
+    shoulder.a = ux * reference;
+    shoulder.b = -ux * ux * reference;
+    shoulder.c = uut * reference;
+    // R47(psi) = R34^T R03(psi)^T R07.
+    const Eigen::Matrix3d r34t = rotY(q4).transpose();
+    Sinusoid& wrist = terms.wrist[k];
+    wrist.a = r34t * shoulder.a.transpose() * r07;
+    wrist.b = r34t * shoulder.b.transpose() * r07;
+    wrist.c = r34t * shoulder.c.transpose() * r07;
+  }
+  return true;
+}
+
+/// One solution in canonical angles on branch (elbow k, sign of q2, sign of q6). Sets the
+/// flags when the shoulder or wrist pair is aligned (the opposite sign gives the same solution).
+Joints7 solveBranch(const PoseTerms& terms, int k, double psi, int sign2, int sign6, const Joints7& preferred,
+                    bool& shoulder_aligned, bool& wrist_aligned) {
+  const double s = std::sin(psi);
+  const double c = std::cos(psi);
+  Joints7 q;
+  shoulder_aligned = zyz(terms.shoulder[k], s, c, sign2, preferred[0], q[0], q[1], q[2]);
+  q[3] = terms.q4[k];
+  wrist_aligned = zyz(terms.wrist[k], s, c, sign6, preferred[4], q[4], q[5], q[6]);
+  return q;
+}
+
+/// An interval [begin, end] of arm angles (end may exceed pi), and the branches on which every
+/// joint is within limits there: bit 2 * (sign2 < 0) + (sign6 < 0).
+struct ArmAngleInterval {
+  double begin = 0.0;
+  double end = 0.0;
+  unsigned feasible_on = 0;
+};
+using Intervals = FixedList<ArmAngleInterval, 32>;
+
+/// inverseNearest()'s search, in canonical angles.
+class NearestSearch {
+ public:
+  NearestSearch(const PoseTerms& terms, const Joints7& seed, const Joints7& lower, const Joints7& upper,
+                const std::function<bool(const Joints7&)>& accept)
+      : terms_(terms), seed_(seed), lower_(lower), upper_(upper), accept_(accept) {}
+
+  /// The seed's arm angle for this pose on elbow branch k: the one at which the shoulder and
+  /// wrist rotations R03 and R47 are nearest the seed's (the largest sum of traces of
+  /// R_seed^T R(psi), a sinusoid of psi). For a seed that solves the pose it is the seed's own
+  /// arm angle; unlike comparing arm-angle values, it does not jump where the reference plane
+  /// turns quickly (the wrist centre near joint 1's axis).
+  double seedArmAngle(int k) const {
+    const Eigen::Matrix3d r03 = rotZ(seed_[0]) * rotY(seed_[1]) * rotZ(seed_[2]);
+    const Eigen::Matrix3d r47 = rotZ(seed_[4]) * rotY(seed_[5]) * rotZ(seed_[6]);
+    const double alpha = r03.cwiseProduct(terms_.shoulder[k].a).sum() + r47.cwiseProduct(terms_.wrist[k].a).sum();
+    const double beta = r03.cwiseProduct(terms_.shoulder[k].b).sum() + r47.cwiseProduct(terms_.wrist[k].b).sum();
+    return std::atan2(alpha, beta);
+  }
+
+  /// The solution on a branch at `psi`, mapped into the limits near the seed; false when a joint
+  /// cannot be, or the caller does not accept it.
+  bool solve(int k, int sign2, int sign6, double psi, Joints7& out) const {
+    bool shoulder_aligned = false;
+    bool wrist_aligned = false;
+    const Joints7 q = solveBranch(terms_, k, psi, sign2, sign6, seed_, shoulder_aligned, wrist_aligned);
+    for (int i = 0; i < 7; ++i) {
+      if (!intoLimits(q[i], seed_[i], lower_[i], upper_[i], out[i])) {
+        return false;
+      }
+    }
+    return accept_(out);
+  }
+
+  /// The arm angles of elbow branch k at which joints 1-3 and 5-7 are within limits, found from
+  /// the angles at which each meets a limit (each joint angle is a sinusoid, or the arctangent
+  /// of a ratio of sinusoids, of psi).
+  void feasibleIntervals(int k, Intervals& intervals) const {
+    const Sinusoid& sh = terms_.shoulder[k];
+    const Sinusoid& wr = terms_.wrist[k];
+    Roots roots;
+    for (double limit : {lower_[0], upper_[0]}) addHingeRoots(sh, 1, 2, 0, 2, 1.0, limit, roots);
+    for (double limit : {lower_[2], upper_[2]}) addHingeRoots(sh, 2, 1, 2, 0, -1.0, limit, roots);
+    for (double limit : {lower_[4], upper_[4]}) addHingeRoots(wr, 1, 2, 0, 2, 1.0, limit, roots);
+    for (double limit : {lower_[6], upper_[6]}) addHingeRoots(wr, 2, 1, 2, 0, -1.0, limit, roots);
+    for (double limit : {lower_[1], upper_[1]}) addRoots(sh.a(2, 2), sh.b(2, 2), sh.c(2, 2) - std::cos(limit), roots);
+    for (double limit : {lower_[5], upper_[5]}) addRoots(wr.a(2, 2), wr.b(2, 2), wr.c(2, 2) - std::cos(limit), roots);
+    std::sort(roots.begin(), roots.end());
+    if (roots.empty()) {
+      roots.push_back(-kPi);  // the whole circle, one interval
+    }
+    // Feasibility is constant between consecutive roots: test each interval's middle, the
+    // shoulder (joints 1-3, by the sign of joint 2) apart from the wrist (joints 5-7, by the
+    // sign of joint 6).
+    intervals.clear();
+    for (std::size_t i = 0; i < roots.size(); ++i) {
+      const double begin = roots[i];
+      const double end = i + 1 < roots.size() ? roots[i + 1] : roots.front() + kTwoPi;
+      if (end - begin < 1e-12) {
+        continue;
+      }
+      const double middle = 0.5 * (begin + end);
+      const double s = std::sin(middle);
+      const double c = std::cos(middle);
+      unsigned shoulder_ok = 0;
+      unsigned wrist_ok = 0;
+      for (unsigned b = 0; b < 2; ++b) {
+        const int sign = b == 0 ? 1 : -1;
+        double first = 0.0, middle_angle = 0.0, last = 0.0;
+        zyz(sh, s, c, sign, seed_[0], first, middle_angle, last);
+        if (within(first, 0) && within(middle_angle, 1) && within(last, 2)) shoulder_ok |= 1u << b;
+        zyz(wr, s, c, sign, seed_[4], first, middle_angle, last);
+        if (within(first, 4) && within(middle_angle, 5) && within(last, 6)) wrist_ok |= 1u << b;
+      }
+      unsigned feasible_on = 0;
+      for (unsigned b2 = 0; b2 < 2; ++b2) {
+        for (unsigned b6 = 0; b6 < 2; ++b6) {
+          if ((shoulder_ok >> b2 & 1u) && (wrist_ok >> b6 & 1u)) feasible_on |= 1u << (2 * b2 + b6);
+        }
+      }
+      if (feasible_on != 0) {
+        intervals.push_back(ArmAngleInterval{begin, end, feasible_on});
+      }
+    }
+  }
+
+  /// On one branch: the feasible arm angle nearest `psi_seed`, then (if the caller rejects that
+  /// solution) feasible arm angles in widening steps around it.
+  bool nearestOnBranch(int k, int sign2, int sign6, double psi_seed, const Intervals& intervals, Joints7& out) const {
+    const unsigned bit = 1u << (2 * (sign2 < 0) + (sign6 < 0));
+    double psi_best = 0.0;
+    double middle_best = 0.0;
+    double gap_best = kTwoPi + 1.0;
+    for (const ArmAngleInterval& interval : intervals) {
+      if (!(interval.feasible_on & bit)) {
+        continue;
+      }
+      const double width = interval.end - interval.begin;
+      const double margin = std::min(1e-6, 0.5 * width);
+      double offset = wrap(psi_seed - interval.begin);  // where the seed's angle lies from the start
+      if (offset < 0.0) offset += kTwoPi;
+      double psi = 0.0;
+      double gap = 0.0;
+      if (offset <= width) {
+        psi = interval.begin + std::clamp(offset, margin, width - margin);
+      } else {
+        const double to_end = offset - width;
+        const double to_begin = kTwoPi - offset;
+        psi = to_end < to_begin ? interval.end - margin : interval.begin + margin;
+        gap = std::min(to_end, to_begin);
+      }
+      if (gap < gap_best) {
+        gap_best = gap;
+        psi_best = psi;
+        middle_best = 0.5 * (interval.begin + interval.end);
+      }
+    }
+    if (gap_best > kTwoPi) {
+      return false;  // no feasible arm angle on this branch
+    }
+    // The nearest arm angle, or (should rounding put it a hair outside) its interval's middle.
+    if (solve(k, sign2, sign6, psi_best, out) || solve(k, sign2, sign6, middle_best, out)) {
+      return true;
+    }
+    for (int step = 1; step * kSweepStep <= kPi; ++step) {
+      for (int direction : {1, -1}) {
+        const double psi = wrap(psi_best + direction * step * kSweepStep);
+        const bool inside = std::any_of(intervals.begin(), intervals.end(), [&](const ArmAngleInterval& interval) {
+          double offset = wrap(psi - interval.begin);
+          if (offset < 0.0) offset += kTwoPi;
+          return (interval.feasible_on & bit) && offset <= interval.end - interval.begin;
+        });
+        if (inside && solve(k, sign2, sign6, psi, out)) {
+          return true;
+        }
+      }
+    }
+    return false;
+  }
+
+ private:
+  bool within(double value, int joint) const { return hasEquivalentWithin(value, lower_[joint], upper_[joint]); }
+
+  const PoseTerms& terms_;
+  const Joints7& seed_;
+  const Joints7& lower_;
+  const Joints7& upper_;
+  const std::function<bool(const Joints7&)>& accept_;
+};
+
+}  // namespace
 
 SrsKinematics::SrsKinematics(SrsGeometry geometry) : geometry_(geometry) {
   for (double length : {geometry_.base_to_shoulder, geometry_.shoulder_to_elbow, geometry_.elbow_to_wrist}) {
@@ -348,20 +575,6 @@ world::Pose SrsKinematics::forward(const Joints7& q_real) const {
   return pose * geometry_.wrist_to_flange;
 }
 
-namespace {
-
-/// Shoulder rotation R03 in the reference plane (joint 3 = 0) for the wrist at `shoulder_to_wrist`
-/// with elbow angle q4 (canonical).
-Eigen::Matrix3d referenceShoulder(const Eigen::Vector3d& shoulder_to_wrist, double q4, double upper, double lower) {
-  const double r = std::hypot(shoulder_to_wrist.x(), shoulder_to_wrist.y());
-  const double q1 = r > 1e-12 ? std::atan2(shoulder_to_wrist.y(), shoulder_to_wrist.x()) : 0.0;
-  const double beta = std::atan2(r, shoulder_to_wrist.z());
-  const double phi = std::atan2(lower * std::sin(q4), upper + lower * std::cos(q4));
-  return rotZ(q1) * rotY(beta - phi);
-}
-
-}  // namespace
-
 double SrsKinematics::armAngle(const Joints7& q_real) const {
   const Joints7 q = toCanonical(q_real);
   const Eigen::Matrix3d r02 = rotZ(q[0]) * rotY(q[1]);
@@ -377,79 +590,21 @@ double SrsKinematics::armAngle(const Joints7& q_real) const {
   return std::atan2(0.5 * u.dot(vee), 0.5 * (m.trace() - 1.0));
 }
 
-bool SrsKinematics::prepare(const world::Pose& flange, Prepared& prepared) const {
-  if (!flange.matrix().allFinite()) {
-    return false;
-  }
-  const world::Pose wrist_pose = flange * flange_to_wrist_;
-  const Eigen::Matrix3d r07 = wrist_pose.linear();
-  const Eigen::Vector3d shoulder_to_wrist =
-      wrist_pose.translation() - Eigen::Vector3d(0.0, 0.0, geometry_.base_to_shoulder);
-  const double upper = geometry_.shoulder_to_elbow;
-  const double lower = geometry_.elbow_to_wrist;
-  const double distance = shoulder_to_wrist.norm();
-  if (distance > upper + lower + kReachTolerance || distance < std::abs(upper - lower) - kReachTolerance ||
-      distance == 0.0) {
-    return false;
-  }
-  const double elbow =
-      std::acos(clampUnit((distance * distance - upper * upper - lower * lower) / (2.0 * upper * lower)));
-  prepared.shoulder_to_wrist = shoulder_to_wrist;
-  prepared.elbow_branches = elbow < kStraightThreshold ? 1 : 2;
-  const Eigen::Vector3d u = shoulder_to_wrist / distance;
-  const Eigen::Matrix3d ux = skew(u);
-  const Eigen::Matrix3d uut = u * u.transpose();
-  for (int k = 0; k < prepared.elbow_branches; ++k) {
-    const double q4 = k == 0 ? elbow : -elbow;
-    prepared.q4[k] = q4;
-    // R03(psi) = Rot(u, psi) R03_ref = ux R03_ref sin(psi) - ux^2 R03_ref cos(psi) + u u^T R03_ref.
-    const Eigen::Matrix3d reference = referenceShoulder(shoulder_to_wrist, q4, upper, lower);
-    Sinusoid& shoulder = prepared.shoulder[k];
-    shoulder.a = ux * reference;
-    shoulder.b = -ux * ux * reference;
-    shoulder.c = uut * reference;
-    // R47(psi) = R34^T R03(psi)^T R07.
-    const Eigen::Matrix3d r34t = rotY(q4).transpose();
-    Sinusoid& wrist = prepared.wrist[k];
-    wrist.a = r34t * shoulder.a.transpose() * r07;
-    wrist.b = r34t * shoulder.b.transpose() * r07;
-    wrist.c = r34t * shoulder.c.transpose() * r07;
-  }
-  return true;
-}
-
-namespace {
-
-/// One solution in canonical angles on branch (elbow k, sign of q2, sign of q6). Sets the
-/// flags when the shoulder or wrist pair is aligned (the opposite sign gives the same solution).
-Joints7 solveBranch(const Sinusoid& shoulder, const Sinusoid& wrist, double q4, double psi, int sign2, int sign6,
-                    const Joints7& preferred, bool& shoulder_aligned, bool& wrist_aligned) {
-  const double s = std::sin(psi);
-  const double c = std::cos(psi);
-  Joints7 q;
-  shoulder_aligned = zyz(shoulder, s, c, sign2, preferred[0], q[0], q[1], q[2]);
-  q[3] = q4;
-  wrist_aligned = zyz(wrist, s, c, sign6, preferred[4], q[4], q[5], q[6]);
-  return q;
-}
-
-}  // namespace
-
 int SrsKinematics::inverse(const world::Pose& flange, double psi, std::array<Joints7, kMaxSolutions>& solutions,
                            const Joints7& preferred) const {
-  Prepared prepared;
-  if (!std::isfinite(psi) || !prepare(flange, prepared)) {
+  PoseTerms terms;
+  if (!std::isfinite(psi) || !poseTerms(geometry_, flange_to_wrist_, flange, terms)) {
     return 0;
   }
   const Joints7 preferred_canonical = toCanonical(preferred);
   int count = 0;
-  for (int k = 0; k < prepared.elbow_branches; ++k) {
+  for (int k = 0; k < terms.elbow_branches; ++k) {
     for (int sign2 : {1, -1}) {
       for (int sign6 : {1, -1}) {
         bool shoulder_aligned = false;
         bool wrist_aligned = false;
-        const Joints7 q = solveBranch(prepared.shoulder[k], prepared.wrist[k], prepared.q4[k], psi, sign2, sign6,
-                                      preferred_canonical, shoulder_aligned, wrist_aligned);
+        const Joints7 q =
+            solveBranch(terms, k, psi, sign2, sign6, preferred_canonical, shoulder_aligned, wrist_aligned);
         // A merged branch is returned once, from its positive side.
         if ((shoulder_aligned && sign2 < 0) || (wrist_aligned && sign6 < 0)) {
           continue;
@@ -476,11 +631,11 @@ std::optional<Joints7> SrsKinematics::inverseNearest(const world::Pose& flange, 
   if (!seed.allFinite()) {
     throw std::invalid_argument("SrsKinematics::inverseNearest: the seed has a non-finite joint angle");
   }
-  Prepared prepared;
-  if (!prepare(flange, prepared)) {
+  PoseTerms terms;
+  if (!poseTerms(geometry_, flange_to_wrist_, flange, terms)) {
     return std::nullopt;
   }
-  // Work in canonical angles: limits, seed.
+  // Work in canonical angles: seed, limits, and what the caller's predicate sees.
   const Joints7 seed_c = toCanonical(seed);
   Joints7 lower_c;
   Joints7 upper_c;
@@ -489,169 +644,34 @@ std::optional<Joints7> SrsKinematics::inverseNearest(const world::Pose& flange, 
     lower_c[i] = positive ? limits.lower[i] : -limits.upper[i];
     upper_c[i] = positive ? limits.upper[i] : -limits.lower[i];
   }
-  // A canonical solution mapped into the limits near the seed; false when a joint cannot be.
-  auto withinLimits = [&](const Joints7& q, Joints7& out) {
-    for (int i = 0; i < 7; ++i) {
-      if (!intoLimits(q[i], seed_c[i], lower_c[i], upper_c[i], out[i])) {
-        return false;
-      }
-    }
-    return true;
+  const std::function<bool(const Joints7&)> accept = [&](const Joints7& canonical) {
+    return !acceptable || acceptable(toReal(canonical));
   };
-  auto solve = [&](int k, int sign2, int sign6, double psi, Joints7& out) {
-    bool shoulder_aligned = false;
-    bool wrist_aligned = false;
-    const Joints7 q = solveBranch(prepared.shoulder[k], prepared.wrist[k], prepared.q4[k], psi, sign2, sign6, seed_c,
-                                  shoulder_aligned, wrist_aligned);
-    return withinLimits(q, out);
-  };
-  auto accept = [&](const Joints7& canonical) { return !acceptable || acceptable(toReal(canonical)); };
-
-  // The seed's arm angle for this pose, per elbow branch: the one at which the shoulder and wrist
-  // rotations R03 and R47 are nearest the seed's (the largest sum of traces of R_seed^T R(psi),
-  // a sinusoid of psi). For a seed that solves the pose it is the seed's own arm angle; unlike
-  // comparing arm-angle values, it does not jump where the reference plane turns quickly (the
-  // wrist centre near joint 1's axis).
-  const Eigen::Matrix3d r03_seed = rotZ(seed_c[0]) * rotY(seed_c[1]) * rotZ(seed_c[2]);
-  const Eigen::Matrix3d r47_seed = rotZ(seed_c[4]) * rotY(seed_c[5]) * rotZ(seed_c[6]);
-  std::array<double, 2> psi_seeds{};
-  for (int k = 0; k < prepared.elbow_branches; ++k) {
-    const double alpha =
-        r03_seed.cwiseProduct(prepared.shoulder[k].a).sum() + r47_seed.cwiseProduct(prepared.wrist[k].a).sum();
-    const double beta =
-        r03_seed.cwiseProduct(prepared.shoulder[k].b).sum() + r47_seed.cwiseProduct(prepared.wrist[k].b).sum();
-    psi_seeds[k] = std::atan2(alpha, beta);
-  }
+  const NearestSearch search(terms, seed_c, lower_c, upper_c, accept);
 
   // 1. The seed's branch at the seed's arm angle.
-  const int seed_elbow = prepared.elbow_branches == 2 && seed_c[3] < 0.0 ? 1 : 0;
+  const int seed_elbow = terms.elbow_branches == 2 && seed_c[3] < 0.0 ? 1 : 0;
   const int seed_sign2 = seed_c[1] < 0.0 ? -1 : 1;
   const int seed_sign6 = seed_c[5] < 0.0 ? -1 : 1;
   Joints7 candidate;
-  if (solve(seed_elbow, seed_sign2, seed_sign6, psi_seeds[seed_elbow], candidate) && accept(candidate)) {
+  if (search.solve(seed_elbow, seed_sign2, seed_sign6, search.seedArmAngle(seed_elbow), candidate)) {
     return toReal(candidate);
   }
 
-  // 2. Every branch: the feasible arm angles in closed form, nearest to the seed's first.
+  // 2. Every branch at its feasible arm angle nearest the seed's; the nearest solution wins.
   std::optional<Joints7> best;
   double best_distance = 0.0;
-  Roots roots;
-  FixedList<std::pair<double, double>, 32> feasible;  // intervals [begin, end] of psi, end may exceed pi
-  struct Interval {
-    double begin, end;
-    unsigned feasible_on;
-  };
-  FixedList<Interval, 32> intervals;
-  auto within = [&](double value, int joint) { return hasEquivalentWithin(value, lower_c[joint], upper_c[joint]); };
-  for (int k = 0; k < prepared.elbow_branches; ++k) {
-    const double psi_seed = psi_seeds[k];
-    const Sinusoid& sh = prepared.shoulder[k];
-    const Sinusoid& wr = prepared.wrist[k];
+  Intervals intervals;
+  for (int k = 0; k < terms.elbow_branches; ++k) {
     double q4_within = 0.0;
-    if (!intoLimits(prepared.q4[k], seed_c[3], lower_c[3], upper_c[3], q4_within)) {
+    if (!intoLimits(terms.q4[k], seed_c[3], lower_c[3], upper_c[3], q4_within)) {
       continue;  // joint 4 does not depend on the arm angle
     }
-    // Arm angles at which a joint meets one of its limits.
-    roots.clear();
-    for (double limit : {lower_c[0], upper_c[0]}) addHingeRoots(sh, 1, 2, 0, 2, 1.0, limit, roots);
-    for (double limit : {lower_c[2], upper_c[2]}) addHingeRoots(sh, 2, 1, 2, 0, -1.0, limit, roots);
-    for (double limit : {lower_c[4], upper_c[4]}) addHingeRoots(wr, 1, 2, 0, 2, 1.0, limit, roots);
-    for (double limit : {lower_c[6], upper_c[6]}) addHingeRoots(wr, 2, 1, 2, 0, -1.0, limit, roots);
-    for (double limit : {lower_c[1], upper_c[1]}) addRoots(sh.a(2, 2), sh.b(2, 2), sh.c(2, 2) - std::cos(limit), roots);
-    for (double limit : {lower_c[5], upper_c[5]}) addRoots(wr.a(2, 2), wr.b(2, 2), wr.c(2, 2) - std::cos(limit), roots);
-    std::sort(roots.begin(), roots.end());
-    if (roots.empty()) {
-      roots.push_back(-kPi);
-    }
-    // Feasibility is constant between consecutive roots: test each interval's middle, the
-    // shoulder (joints 1-3, by the sign of joint 2) apart from the wrist (joints 5-7, by the
-    // sign of joint 6). Bit 2 * (sign2 < 0) + (sign6 < 0) of `feasible_on` marks the branches.
-    intervals.clear();
-    for (std::size_t i = 0; i < roots.size(); ++i) {
-      const double begin = roots[i];
-      const double end = i + 1 < roots.size() ? roots[i + 1] : roots.front() + kTwoPi;
-      if (end - begin < 1e-12) {
-        continue;
-      }
-      const double middle = 0.5 * (begin + end);
-      const double s = std::sin(middle);
-      const double c = std::cos(middle);
-      unsigned shoulder_ok = 0;
-      unsigned wrist_ok = 0;
-      for (int b = 0; b < 2; ++b) {
-        const int sign = b == 0 ? 1 : -1;
-        double a0 = 0.0, a1 = 0.0, a2 = 0.0;
-        zyz(sh, s, c, sign, seed_c[0], a0, a1, a2);
-        if (within(a0, 0) && within(a1, 1) && within(a2, 2)) shoulder_ok |= 1u << b;
-        zyz(wr, s, c, sign, seed_c[4], a0, a1, a2);
-        if (within(a0, 4) && within(a1, 5) && within(a2, 6)) wrist_ok |= 1u << b;
-      }
-      unsigned feasible_on = 0;
-      for (int b2 = 0; b2 < 2; ++b2) {
-        for (int b6 = 0; b6 < 2; ++b6) {
-          if ((shoulder_ok >> b2 & 1u) && (wrist_ok >> b6 & 1u)) feasible_on |= 1u << (2 * b2 + b6);
-        }
-      }
-      if (feasible_on != 0) {
-        intervals.push_back(Interval{begin, end, feasible_on});
-      }
-    }
+    search.feasibleIntervals(k, intervals);
+    const double psi_seed = search.seedArmAngle(k);
     for (int sign2 : {1, -1}) {
       for (int sign6 : {1, -1}) {
-        const unsigned bit = 1u << (2 * (sign2 < 0) + (sign6 < 0));
-        feasible.clear();
-        for (const Interval& interval : intervals) {
-          if (interval.feasible_on & bit) feasible.emplace_back(interval.begin, interval.end);
-        }
-        if (feasible.empty()) {
-          continue;
-        }
-        // Arm angles to try, in order of distance from the seed's: the nearest feasible one,
-        // then a sweep through the feasible intervals.
-        auto nearestIn = [&](const std::pair<double, double>& interval, double& psi) {
-          const double margin = std::min(1e-6, 0.5 * (interval.second - interval.first));
-          const double width = interval.second - interval.first;
-          double offset = wrap(psi_seed - interval.first);
-          if (offset < 0.0) offset += kTwoPi;
-          if (offset <= width) {
-            psi = interval.first + std::clamp(offset, margin, width - margin);
-            return 0.0;
-          }
-          const double to_end = offset - width;
-          const double to_begin = kTwoPi - offset;
-          psi = to_end < to_begin ? interval.second - margin : interval.first + margin;
-          return std::min(to_end, to_begin);
-        };
-        double psi_best = 0.0;
-        double gap_best = kTwoPi;
-        double middle_best = 0.0;
-        for (const auto& interval : feasible) {
-          double psi = 0.0;
-          const double gap = nearestIn(interval, psi);
-          if (gap < gap_best) {
-            gap_best = gap;
-            psi_best = psi;
-            middle_best = 0.5 * (interval.first + interval.second);
-          }
-        }
-        // The nearest arm angle, or (should rounding put it a hair outside) its interval's middle.
-        bool found = (solve(k, sign2, sign6, psi_best, candidate) || solve(k, sign2, sign6, middle_best, candidate)) &&
-                     accept(candidate);
-        for (int step = 1; !found && step * kSweepStep <= kPi; ++step) {
-          for (int direction : {1, -1}) {
-            const double psi = wrap(psi_best + direction * step * kSweepStep);
-            const bool inside = std::any_of(feasible.begin(), feasible.end(), [&](const auto& interval) {
-              double offset = wrap(psi - interval.first);
-              if (offset < 0.0) offset += kTwoPi;
-              return offset <= interval.second - interval.first;
-            });
-            if (inside && solve(k, sign2, sign6, psi, candidate) && accept(candidate)) {
-              found = true;
-              break;
-            }
-          }
-        }
-        if (!found) {
+        if (!search.nearestOnBranch(k, sign2, sign6, psi_seed, intervals, candidate)) {
           continue;
         }
         const double distance = (candidate - seed_c).squaredNorm();

@@ -139,8 +139,6 @@ class SrsKinematics {
                                         const Acceptable& acceptable = {}) const;
 
  private:
-  struct Prepared;
-  bool prepare(const world::Pose& flange, Prepared& prepared) const;
   Joints7 toReal(const Joints7& canonical) const;
   Joints7 toCanonical(const Joints7& real) const;
 
