@@ -133,7 +133,8 @@ class SrsKinematics {
   ///    feasible ranges in steps of 2 degrees until `acceptable` agrees; of those, the solution
   ///    nearest the seed (Euclidean distance in joint space).
   /// Returns nullopt when the pose is unreachable, has no solution within limits, or none that is
-  /// acceptable. Each joint is the 2*pi-equivalent within limits closest to the seed's.
+  /// acceptable. Each joint is the 2*pi-equivalent within limits closest to the seed's. Does not
+  /// allocate (beyond what `acceptable` does). Precondition: `flange.linear()` is a rotation.
   /// @throws std::invalid_argument when `seed` has a non-finite entry.
   std::optional<Joints7> inverseNearest(const world::Pose& flange, const Joints7& seed, const SrsLimits& limits,
                                         const Acceptable& acceptable = {}) const;
