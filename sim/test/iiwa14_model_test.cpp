@@ -135,6 +135,7 @@ TEST_F(Iiwa14Model, ForwardKinematicsAgreesWithKdlAndTheAnalyticSolver) {
   EXPECT_LT(worst_position, 1e-4);         // 0.1 mm, the requirement; in fact ~1e-15 m
   EXPECT_LT(worst_angle, 0.01 * kDegree);  // 0.01 degree
   EXPECT_LT(worst_position, 1e-12);        // the same numbers, so rounding only
+  EXPECT_LT(worst_angle, 1e-9);
   EXPECT_LT(worst_analytic, 1e-12);
 }
 
