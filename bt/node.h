@@ -64,6 +64,7 @@ class TreeContext {
 
   void addObserver(TreeObserver* observer);
   void removeObserver(TreeObserver* observer);
+  void removeAllObservers() { observers_.clear(); }
   bool observed() const { return !observers_.empty(); }
   void notify(const TreeNode& node, Status from, Status to);
 

@@ -27,7 +27,11 @@ Tree::Tree(std::string main_tree_id, std::vector<std::unique_ptr<TreeNode>> node
 }
 
 Tree::~Tree() {
-  // Stop running operations before the nodes that hold them go away.
+  // Stop running operations before the nodes that hold them go away. Observers hear nothing of
+  // it: a tree is often destroyed after them (the halts of a run are reported by halt()).
+  if (context_ != nullptr) {  // null when moved from
+    context_->removeAllObservers();
+  }
   if (root_ != nullptr && owned_.size() > 0) {
     root_->halt();
   }
