@@ -13,21 +13,13 @@ using component::ValueType;
 namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
-constexpr const char* kJointNames[kJointCount] = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
+constexpr const char* kJointNames[] = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
                                                   "wrist_1_joint",      "wrist_2_joint",       "wrist_3_joint"};
 
 std::string format(const char* pattern, double value) {
   char text[96];
   std::snprintf(text, sizeof text, pattern, value);
   return text;
-}
-
-double maxAbs(const JointVector& a, const JointVector& b) {
-  double largest = 0.0;
-  for (int j = 0; j < kJointCount; ++j) {
-    largest = std::max(largest, std::abs(a[j] - b[j]));
-  }
-  return largest;
 }
 
 /// A motion being executed by the driver.
@@ -56,8 +48,8 @@ class MotionOperation final : public component::RunningOperation {
       return OperationResult::running();
     }
     const ArmState state = driver_.read();
-    const double error = maxAbs(state.position, plan_.goal);
-    const double speed = maxAbs(state.velocity, JointVector{});
+    const double error = maxAbsDifference(state.position, plan_.goal);
+    const double speed = maxAbs(state.velocity);
     if (error < config_.arrival_tolerance && speed < 0.05) {
       return OperationResult::success({{"duration", toSeconds(plan_.trajectory->duration())}});
     }
@@ -124,9 +116,12 @@ ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::Coll
                  {"pose", "joints"}};
   ParamSpec axis_frame{
       "frame", ValueType::kString, "axes of the offset: world or tool", std::string("world"), {"world", "tool"}};
-  ParamSpec joint{"joint", ValueType::kInt, "joint number, 1 (base) to 6 (wrist 3)", {}};
+  const int joint_count = config_.limits.size();
+  ParamSpec joint{"joint", ValueType::kInt,
+                  "joint number, 1 (base) to " + std::to_string(joint_count) + (joint_count == 6 ? " (wrist 3)" : ""),
+                  {}};
   joint.min = 1;
-  joint.max = 6;
+  joint.max = joint_count;
   ParamSpec degrees{"degrees", ValueType::kDouble, "how far to turn, in degrees", {}};
   degrees.min = -90;
   degrees.max = 90;
@@ -164,7 +159,7 @@ ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::Coll
 }
 
 Eigen::VectorXd ArmComponent::toEigen(const JointVector& q) const {
-  return Eigen::Map<const Eigen::Matrix<double, kJointCount, 1>>(q.data());
+  return q.eigen();
 }
 
 world::Pose ArmComponent::endpoint() const {
@@ -182,7 +177,7 @@ std::vector<JointVector> ArmComponent::solutions(const world::Pose& tcp_in_world
   for (int s = 0; s < count; ++s) {
     JointVector q = raw[s];
     bool within = true;
-    for (int j = 0; j < kJointCount && within; ++j) {
+    for (int j = 0; j < q.size() && within; ++j) {
       // The 2*pi-equivalent nearest the seed, moved inside the limits if it is not.
       double angle = q[j] + kTwoPi * std::round((seed[j] - q[j]) / kTwoPi);
       while (angle > config_.limits.max_position[j]) {
@@ -201,7 +196,7 @@ std::vector<JointVector> ArmComponent::solutions(const world::Pose& tcp_in_world
   std::sort(result.begin(), result.end(), [&seed](const JointVector& a, const JointVector& b) {
     double da = 0;
     double db = 0;
-    for (int j = 0; j < kJointCount; ++j) {
+    for (int j = 0; j < seed.size(); ++j) {
       da += (a[j] - seed[j]) * (a[j] - seed[j]);
       db += (b[j] - seed[j]) * (b[j] - seed[j]);
     }
@@ -229,7 +224,12 @@ world::Pose ArmComponent::toolAt(const JointVector& q) const {
 }
 
 MotionPlan ArmComponent::planToJoints(const JointVector& start, const JointVector& goal, double speed) const {
-  for (int j = 0; j < kJointCount; ++j) {
+  if (goal.size() != config_.limits.size() || start.size() != config_.limits.size()) {
+    return {nullptr, goal,
+            "the goal has " + std::to_string(goal.size()) + " joints and the start " + std::to_string(start.size()) +
+                ", the arm " + std::to_string(config_.limits.size())};
+  }
+  for (int j = 0; j < goal.size(); ++j) {
     if (goal[j] < config_.limits.min_position[j] || goal[j] > config_.limits.max_position[j]) {
       return {nullptr, goal, "joint " + std::to_string(j + 1) + " would leave its limits"};
     }
@@ -240,9 +240,7 @@ MotionPlan ArmComponent::planToJoints(const JointVector& start, const JointVecto
   }
   std::vector<JointVector> joints;
   for (const auto& q : path.path) {
-    JointVector v;
-    std::copy(q.data(), q.data() + kJointCount, v.begin());
-    joints.push_back(v);
+    joints.push_back(JointVector::fromEigen(q));
   }
   return timed(std::move(joints), speed);
 }
@@ -292,7 +290,7 @@ MotionPlan ArmComponent::planLine(const JointVector& current, const world::Pose&
     if (options.empty()) {
       return {nullptr, current, "the straight line leaves the arm's reach " + format("%.0f %% of the way", 100.0 * s)};
     }
-    if (maxAbs(options.front(), path.back()) > 0.25) {
+    if (maxAbsDifference(options.front(), path.back()) > 0.25) {
       return {nullptr, current, "the straight line passes too close to a singularity (a joint would have to flip)"};
     }
     path.push_back(options.front());
@@ -446,7 +444,7 @@ world::Report ArmComponent::report() const {
   report.symbols.push_back({"arm_joints", "", now,
                             world::JointsValue{std::vector<std::string>(std::begin(kJointNames), std::end(kJointNames)),
                                                std::vector<double>(state.position.begin(), state.position.end())}});
-  if (maxAbs(state.velocity, JointVector{}) > 0.01) {
+  if (maxAbs(state.velocity) > 0.01) {
     report.predicates.push_back({"arm_moving", {}, true, ""});
   }
   for (const Waypoint& waypoint : waypoints_.all()) {
@@ -455,7 +453,7 @@ world::Report ArmComponent::report() const {
           {waypoint.name, "", now,
            world::JointsValue{std::vector<std::string>(std::begin(kJointNames), std::end(kJointNames)),
                               std::vector<double>(waypoint.joints.begin(), waypoint.joints.end())}});
-      if (maxAbs(waypoint.joints, state.position) < config_.at_waypoint_joints) {
+      if (maxAbsDifference(waypoint.joints, state.position) < config_.at_waypoint_joints) {
         report.predicates.push_back({"at_waypoint", {waypoint.name}, true, ""});
       }
       continue;

@@ -101,6 +101,8 @@ class ArmComponent final : public component::LocalComponent {
   std::unique_ptr<component::RunningOperation> execute(MotionPlan plan, const std::string& what);
 
   const ArmConfig& config() const { return config_; }
+  /// Number of joints of the arm.
+  int jointCount() const { return config_.limits.size(); }
   const Ur5Kinematics& kinematics() const { return kinematics_; }
 
  private:

@@ -1,6 +1,7 @@
 #include "arm/ur5_kinematics.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -84,6 +85,7 @@ world::Pose dhTransform(double cos_theta, double sin_theta, double d, double a, 
 }  // namespace
 
 world::Pose Ur5Kinematics::forward(const JointVector& q) const {
+  assert(q.size() == kJointCount);
   world::Pose pose = world::Pose::Identity();
   for (int i = 0; i < kJointCount; ++i) {
     pose = pose * dhTransform(std::cos(q[i]), std::sin(q[i]), parameters_.d[i], parameters_.a[i], cos_alpha_[i],
@@ -254,6 +256,10 @@ std::vector<JointVector> Ur5Kinematics::inverse(const world::Pose& flange, doubl
 
 std::optional<JointVector> Ur5Kinematics::inverseNearest(const world::Pose& flange, const JointVector& seed,
                                                          const JointLimits* limits) const {
+  if (seed.size() != kJointCount) {
+    throw std::invalid_argument("Ur5Kinematics::inverseNearest: the seed has " + std::to_string(seed.size()) +
+                                " joints, not 6");
+  }
   if (!allFinite(seed)) {
     throw std::invalid_argument("Ur5Kinematics::inverseNearest: the seed has a non-finite joint angle");
   }
@@ -262,7 +268,7 @@ std::optional<JointVector> Ur5Kinematics::inverseNearest(const world::Pose& flan
   std::optional<JointVector> nearest;
   double nearest_distance_squared = 0.0;
   for (int k = 0; k < count; ++k) {
-    JointVector candidate;
+    JointVector candidate = JointVector::zero(kJointCount);
     bool within_limits = true;
     double distance_squared = 0.0;
     for (int j = 0; j < kJointCount && within_limits; ++j) {

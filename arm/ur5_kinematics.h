@@ -25,9 +25,9 @@ namespace costar::arm {
 /// Standard Denavit-Hartenberg parameters of a six-joint arm: link offsets d and lengths a in
 /// metres, twists alpha in radians, joint 1 first.
 struct DhParameters {
-  std::array<double, kJointCount> d;
-  std::array<double, kJointCount> a;
-  std::array<double, kJointCount> alpha;
+  std::array<double, 6> d;
+  std::array<double, 6> a;
+  std::array<double, 6> alpha;
 
   /// UR5 (CB-series) values published by Universal Robots:
   /// d = {0.089159, 0, 0, 0.10915, 0.09465, 0.0823}, a = {0, -0.425, -0.39225, 0, 0, 0},
@@ -39,6 +39,8 @@ struct DhParameters {
 /// construction, so one instance may be shared by threads.
 class Ur5Kinematics {
  public:
+  /// Joints of a UR-structured arm.
+  static constexpr int kJointCount = 6;
   /// Most solutions a pose has away from singularities.
   static constexpr int kMaxSolutions = 8;
   /// |sin(q5)| below which the wrist is treated as singular (joint 6's axis parallel to those
@@ -53,7 +55,8 @@ class Ur5Kinematics {
 
   const DhParameters& parameters() const { return parameters_; }
 
-  /// Pose of the flange (frame 6) in the base frame for joint angles `q` (radians, any range).
+  /// Pose of the flange (frame 6) in the base frame for joint angles `q` (radians, any range;
+  /// six of them).
   world::Pose forward(const JointVector& q) const;
 
   /// Every analytic solution for the flange pose `flange` (in the base frame), written to
@@ -88,7 +91,7 @@ class Ur5Kinematics {
   /// equivalent within its limits are discarded. At a wrist singularity q6 stays at the seed's
   /// where the arm can reach so (see inverse()).
   /// Returns nullopt when the pose is unreachable or no solution is within limits.
-  /// Throws std::invalid_argument when `seed` has a non-finite entry.
+  /// Throws std::invalid_argument when `seed` has a non-finite entry or not six joints.
   std::optional<JointVector> inverseNearest(const world::Pose& flange, const JointVector& seed,
                                             const JointLimits* limits = nullptr) const;
 

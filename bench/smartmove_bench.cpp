@@ -41,7 +41,7 @@ class NoGripper final : public component::LocalComponent {
 struct Cell {
   Cell()
       : robot(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp")),
-        collisions(robot, kBase, {.padding = 0.005}, {Eigen::Map<const Eigen::VectorXd>(kHome.data(), 6)}),
+        collisions(robot, kBase, {.padding = 0.005}, {kHome.eigen()}),
         driver(kHome),
         grasps(dataRoot() / "data/grasps.json", {}),
         arm(driver, clock, collisions, waypoints, nullptr, config()),

@@ -91,8 +91,9 @@ struct Simulation::Impl {
   std::vector<PartPlacement> placements;
   std::vector<int> part_bodies;
 
-  std::array<int, 6> arm_qpos{};
-  std::array<int, 6> arm_dof{};
+  int arm_joints = 0;  // the arm's joints, at most arm::kMaxJoints
+  std::array<int, arm::kMaxJoints> arm_qpos{};
+  std::array<int, arm::kMaxJoints> arm_dof{};
   int finger_qpos = 0;
   int finger_dof = 0;
   int finger_actuator = 0;
@@ -163,18 +164,21 @@ struct Simulation::Impl {
   void control() {
     // Arm: computed torque, tau = M (qdd_d + Kp e + Kd de) + bias, clamped by the actuators.
     const TimePoint t = now();
-    const ArmSetpoint setpoint = setpoint_source ? setpoint_source(t) : held;
-    if (setpoint_source) {
-      held = {setpoint.position, {}, {}};
+    ArmSetpoint setpoint = setpoint_source ? setpoint_source(t) : held;
+    if (setpoint.position.size() != arm_joints || setpoint.velocity.size() != arm_joints ||
+        setpoint.acceleration.size() != arm_joints) {
+      setpoint = held;  // a setpoint for another arm: hold where the last good one was
+    } else if (setpoint_source) {
+      held = {setpoint.position, ArmJoints::zero(arm_joints), ArmJoints::zero(arm_joints)};
     }
     std::fill(acceleration.begin(), acceleration.end(), 0.0);
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < arm_joints; ++i) {
       const double error = setpoint.position[i] - data->qpos[arm_qpos[i]];
       const double rate_error = setpoint.velocity[i] - data->qvel[arm_dof[i]];
       acceleration[arm_dof[i]] = setpoint.acceleration[i] + kArmKp * error + kArmKd * rate_error;
     }
     mj_mulM(model, data, torque.data(), acceleration.data());
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < arm_joints; ++i) {
       data->ctrl[i] = torque[arm_dof[i]] + data->qfrc_bias[arm_dof[i]];
     }
     // Gripper: the servo setpoint moves toward the target at the commanded speed.
@@ -275,7 +279,8 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->data = mj_makeData(impl->model);
   mjModel* m = impl->model;
 
-  for (int i = 0; i < 6; ++i) {
+  impl->arm_joints = static_cast<int>(kArmJoints.size());
+  for (int i = 0; i < impl->arm_joints; ++i) {
     const int joint = impl->id(mjOBJ_JOINT, kArmJoints[i]);
     impl->arm_qpos[i] = m->jnt_qposadr[joint];
     impl->arm_dof[i] = m->jnt_dofadr[joint];
@@ -304,10 +309,14 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
 
   // Start at the initial configuration, fingers open, and let the parts settle.
   const ArmJoints initial = options.initial_arm.value_or(homeConfiguration());
-  for (int i = 0; i < 6; ++i) {
+  if (initial.size() != impl->arm_joints) {
+    throw std::runtime_error("the initial arm configuration has " + std::to_string(initial.size()) +
+                             " joints, the arm " + std::to_string(impl->arm_joints));
+  }
+  for (int i = 0; i < impl->arm_joints; ++i) {
     impl->data->qpos[impl->arm_qpos[i]] = initial[i];
   }
-  impl->held.position = initial;
+  impl->held = {initial, ArmJoints::zero(impl->arm_joints), ArmJoints::zero(impl->arm_joints)};
   impl->data->qpos[impl->finger_qpos] = kMaxOpening / 2;
   impl->data->qpos[m->jnt_qposadr[impl->id(mjOBJ_JOINT, "right_finger_joint")]] = kMaxOpening / 2;
   mj_forward(m, impl->data);
@@ -349,16 +358,16 @@ void Simulation::detach() {
 }
 
 ArmJoints Simulation::armPositions() const {
-  ArmJoints q{};
-  for (int i = 0; i < 6; ++i) {
+  ArmJoints q = ArmJoints::zero(impl_->arm_joints);
+  for (int i = 0; i < impl_->arm_joints; ++i) {
     q[i] = impl_->data->qpos[impl_->arm_qpos[i]];
   }
   return q;
 }
 
 ArmJoints Simulation::armVelocities() const {
-  ArmJoints v{};
-  for (int i = 0; i < 6; ++i) {
+  ArmJoints v = ArmJoints::zero(impl_->arm_joints);
+  for (int i = 0; i < impl_->arm_joints; ++i) {
     v[i] = impl_->data->qvel[impl_->arm_dof[i]];
   }
   return v;

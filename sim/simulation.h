@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "arm/joints.h"
 #include "camera/rgbd.h"
 #include "core/clock.h"
 #include "core/image.h"
@@ -34,7 +35,8 @@
 
 namespace costar::sim {
 
-using ArmJoints = std::array<double, 6>;
+/// One value per arm joint (as many as the robot has).
+using ArmJoints = arm::JointVector;
 
 /// Where the arm should be at a given time.
 struct ArmSetpoint {

@@ -175,7 +175,7 @@ class Ur5SimWorkcell final : public Workcell {
     sim_options.placement_seed = options.seed;
     return sim_options;
   }
-  static Eigen::VectorXd toEigen(const sim::ArmJoints& q) { return Eigen::Map<const Eigen::VectorXd>(q.data(), 6); }
+  static Eigen::VectorXd toEigen(const sim::ArmJoints& q) { return q.eigen(); }
 
   sim::Scene scene_;
   std::unique_ptr<sim::Simulation> simulation_;

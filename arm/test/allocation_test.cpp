@@ -12,13 +12,16 @@
 namespace costar::arm {
 namespace {
 
+/// The UR5's joints.
+constexpr int kJointCount = arm::Ur5Kinematics::kJointCount;
+
 TEST(ArmAllocation, NoneInInverseKinematics) {
   const Ur5Kinematics kinematics;
   std::mt19937_64 random(21);
   std::uniform_real_distribution<double> angle(-3.0, 3.0);
   std::vector<world::Pose> poses;
   for (int k = 0; k < 100; ++k) {
-    JointVector q;
+    JointVector q = JointVector::zero(kJointCount);
     for (double& value : q) {
       value = angle(random);
     }
@@ -30,7 +33,7 @@ TEST(ArmAllocation, NoneInInverseKinematics) {
   const std::uint64_t before = bench::allocations();
   for (const world::Pose& pose : poses) {
     total += kinematics.inverse(pose, solutions);
-    total += kinematics.inverseNearest(pose, JointVector{}, &limits).has_value();
+    total += kinematics.inverseNearest(pose, JointVector::zero(kJointCount), &limits).has_value();
   }
   EXPECT_EQ(bench::allocations() - before, 0u);
   EXPECT_GT(total, 100);

@@ -53,7 +53,7 @@ class ArmTest : public ::testing::Test {
  protected:
   ArmTest()
       : robot(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp")),
-        collisions(robot, kBase, {.padding = 0.005}, {Eigen::Map<const Eigen::VectorXd>(kHome.data(), 6)}),
+        collisions(robot, kBase, {.padding = 0.005}, {kHome.eigen()}),
         driver(clock, kHome),
         arm(
             driver, clock, collisions, waypoints, [this](const std::string& frame) { return frame_lookup(frame); },
@@ -165,7 +165,7 @@ TEST_F(ArmTest, ABlockedStraightMotionIsPlannedAroundTheObstacle) {
   const auto& trajectory = *driver.executed.back();
   for (Duration t{}; t <= trajectory.duration(); t += std::chrono::milliseconds(5)) {
     const JointVector q = trajectory.sample(t).position;
-    EXPECT_FALSE(collisions.check(Eigen::Map<const Eigen::VectorXd>(q.data(), 6)).has_value());
+    EXPECT_FALSE(collisions.check(q.eigen()).has_value());
   }
 }
 

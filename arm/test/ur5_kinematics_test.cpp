@@ -10,6 +10,9 @@
 namespace costar::arm {
 namespace {
 
+/// The UR5's joints.
+constexpr int kJointCount = arm::Ur5Kinematics::kJointCount;
+
 constexpr double kPi = std::numbers::pi;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
@@ -18,7 +21,7 @@ constexpr double kPoseTolerance = 1e-9;
 
 JointVector randomJoints(std::mt19937_64& random, double low = -kPi, double high = kPi) {
   std::uniform_real_distribution<double> angle(low, high);
-  JointVector q;
+  JointVector q = JointVector::zero(kJointCount);
   for (double& value : q) {
     value = angle(random);
   }
@@ -81,7 +84,7 @@ TEST(Ur5Kinematics, ForwardMatchesAnIndependentProductOfDhMatrices) {
 
 TEST(Ur5Kinematics, ZeroConfigurationIsTheArmStretchedAlongMinusX) {
   // Published UR5 zero pose: flange at (a2 + a3, -(d4 + d6), d1 - d5), tool z along -y.
-  const world::Pose flange = Ur5Kinematics().forward(JointVector{});
+  const world::Pose flange = Ur5Kinematics().forward(JointVector::zero(kJointCount));
   EXPECT_NEAR(flange.translation().x(), -0.425 - 0.39225, 1e-15);
   EXPECT_NEAR(flange.translation().y(), -0.10915 - 0.0823, 1e-15);
   EXPECT_NEAR(flange.translation().z(), 0.089159 - 0.09465, 1e-15);
@@ -266,7 +269,7 @@ TEST(Ur5Kinematics, UnreachablePosesHaveNoSolution) {
   const auto expect_none = [&](const world::Pose& pose, const char* what) {
     EXPECT_EQ(kinematics.inverse(pose, solutions), 0) << what;
     EXPECT_TRUE(kinematics.inverse(pose).empty()) << what;
-    EXPECT_FALSE(kinematics.inverseNearest(pose, JointVector{})) << what;
+    EXPECT_FALSE(kinematics.inverseNearest(pose, JointVector::zero(kJointCount))) << what;
   };
   expect_none(world::poseFromXyzRpy(2.0, 0.0, 0.3, 0.0, 0.0, 0.0), "beyond the reach");
   expect_none(world::poseFromXyzRpy(0.0, 0.0, 1.2, 0.0, 0.0, 0.0), "straight up, too high");
@@ -301,7 +304,7 @@ std::optional<JointVector> bruteForceNearest(const std::vector<JointVector>& sol
   std::optional<JointVector> best;
   double best_distance = std::numeric_limits<double>::infinity();
   for (const JointVector& solution : solutions) {
-    JointVector candidate;
+    JointVector candidate = JointVector::zero(kJointCount);
     double sum = 0.0;
     for (int j = 0; j < kJointCount; ++j) {
       double best_angle = std::numeric_limits<double>::quiet_NaN();
@@ -345,8 +348,8 @@ TEST(Ur5Kinematics, InverseNearestPicksTheClosestSolutionExpressedNearTheSeed) {
 
     // A seed near q, some joints a whole turn away: the answer is q expressed near the seed,
     // unless another solution is about as close (near a singularity).
-    JointVector seed;
-    JointVector expected;
+    JointVector seed = JointVector::zero(kJointCount);
+    JointVector expected = JointVector::zero(kJointCount);
     for (int j = 0; j < kJointCount; ++j) {
       expected[j] = q[j] + turns(random) * kTwoPi;
       seed[j] = expected[j] + nudge(random);
@@ -354,11 +357,11 @@ TEST(Ur5Kinematics, InverseNearestPicksTheClosestSolutionExpressedNearTheSeed) {
     double gap = std::numeric_limits<double>::infinity();  // to the nearest other solution
     for (const JointVector& solution : solutions) {
       if (maxWrappedDifference(solution, q) > 1e-6) {
-        JointVector difference;
+        JointVector difference = JointVector::zero(kJointCount);
         for (int j = 0; j < kJointCount; ++j) {
           difference[j] = wrapAngle(solution[j] - q[j]);
         }
-        gap = std::min(gap, euclidean(difference, JointVector{}));
+        gap = std::min(gap, euclidean(difference, JointVector::zero(kJointCount)));
       }
     }
     const std::optional<JointVector> nearest = kinematics.inverseNearest(target, seed);
@@ -476,9 +479,9 @@ TEST(Ur5Kinematics, InverseNearestKeepsTheSeedsQ6AtTheWristSingularity) {
 
 TEST(Ur5Kinematics, InverseNearestRejectsANonFiniteSeed) {
   const Ur5Kinematics kinematics;
-  JointVector seed{};
+  JointVector seed = JointVector::zero(kJointCount);
   seed[2] = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(kinematics.inverseNearest(kinematics.forward(JointVector{}), seed), std::invalid_argument);
+  EXPECT_THROW(kinematics.inverseNearest(kinematics.forward(JointVector::zero(kJointCount)), seed), std::invalid_argument);
 }
 
 TEST(Ur5Kinematics, OtherUrArmsWork) {
