@@ -12,7 +12,6 @@ using component::ValueType;
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
 constexpr const char* kJointNames[] = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
                                                   "wrist_1_joint",      "wrist_2_joint",       "wrist_3_joint"};
 
@@ -26,13 +25,14 @@ std::string format(const char* pattern, double value) {
 class MotionOperation final : public component::RunningOperation {
  public:
   MotionOperation(ArmDriver& driver, const Clock& clock, MotionPlan plan, std::shared_ptr<std::uint64_t> counter,
-                  const ArmConfig& config, std::string what)
+                  const ArmConfig& config, std::shared_ptr<const Kinematics> kinematics, std::string what)
       : driver_(driver),
         clock_(clock),
         plan_(std::move(plan)),
         counter_(std::move(counter)),
         id_(++*counter_),
         config_(config),
+        kinematics_(std::move(kinematics)),
         what_(std::move(what)),
         start_(clock.now()) {
     driver_.execute(plan_.trajectory, start_);
@@ -67,7 +67,7 @@ class MotionOperation final : public component::RunningOperation {
     ++*counter_;
     const TimePoint now = clock_.now();
     const TrajectoryPoint state = plan_.trajectory->sample(now - start_);
-    driver_.execute(std::make_shared<JointTrajectory>(JointTrajectory::stopFrom(state, config_.limits)), now);
+    driver_.execute(std::make_shared<JointTrajectory>(JointTrajectory::stopFrom(state, kinematics_->limits())), now);
   }
 
  private:
@@ -77,6 +77,7 @@ class MotionOperation final : public component::RunningOperation {
   std::shared_ptr<std::uint64_t> counter_;
   std::uint64_t id_;
   const ArmConfig& config_;
+  std::shared_ptr<const Kinematics> kinematics_;
   std::string what_;
   TimePoint start_;
 };
@@ -91,13 +92,23 @@ ParamSpec speedParam(double default_speed) {
 }  // namespace
 
 ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::CollisionWorld& collisions,
-                           WaypointStore& waypoints, FrameLookup frames, ArmConfig config)
+                           WaypointStore& waypoints, FrameLookup frames, std::shared_ptr<const Kinematics> kinematics,
+                           ArmConfig config)
     : driver_(driver),
       clock_(clock),
       collisions_(collisions),
       waypoints_(waypoints),
       frames_(std::move(frames)),
+      kinematics_(std::move(kinematics)),
       config_(std::move(config)) {
+  if (kinematics_ == nullptr) {
+    throw std::invalid_argument("ArmComponent '" + config_.name + "': no kinematics");
+  }
+  if (config_.home.size() != kinematics_->jointCount()) {
+    throw std::invalid_argument("ArmComponent '" + config_.name + "': the home configuration has " +
+                                std::to_string(config_.home.size()) + " angles, the arm " +
+                                std::to_string(kinematics_->jointCount()) + " joints");
+  }
   description_.name = config_.name;
   description_.type = config_.type;
   description_.implements = {"Arm"};
@@ -116,7 +127,7 @@ ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::Coll
                  {"pose", "joints"}};
   ParamSpec axis_frame{
       "frame", ValueType::kString, "axes of the offset: world or tool", std::string("world"), {"world", "tool"}};
-  const int joint_count = config_.limits.size();
+  const int joint_count = kinematics_->jointCount();
   ParamSpec joint{"joint", ValueType::kInt,
                   "joint number, 1 (base) to " + std::to_string(joint_count) + (joint_count == 6 ? " (wrist 3)" : ""),
                   {}};
@@ -163,7 +174,7 @@ Eigen::VectorXd ArmComponent::toEigen(const JointVector& q) const {
 }
 
 world::Pose ArmComponent::endpoint() const {
-  return config_.base_in_world * kinematics_.forward(driver_.read().position) * config_.tcp_in_flange;
+  return config_.base_in_world * kinematics_->forward(driver_.read().position) * config_.tcp_in_flange;
 }
 
 world::Pose ArmComponent::flangeInBase(const world::Pose& tcp_in_world) const {
@@ -171,38 +182,9 @@ world::Pose ArmComponent::flangeInBase(const world::Pose& tcp_in_world) const {
 }
 
 std::vector<JointVector> ArmComponent::solutions(const world::Pose& tcp_in_world, const JointVector& seed) const {
-  std::array<JointVector, Ur5Kinematics::kMaxSolutions> raw;
-  const int count = kinematics_.inverse(flangeInBase(tcp_in_world), raw, seed[5]);
-  std::vector<JointVector> result;
-  for (int s = 0; s < count; ++s) {
-    JointVector q = raw[s];
-    bool within = true;
-    for (int j = 0; j < q.size() && within; ++j) {
-      // The 2*pi-equivalent nearest the seed, moved inside the limits if it is not.
-      double angle = q[j] + kTwoPi * std::round((seed[j] - q[j]) / kTwoPi);
-      while (angle > config_.limits.max_position[j]) {
-        angle -= kTwoPi;
-      }
-      while (angle < config_.limits.min_position[j]) {
-        angle += kTwoPi;
-      }
-      within = angle <= config_.limits.max_position[j];
-      q[j] = angle;
-    }
-    if (within) {
-      result.push_back(q);
-    }
-  }
-  std::sort(result.begin(), result.end(), [&seed](const JointVector& a, const JointVector& b) {
-    double da = 0;
-    double db = 0;
-    for (int j = 0; j < seed.size(); ++j) {
-      da += (a[j] - seed[j]) * (a[j] - seed[j]);
-      db += (b[j] - seed[j]) * (b[j] - seed[j]);
-    }
-    return da < db;
-  });
-  return result;
+  IkSolutions found;
+  kinematics_->solutionsNear(flangeInBase(tcp_in_world), seed, found);
+  return std::vector<JointVector>(found.begin(), found.end());
 }
 
 MotionPlan ArmComponent::timed(std::vector<JointVector> path, double speed) const {
@@ -210,8 +192,8 @@ MotionPlan ArmComponent::timed(std::vector<JointVector> path, double speed) cons
   try {
     plan.goal = path.back();
     plan.trajectory = std::make_shared<JointTrajectory>(
-        path.size() == 2 ? JointTrajectory::pointToPoint(path.front(), path.back(), config_.limits, speed)
-                         : JointTrajectory::alongPath(path, config_.limits, speed));
+        path.size() == 2 ? JointTrajectory::pointToPoint(path.front(), path.back(), kinematics_->limits(), speed)
+                         : JointTrajectory::alongPath(path, kinematics_->limits(), speed));
   } catch (const std::invalid_argument& e) {
     plan.trajectory.reset();
     plan.failure = e.what();
@@ -220,17 +202,17 @@ MotionPlan ArmComponent::timed(std::vector<JointVector> path, double speed) cons
 }
 
 world::Pose ArmComponent::toolAt(const JointVector& q) const {
-  return config_.base_in_world * kinematics_.forward(q) * config_.tcp_in_flange;
+  return config_.base_in_world * kinematics_->forward(q) * config_.tcp_in_flange;
 }
 
 MotionPlan ArmComponent::planToJoints(const JointVector& start, const JointVector& goal, double speed) const {
-  if (goal.size() != config_.limits.size() || start.size() != config_.limits.size()) {
+  if (goal.size() != kinematics_->limits().size() || start.size() != kinematics_->limits().size()) {
     return {nullptr, goal,
             "the goal has " + std::to_string(goal.size()) + " joints and the start " + std::to_string(start.size()) +
-                ", the arm " + std::to_string(config_.limits.size())};
+                ", the arm " + std::to_string(kinematics_->limits().size())};
   }
   for (int j = 0; j < goal.size(); ++j) {
-    if (goal[j] < config_.limits.min_position[j] || goal[j] > config_.limits.max_position[j]) {
+    if (goal[j] < kinematics_->limits().min_position[j] || goal[j] > kinematics_->limits().max_position[j]) {
       return {nullptr, goal, "joint " + std::to_string(j + 1) + " would leave its limits"};
     }
   }
@@ -273,7 +255,7 @@ MotionPlan ArmComponent::planToPose(const world::Pose& tcp_in_world, double spee
 }
 
 MotionPlan ArmComponent::planLine(const JointVector& current, const world::Pose& target, double speed) const {
-  const world::Pose start = config_.base_in_world * kinematics_.forward(current) * config_.tcp_in_flange;
+  const world::Pose start = config_.base_in_world * kinematics_->forward(current) * config_.tcp_in_flange;
   const double distance = (target.translation() - start.translation()).norm();
   const double angle = world::rotationAngle(start, target);
   const int steps =
@@ -318,7 +300,8 @@ std::unique_ptr<component::RunningOperation> ArmComponent::execute(MotionPlan pl
   if (!plan.ok()) {
     return std::make_unique<component::FinishedOperation>(OperationResult::failure(what + ": " + plan.failure));
   }
-  return std::make_unique<MotionOperation>(driver_, clock_, std::move(plan), motion_counter_, config_, what);
+  return std::make_unique<MotionOperation>(driver_, clock_, std::move(plan), motion_counter_, config_, kinematics_,
+                                           what);
 }
 
 std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::string& operation,
@@ -437,7 +420,7 @@ std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::stri
 
 world::Report ArmComponent::report() const {
   const ArmState state = driver_.read();
-  const world::Pose tcp = config_.base_in_world * kinematics_.forward(state.position) * config_.tcp_in_flange;
+  const world::Pose tcp = config_.base_in_world * kinematics_->forward(state.position) * config_.tcp_in_flange;
   const TimePoint now = clock_.now();
   world::Report report;
   report.symbols.push_back({"endpoint", "", now, world::FrameValue{"world", tcp}});

@@ -74,9 +74,10 @@ BENCHMARK(BM_Ur5ClosedFormInverse);
 
 void BM_Ur5ClosedFormInverseNearest(benchmark::State& state) {
   // The usual call in a Cartesian move: the solution nearest the current joint angles, within
-  // the UR5's limits. Seeds are the generating configurations, nudged.
+  // the UR5's limits, through the Kinematics interface (as the arm and SmartMove call it).
+  // Seeds are the generating configurations, nudged.
   const Ur5Kinematics kinematics;
-  const arm::JointLimits limits = arm::JointLimits::ur5();
+  const arm::Kinematics& generic = kinematics;
   const std::vector<world::Pose>& poses = randomReachablePoses();
   std::vector<JointVector> seeds;
   std::mt19937_64 random(7);
@@ -90,7 +91,7 @@ void BM_Ur5ClosedFormInverseNearest(benchmark::State& state) {
   }
   std::size_t next = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(kinematics.inverseNearest(poses[next], seeds[next], &limits));
+    benchmark::DoNotOptimize(generic.inverseNearest(poses[next], seeds[next]));
     next = (next + 1) % poses.size();
   }
   state.counters["solves_per_s"] =

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "arm/arm_component.h"
+#include "arm/ur5_kinematics.h"
 #include "core/paths.h"
 #include "smartmove/smartmove.h"
 
@@ -44,7 +45,7 @@ struct Cell {
         collisions(robot, kBase, {.padding = 0.005}, {kHome.eigen()}),
         driver(kHome),
         grasps(dataRoot() / "data/grasps.json", {}),
-        arm(driver, clock, collisions, waypoints, nullptr, config()),
+        arm(driver, clock, collisions, waypoints, nullptr, std::make_shared<arm::Ur5Kinematics>(), config()),
         smartmove(arm, gripper, world, collisions, world::loadObjectClasses(dataRoot() / "data/objects"), grasps) {
     collisions.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
     collisions.allow("base_link", "table");

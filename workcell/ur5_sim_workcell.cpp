@@ -1,6 +1,7 @@
 #include "workcell/ur5_sim_workcell.h"
 
 #include "arm/arm_component.h"
+#include "arm/ur5_kinematics.h"
 #include "core/paths.h"
 #include "gripper/parallel_gripper.h"
 #include "perception/perception_component.h"
@@ -120,7 +121,8 @@ class Ur5SimWorkcell final : public Workcell {
     arm_config.home = sim::Simulation::homeConfiguration();
     auto arm = std::make_shared<arm::ArmComponent>(
         arm_driver_, clock(), collisions_, waypoints_,
-        [this](const std::string& frame) { return components().world().worldPose(frame); }, arm_config);
+        [this](const std::string& frame) { return components().world().worldPose(frame); },
+        std::make_shared<arm::Ur5Kinematics>(), arm_config);
     auto gripper = std::make_shared<gripper::ParallelGripper>(gripper_driver_, clock());
     components().add(arm);
     components().add(gripper);

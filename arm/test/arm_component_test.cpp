@@ -2,6 +2,7 @@
 // what it refuses and why, cancelling, teaching, waypoints and predicates.
 
 #include "arm/arm_component.h"
+#include "arm/ur5_kinematics.h"
 
 #include <gtest/gtest.h>
 
@@ -57,7 +58,7 @@ class ArmTest : public ::testing::Test {
         driver(clock, kHome),
         arm(
             driver, clock, collisions, waypoints, [this](const std::string& frame) { return frame_lookup(frame); },
-            config()) {
+            std::make_shared<Ur5Kinematics>(), config()) {
     collisions.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
     collisions.allow("base_link", "table");
   }

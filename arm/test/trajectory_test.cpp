@@ -349,7 +349,7 @@ std::vector<JointVector> randomPath(std::mt19937_64& random, const JointLimits& 
     for (int step = 1; step <= steps; ++step) {
       world::Pose pose = start;
       pose.translation() += offset * (static_cast<double>(step) / steps);
-      const std::optional<JointVector> next = kinematics.inverseNearest(pose, path.back(), &limits);
+      const std::optional<JointVector> next = kinematics.nearestWithin(pose, path.back(), &limits);
       if (!next || distance(*next, path.back()) > 0.2) {
         break;  // out of reach or through a singularity: keep the path so far
       }
