@@ -12,8 +12,6 @@ using component::ValueType;
 
 namespace {
 
-constexpr const char* kJointNames[] = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
-                                                  "wrist_1_joint",      "wrist_2_joint",       "wrist_3_joint"};
 
 std::string format(const char* pattern, double value) {
   char text[96];
@@ -109,6 +107,19 @@ ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::Coll
                                 std::to_string(config_.home.size()) + " angles, the arm " +
                                 std::to_string(kinematics_->jointCount()) + " joints");
   }
+  const auto check_count = [this](const std::vector<std::string>& list, const char* what) {
+    if (!list.empty() && static_cast<int>(list.size()) != kinematics_->jointCount()) {
+      throw std::invalid_argument("ArmComponent '" + config_.name + "': " + std::to_string(list.size()) + " " + what +
+                                  " for " + std::to_string(kinematics_->jointCount()) + " joints");
+    }
+  };
+  check_count(config_.joint_names, "joint names");
+  check_count(config_.joint_labels, "joint labels");
+  if (config_.joint_names.empty()) {
+    for (int j = 1; j <= kinematics_->jointCount(); ++j) {
+      config_.joint_names.push_back("joint_" + std::to_string(j));
+    }
+  }
   description_.name = config_.name;
   description_.type = config_.type;
   description_.implements = {"Arm"};
@@ -128,9 +139,11 @@ ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::Coll
   ParamSpec axis_frame{
       "frame", ValueType::kString, "axes of the offset: world or tool", std::string("world"), {"world", "tool"}};
   const int joint_count = kinematics_->jointCount();
+  const auto label = [this](int j) {
+    return config_.joint_labels.empty() ? std::string() : " (" + config_.joint_labels[j] + ")";
+  };
   ParamSpec joint{"joint", ValueType::kInt,
-                  "joint number, 1 (base) to " + std::to_string(joint_count) + (joint_count == 6 ? " (wrist 3)" : ""),
-                  {}};
+                  "joint number, 1" + label(0) + " to " + std::to_string(joint_count) + label(joint_count - 1), {}};
   joint.min = 1;
   joint.max = joint_count;
   ParamSpec degrees{"degrees", ValueType::kDouble, "how far to turn, in degrees", {}};
@@ -425,7 +438,7 @@ world::Report ArmComponent::report() const {
   world::Report report;
   report.symbols.push_back({"endpoint", "", now, world::FrameValue{"world", tcp}});
   report.symbols.push_back({"arm_joints", "", now,
-                            world::JointsValue{std::vector<std::string>(std::begin(kJointNames), std::end(kJointNames)),
+                            world::JointsValue{config_.joint_names,
                                                std::vector<double>(state.position.begin(), state.position.end())}});
   if (maxAbs(state.velocity) > 0.01) {
     report.predicates.push_back({"arm_moving", {}, true, ""});
@@ -434,7 +447,7 @@ world::Report ArmComponent::report() const {
     if (waypoint.kind == Waypoint::Kind::kJoints) {
       report.symbols.push_back(
           {waypoint.name, "", now,
-           world::JointsValue{std::vector<std::string>(std::begin(kJointNames), std::end(kJointNames)),
+           world::JointsValue{config_.joint_names,
                               std::vector<double>(waypoint.joints.begin(), waypoint.joints.end())}});
       if (maxAbsDifference(waypoint.joints, state.position) < config_.at_waypoint_joints) {
         report.predicates.push_back({"at_waypoint", {waypoint.name}, true, ""});

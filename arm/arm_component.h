@@ -23,6 +23,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "arm/arm_driver.h"
 #include "arm/trajectory.h"
@@ -36,11 +37,16 @@ namespace costar::arm {
 
 struct ArmConfig {
   std::string name = "arm";
-  std::string type = "UR5";
+  /// The component's concrete type (the robot description's "type", e.g. "UR5").
+  std::string type = "Arm";
   /// Where the robot's base frame is in the world.
   world::Pose base_in_world = world::Pose::Identity();
   /// The tool centre point in the flange frame (between the gripper's finger pads).
-  world::Pose tcp_in_flange = world::Pose(Eigen::Translation3d(0, 0, 0.14));
+  world::Pose tcp_in_flange = world::Pose::Identity();
+  /// The joints' names (in arm_joints and joint waypoints) and labels for people ("wrist 3"),
+  /// base first; empty: "joint_1", "joint_2"... and no labels.
+  std::vector<std::string> joint_names;
+  std::vector<std::string> joint_labels;
   /// The home configuration (Home), one angle per joint.
   JointVector home{};
   /// Default speed of motions: a fraction of the joint velocity and acceleration limits.

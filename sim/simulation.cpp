@@ -18,8 +18,6 @@ namespace costar::sim {
 
 namespace {
 
-constexpr std::array<const char*, 6> kArmJoints = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
-                                                   "wrist_1_joint",      "wrist_2_joint",       "wrist_3_joint"};
 
 // Computed-torque gains: critically damped, 8 Hz bandwidth.
 constexpr double kArmOmega = 50.0;
@@ -78,9 +76,10 @@ std::string partBody(const PartPlacement& part, const world::ObjectClass& object
 
 }  // namespace
 
-const std::array<const char*, 6>& armJointNames() { return kArmJoints; }
-
-ArmJoints Simulation::homeConfiguration() { return {0.0, -2.3, 1.9, -M_PI / 2 + 0.4, -M_PI / 2, 0.0}; }
+ArmJoints Simulation::homeConfiguration() {
+  static const ArmJoints home = arm::loadRobotDescription(arm::robotDescriptionFile(kDefaultRobot)).home;
+  return home;
+}
 
 // --- implementation ------------------------------------------------------------------------
 
@@ -91,6 +90,7 @@ struct Simulation::Impl {
   std::vector<PartPlacement> placements;
   std::vector<int> part_bodies;
 
+  std::vector<std::string> arm_joint_names;
   int arm_joints = 0;  // the arm's joints, at most arm::kMaxJoints
   std::array<int, arm::kMaxJoints> arm_qpos{};
   std::array<int, arm::kMaxJoints> arm_dof{};
@@ -104,7 +104,6 @@ struct Simulation::Impl {
   int tcp_site = 0;
   int rgbd_camera = 0;
   int first_arm_body = 0;
-  int tool_body = 0;
 
   std::int64_t steps = 0;         // physics steps since time 0
   std::int64_t settle_steps = 0;  // steps taken before time 0
@@ -239,8 +238,13 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->placements = placeParts(scene, impl->classes, options.placement_seed);
   impl->noise = options.depth_noise;
 
+  // The robot: its description names the model, the joints, home and links. The default
+  // robot's model files are read from `root`, like everything else.
+  const arm::RobotDescription robot =
+      options.robot ? *options.robot : arm::loadRobotDescription(arm::robotDescriptionFile(kDefaultRobot), root);
+
   // Model: the workcell template plus a material per class colour and a body per part.
-  std::string xml = readText(root / "sim" / "models" / "ur5_workcell.xml");
+  std::string xml = readText(robot.mjcf);
   std::string assets;
   for (const auto& object : impl->classes) {
     for (const auto& [color_name, rgb] : object.colors) {
@@ -254,8 +258,8 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
                                      [&](const world::ObjectClass& c) { return c.name == part.object_class; });
     bodies += partBody(part, *object);
   }
-  // Textures and meshes named in the model are files in sim/models.
-  const std::string models = (root / "sim" / "models").string();
+  // Textures and meshes named in the model are files beside it.
+  const std::string models = robot.mjcf.parent_path().string();
   replaceMarker(
       xml, "<compiler angle=\"radian\" autolimits=\"true\"/>",
       "<compiler angle=\"radian\" autolimits=\"true\" texturedir=\"" + models + "\" meshdir=\"" + models + "\"/>");
@@ -279,9 +283,10 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->data = mj_makeData(impl->model);
   mjModel* m = impl->model;
 
-  impl->arm_joints = static_cast<int>(kArmJoints.size());
+  impl->arm_joint_names = robot.joint_names;
+  impl->arm_joints = robot.jointCount();
   for (int i = 0; i < impl->arm_joints; ++i) {
-    const int joint = impl->id(mjOBJ_JOINT, kArmJoints[i]);
+    const int joint = impl->id(mjOBJ_JOINT, robot.joint_names[i].c_str());
     impl->arm_qpos[i] = m->jnt_qposadr[joint];
     impl->arm_dof[i] = m->jnt_dofadr[joint];
   }
@@ -295,8 +300,7 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->table_surface_geom = impl->id(mjOBJ_GEOM, "table_surface");
   impl->tcp_site = impl->id(mjOBJ_SITE, "tcp");
   impl->rgbd_camera = impl->id(mjOBJ_CAMERA, "rgbd");
-  impl->first_arm_body = impl->id(mjOBJ_BODY, "shoulder_link");
-  impl->tool_body = impl->id(mjOBJ_BODY, "tool0");
+  impl->first_arm_body = impl->id(mjOBJ_BODY, robot.first_moving_link.c_str());
   for (const auto& part : impl->placements) {
     impl->part_bodies.push_back(impl->id(mjOBJ_BODY, part.name.c_str()));
   }
@@ -308,7 +312,7 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->torque.assign(m->nv, 0.0);
 
   // Start at the initial configuration, fingers open, and let the parts settle.
-  const ArmJoints initial = options.initial_arm.value_or(homeConfiguration());
+  const ArmJoints initial = options.initial_arm.value_or(robot.home);
   if (initial.size() != impl->arm_joints) {
     throw std::runtime_error("the initial arm configuration has " + std::to_string(initial.size()) +
                              " joints, the arm " + std::to_string(impl->arm_joints));
@@ -356,6 +360,8 @@ void Simulation::detach() {
     impl_->clock = nullptr;
   }
 }
+
+const std::vector<std::string>& Simulation::armJointNames() const { return impl_->arm_joint_names; }
 
 ArmJoints Simulation::armPositions() const {
   ArmJoints q = ArmJoints::zero(impl_->arm_joints);

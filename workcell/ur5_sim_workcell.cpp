@@ -1,7 +1,7 @@
 #include "workcell/ur5_sim_workcell.h"
 
 #include "arm/arm_component.h"
-#include "arm/ur5_kinematics.h"
+#include "arm/robot_description.h"
 #include "core/paths.h"
 #include "gripper/parallel_gripper.h"
 #include "perception/perception_component.h"
@@ -96,14 +96,16 @@ class Ur5SimWorkcell final : public Workcell {
  public:
   explicit Ur5SimWorkcell(const WorkcellOptions& options)
       : Workcell(std::make_unique<SimClock>()),
+        robot_description_(arm::loadRobotDescription(arm::robotDescriptionFile("ur5"))),
         scene_(sim::loadScene(options.scene.empty() ? dataRoot() / "sim/scenes/assembly.json" : options.scene)),
-        simulation_(sim::Simulation::create(scene_, simOptions(options))),
+        simulation_(sim::Simulation::create(scene_, simOptions(options, robot_description_))),
         arm_driver_(*simulation_),
         gripper_driver_(*simulation_),
         camera_(*simulation_, options.seed.value_or(scene_.seed)),
-        robot_(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp")),
+        robot_(planning::RobotModel::fromUrdf(robot_description_.urdf, robot_description_.urdf_base_link,
+                                              robot_description_.urdf_tool_link)),
         collisions_(robot_, kBaseInWorld, {.padding = 0.005, .resolution = 0.01},
-                    {toEigen(sim::Simulation::homeConfiguration())}),
+                    {toEigen(robot_description_.home)}),
         waypoints_(!options.waypoints.empty()
                        ? options.waypoints
                        : (options.memory_only ? std::filesystem::path() : defaultWaypointFile("ur5-sim")),
@@ -112,17 +114,21 @@ class Ur5SimWorkcell final : public Workcell {
                 options.memory_only ? std::filesystem::path() : defaultGraspFile("ur5-sim")) {
     simulation_->attach(static_cast<SimClock&>(clock()));
     collisions_.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
-    collisions_.allow("base_link", "table");  // the robot stands on it
+    collisions_.allow(robot_description_.base_link, "table");  // the robot stands on it
     // The tool stays above the table top, within the cell.
     collisions_.setWorkspace(Eigen::AlignedBox3d(Eigen::Vector3d(-0.45, -0.65, 0.0), Eigen::Vector3d(1.05, 0.65, 1.2)));
 
     arm::ArmConfig arm_config;
+    arm_config.type = robot_description_.type;
     arm_config.base_in_world = kBaseInWorld;
-    arm_config.home = sim::Simulation::homeConfiguration();
+    arm_config.home = robot_description_.home;
+    arm_config.tcp_in_flange = robot_description_.tool_in_flange;
+    arm_config.joint_names = robot_description_.joint_names;
+    arm_config.joint_labels = robot_description_.joint_labels;
     auto arm = std::make_shared<arm::ArmComponent>(
         arm_driver_, clock(), collisions_, waypoints_,
         [this](const std::string& frame) { return components().world().worldPose(frame); },
-        std::make_shared<arm::Ur5Kinematics>(), arm_config);
+        arm::makeKinematics(robot_description_), arm_config);
     auto gripper = std::make_shared<gripper::ParallelGripper>(gripper_driver_, clock());
     components().add(arm);
     components().add(gripper);
@@ -137,8 +143,11 @@ class Ur5SimWorkcell final : public Workcell {
       components().add(std::make_shared<perception::PerceptionComponent>(
           camera_, clock(), threadPipeline(perception_config), perception_config));
     }
+    smartmove::SmartMoveConfig smartmove_config;
+    smartmove_config.gripper_links = robot_description_.gripper_links;
     smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(*arm, *gripper, components().world(), collisions_,
-                                                                 simulation_->objectClasses(), grasps_);
+                                                                 simulation_->objectClasses(), grasps_,
+                                                                 smartmove_config);
     components().add(smartmove_);
     // Last: it derives its predicates from what the others report.
     components().add(std::make_shared<predicator::Predicator>(components().world(), simulation_->objectClasses()));
@@ -172,13 +181,15 @@ class Ur5SimWorkcell final : public Workcell {
   sim::Simulation* simulation() override { return simulation_.get(); }
 
  private:
-  static sim::SimulationOptions simOptions(const WorkcellOptions& options) {
+  static sim::SimulationOptions simOptions(const WorkcellOptions& options, const arm::RobotDescription& robot) {
     sim::SimulationOptions sim_options;
+    sim_options.robot = robot;
     sim_options.placement_seed = options.seed;
     return sim_options;
   }
   static Eigen::VectorXd toEigen(const sim::ArmJoints& q) { return q.eigen(); }
 
+  arm::RobotDescription robot_description_;
   sim::Scene scene_;
   std::unique_ptr<sim::Simulation> simulation_;
   sim::SimArmDriver arm_driver_;

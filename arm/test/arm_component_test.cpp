@@ -67,6 +67,7 @@ class ArmTest : public ::testing::Test {
     ArmConfig c;
     c.base_in_world = kBase;
     c.home = kHome;
+    c.tcp_in_flange = world::Pose(Eigen::Translation3d(0, 0, 0.14));
     return c;
   }
 
@@ -181,7 +182,7 @@ TEST_F(ArmTest, MoveRelativeFollowsAStraightLine) {
   const auto& trajectory = *driver.executed.back();
   Ur5Kinematics kinematics;
   for (Duration t{}; t <= trajectory.duration(); t += std::chrono::milliseconds(10)) {
-    const world::Pose tcp = kBase * kinematics.forward(trajectory.sample(t).position) * ArmConfig{}.tcp_in_flange;
+    const world::Pose tcp = kBase * kinematics.forward(trajectory.sample(t).position) * config().tcp_in_flange;
     EXPECT_LT((tcp.translation().head<2>() - Eigen::Vector2d(0.45, 0.1)).norm(), 1e-3);
   }
   const OperationResult into_table =

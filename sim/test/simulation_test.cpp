@@ -137,6 +137,8 @@ TEST(Simulation, TheArmTracksItsSetpointsAndHoldsStill) {
 
 TEST(Simulation, ASetpointForAnotherArmIsRefusedAndTheArmHolds) {
   const auto sim = Simulation::create(sceneOf(R"({"parts": []})"));
+  EXPECT_EQ(sim->armJointNames().size(), 6u);  // from robots/ur5/ur5.json
+  EXPECT_EQ(sim->armJointNames().front(), "shoulder_pan_joint");
   const ArmJoints before = sim->armPositions();
   // Seven joints for a six-joint arm: the controller keeps the last good setpoint.
   sim->setArmSetpointSource([](TimePoint) {
