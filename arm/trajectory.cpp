@@ -170,11 +170,11 @@ void JointTrajectory::validate(const JointLimits& limits, const std::string& who
   const int count = limits.min_position.size();
   if (count == 0 || limits.max_position.size() != count || limits.max_velocity.size() != count ||
       limits.max_acceleration.size() != count) {
-    fail(who, "the limits need one value per joint in each of min_position, max_position, max_velocity and "
-              "max_acceleration, got " +
-                  std::to_string(limits.min_position.size()) + ", " + std::to_string(limits.max_position.size()) +
-                  ", " + std::to_string(limits.max_velocity.size()) + " and " +
-                  std::to_string(limits.max_acceleration.size()));
+    fail(who,
+         "the limits need one value per joint in each of min_position, max_position, max_velocity and "
+         "max_acceleration, got " +
+             std::to_string(limits.min_position.size()) + ", " + std::to_string(limits.max_position.size()) + ", " +
+             std::to_string(limits.max_velocity.size()) + " and " + std::to_string(limits.max_acceleration.size()));
   }
   for (int j = 0; j < count; ++j) {
     const auto joint = [j] { return "joint " + std::to_string(j + 1) + " "; };

@@ -101,7 +101,7 @@ Waypoint fromJson(const json& item, const std::string& field, int joint_count) {
     const json& list = item.at("joints");
     const std::size_t count = joint_count > 0 ? static_cast<std::size_t>(joint_count)
                               : list.is_array() && !list.empty() && list.size() <= kMaxJoints ? list.size()
-                                                                                               : 0;
+                                                                                              : 0;
     const std::string expected = joint_count > 0 ? std::to_string(joint_count) + " angles (radians)"
                                                  : "1 to " + std::to_string(kMaxJoints) + " angles (radians)";
     if (count == 0) {

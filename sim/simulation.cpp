@@ -18,7 +18,6 @@ namespace costar::sim {
 
 namespace {
 
-
 // Computed-torque gains: critically damped, 8 Hz bandwidth.
 constexpr double kArmOmega = 50.0;
 constexpr double kArmKp = kArmOmega * kArmOmega;

@@ -3,6 +3,7 @@
 #include "arm/arm_component.h"
 #include "arm/robot_description.h"
 #include "core/paths.h"
+#include "faults/injector.h"
 #include "gripper/parallel_gripper.h"
 #include "perception/perception_component.h"
 #include "perception/pipeline.h"
@@ -104,15 +105,25 @@ class Ur5SimWorkcell final : public Workcell {
         camera_(*simulation_, options.seed.value_or(scene_.seed)),
         robot_(planning::RobotModel::fromUrdf(robot_description_.urdf, robot_description_.urdf_base_link,
                                               robot_description_.urdf_tool_link)),
-        collisions_(robot_, kBaseInWorld, {.padding = 0.005, .resolution = 0.01},
-                    {toEigen(robot_description_.home)}),
+        collisions_(robot_, kBaseInWorld, {.padding = 0.005, .resolution = 0.01}, {toEigen(robot_description_.home)}),
         waypoints_(!options.waypoints.empty()
                        ? options.waypoints
                        : (options.memory_only ? std::filesystem::path() : defaultWaypointFile("ur5-sim")),
-                   /*persist=*/!options.memory_only),
+                   /*persist=*/!options.memory_only, robot_description_.jointCount()),
         grasps_(dataRoot() / "data/grasps.json",
-                options.memory_only ? std::filesystem::path() : defaultGraspFile("ur5-sim")) {
+                options.memory_only ? std::filesystem::path() : defaultGraspFile("ur5-sim")),
+        faults_(options.faults) {
     simulation_->attach(static_cast<SimClock&>(clock()));
+    if (faults_) {
+      faults_->attach(clock());
+    }
+    // The drivers and components as the cell uses them: wrapped by the fault injector, if any.
+    arm::ArmDriver& arm_driver = faults_ ? faults_->wrap(arm_driver_) : arm_driver_;
+    gripper::GripperDriver& gripper_driver = faults_ ? faults_->wrap(gripper_driver_) : gripper_driver_;
+    camera::RgbdCamera& camera = faults_ ? faults_->wrap(camera_) : camera_;
+    const auto add = [this](std::shared_ptr<component::Component> component) {
+      components().add(faults_ ? faults_->wrap(std::move(component)) : std::move(component));
+    };
     collisions_.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
     collisions_.allow(robot_description_.base_link, "table");  // the robot stands on it
     // The tool stays above the table top, within the cell.
@@ -126,31 +137,36 @@ class Ur5SimWorkcell final : public Workcell {
     arm_config.joint_names = robot_description_.joint_names;
     arm_config.joint_labels = robot_description_.joint_labels;
     auto arm = std::make_shared<arm::ArmComponent>(
-        arm_driver_, clock(), collisions_, waypoints_,
+        arm_driver, clock(), collisions_, waypoints_,
         [this](const std::string& frame) { return components().world().worldPose(frame); },
         arm::makeKinematics(robot_description_), arm_config);
-    auto gripper = std::make_shared<gripper::ParallelGripper>(gripper_driver_, clock());
-    components().add(arm);
-    components().add(gripper);
-    components().add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
-        {"table_center", tableCenter()}, {"robot_base", kBaseInWorld}}));
+    auto gripper = std::make_shared<gripper::ParallelGripper>(gripper_driver, clock());
+    add(arm);
+    add(gripper);
+    add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{{"table_center", tableCenter()},
+                                                                                       {"robot_base", kBaseInWorld}}));
     if (options.test_oracle_perception) {
-      components().add(std::make_shared<TestOraclePerception>(*simulation_));
+      add(std::make_shared<TestOraclePerception>(*simulation_));
     } else {
       // DetectObjects: the camera's frames only, never the simulator's true poses.
       perception::PerceptionConfig perception_config;
       perception_config.table_center = tableCenter();
-      components().add(std::make_shared<perception::PerceptionComponent>(
-          camera_, clock(), threadPipeline(perception_config), perception_config));
+      add(std::make_shared<perception::PerceptionComponent>(camera, clock(), threadPipeline(perception_config),
+                                                            perception_config));
     }
     smartmove::SmartMoveConfig smartmove_config;
     smartmove_config.gripper_links = robot_description_.gripper_links;
-    smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(*arm, *gripper, components().world(), collisions_,
-                                                                 simulation_->objectClasses(), grasps_,
-                                                                 smartmove_config);
-    components().add(smartmove_);
+    smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(
+        *arm, *gripper, components().world(), collisions_, simulation_->objectClasses(), grasps_, smartmove_config);
+    add(smartmove_);
     // Last: it derives its predicates from what the others report.
-    components().add(std::make_shared<predicator::Predicator>(components().world(), simulation_->objectClasses()));
+    add(std::make_shared<predicator::Predicator>(components().world(), simulation_->objectClasses()));
+    if (faults_) {
+      faults_->checkTargets();
+    }
+    // The safety stop (a component failed, a driver's readings cannot be trusted): the arm
+    // decelerates along its path and stops; the fingers keep their last command.
+    components().setOnStop([arm](const std::string&) { arm->stop(); });
     smartmove_->setPatternCheck([this](const predicator::Pattern& pattern) { return checkPattern(pattern); });
     registerNodes();
     smartmove_->syncObstacles();
@@ -200,6 +216,7 @@ class Ur5SimWorkcell final : public Workcell {
   arm::WaypointStore waypoints_;
   smartmove::GraspLibrary grasps_;
   std::shared_ptr<smartmove::SmartMoveComponent> smartmove_;
+  std::shared_ptr<faults::Injector> faults_;
 };
 
 }  // namespace

@@ -98,7 +98,9 @@ TEST_F(BadRobotFile, EachProblemNamesItsField) {
   EXPECT_EQ(problem(j), "home: missing");
   j = good_;
   j["home"].push_back(0.0);
-  EXPECT_EQ(problem(j), "home: must be 6 angles (radians), one per joint, not [0.0,-2.3,1.9,-1.1707963267948966,-1.5707963267948966,0.0...");
+  EXPECT_EQ(problem(j),
+            "home: must be 6 angles (radians), one per joint, not "
+            "[0.0,-2.3,1.9,-1.1707963267948966,-1.5707963267948966,0.0...");
   j = good_;
   j["home"][1] = 7.0;
   EXPECT_EQ(problem(j), "home[1]: is outside joint 2's limits");
@@ -132,7 +134,8 @@ TEST_F(BadRobotFile, EachProblemNamesItsField) {
   j["joints"] = json::array();
   EXPECT_EQ(problem(j), "joints: must be a list of 1 to 8 joints, not []");
   EXPECT_EQ(problem(std::string("{\"name\": ")).rfind("not valid JSON: ", 0), 0u);
-  EXPECT_EQ(problem(std::string("[1, 2]")), "(top level): must be an object {\"name\": ..., \"joints\": [...], ...}, not [1,2]");
+  EXPECT_EQ(problem(std::string("[1, 2]")),
+            "(top level): must be an object {\"name\": ..., \"joints\": [...], ...}, not [1,2]");
 }
 
 TEST(RobotDescription, AMissingFileIsNamed) {

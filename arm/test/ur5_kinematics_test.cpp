@@ -482,7 +482,8 @@ TEST(Ur5Kinematics, InverseNearestRejectsANonFiniteSeed) {
   const Ur5Kinematics kinematics;
   JointVector seed = JointVector::zero(kJointCount);
   seed[2] = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(kinematics.nearestWithin(kinematics.forward(JointVector::zero(kJointCount)), seed), std::invalid_argument);
+  EXPECT_THROW(kinematics.nearestWithin(kinematics.forward(JointVector::zero(kJointCount)), seed),
+               std::invalid_argument);
 }
 
 TEST(Ur5Kinematics, OtherUrArmsWork) {
