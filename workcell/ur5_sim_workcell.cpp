@@ -140,9 +140,14 @@ class Ur5SimWorkcell final : public Workcell {
         arm_driver, clock(), collisions_, waypoints_,
         [this](const std::string& frame) { return components().world().worldPose(frame); },
         arm::makeKinematics(robot_description_), arm_config);
-    auto gripper = std::make_shared<gripper::ParallelGripper>(gripper_driver, clock());
+    // SmartMove reaches the gripper through its operations, as the tree does: the same (possibly
+    // fault-injected) component the registry holds.
+    std::shared_ptr<component::Component> gripper = std::make_shared<gripper::ParallelGripper>(gripper_driver, clock());
+    if (faults_) {
+      gripper = faults_->wrap(std::move(gripper));
+    }
     add(arm);
-    add(gripper);
+    components().add(gripper);
     add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{{"table_center", tableCenter()},
                                                                                        {"robot_base", kBaseInWorld}}));
     if (options.test_oracle_perception) {
