@@ -13,29 +13,24 @@ using component::ValueType;
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
-constexpr const char* kJointNames[kJointCount] = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
-                                                  "wrist_1_joint",      "wrist_2_joint",       "wrist_3_joint"};
-
 std::string format(const char* pattern, double value) {
   char text[96];
   std::snprintf(text, sizeof text, pattern, value);
   return text;
 }
 
-double maxAbs(const JointVector& a, const JointVector& b) {
-  double largest = 0.0;
-  for (int j = 0; j < kJointCount; ++j) {
-    largest = std::max(largest, std::abs(a[j] - b[j]));
-  }
-  return largest;
-}
-
 /// Why a reading cannot be trusted, or empty.
-std::string problemWith(const ArmState& state, TimePoint now, Duration timeout) {
-  for (int j = 0; j < kJointCount; ++j) {
-    if (!std::isfinite(state.position[j]) || !std::isfinite(state.velocity[j])) {
-      return std::string("arm driver: the joint state is not a number (") + kJointNames[j] + ")";
+std::string problemWith(const ArmState& state, TimePoint now, Duration timeout,
+                        const std::vector<std::string>& joint_names) {
+  // Velocities: one per joint, or none from a driver that does not measure them.
+  const int count = static_cast<int>(joint_names.size());
+  if (state.position.size() != count || (state.velocity.size() != count && !state.velocity.empty())) {
+    return "arm driver: the joint state has " + std::to_string(state.position.size()) + " positions and " +
+           std::to_string(state.velocity.size()) + " velocities for " + std::to_string(count) + " joints";
+  }
+  for (int j = 0; j < count; ++j) {
+    if (!std::isfinite(state.position[j]) || (!state.velocity.empty() && !std::isfinite(state.velocity[j]))) {
+      return "arm driver: the joint state is not a number (" + joint_names[j] + ")";
     }
   }
   if (state.stamp != TimePoint{} && now - state.stamp > timeout) {
@@ -64,13 +59,14 @@ void stopMotion(ArmMotion& motion, ArmDriver& driver, const Clock& clock, const 
 class MotionOperation final : public component::RunningOperation {
  public:
   MotionOperation(ArmDriver& driver, const Clock& clock, MotionPlan plan, std::shared_ptr<ArmMotion> motion,
-                  const ArmConfig& config, std::string what)
+                  const ArmConfig& config, std::shared_ptr<const Kinematics> kinematics, std::string what)
       : driver_(driver),
         clock_(clock),
         plan_(std::move(plan)),
         motion_(std::move(motion)),
         id_(++motion_->counter),
         config_(config),
+        kinematics_(std::move(kinematics)),
         what_(std::move(what)),
         start_(clock.now()) {
     motion_->trajectory = plan_.trajectory;
@@ -90,20 +86,20 @@ class MotionOperation final : public component::RunningOperation {
     std::string problem;
     try {
       state = driver_.read();
-      problem = problemWith(state, now, config_.state_timeout);
+      problem = problemWith(state, now, config_.state_timeout, config_.joint_names);
     } catch (const std::exception& e) {
       problem = e.what();
     }
     if (!problem.empty()) {
-      stopMotion(*motion_, driver_, clock_, config_.limits);
+      stopMotion(*motion_, driver_, clock_, kinematics_->limits());
       return OperationResult::failure(what_ + ": " + problem + "; the arm was stopped");
     }
     const TimePoint end = start_ + plan_.trajectory->duration();
     if (now < end) {
       return OperationResult::running();
     }
-    const double error = maxAbs(state.position, plan_.goal);
-    const double speed = maxAbs(state.velocity, JointVector{});
+    const double error = maxAbsDifference(state.position, plan_.goal);
+    const double speed = maxAbs(state.velocity);
     if (error < config_.arrival_tolerance && speed < 0.05) {
       return OperationResult::success({{"duration", toSeconds(plan_.trajectory->duration())}});
     }
@@ -116,7 +112,7 @@ class MotionOperation final : public component::RunningOperation {
 
   void cancel() override {
     if (motion_->counter == id_) {
-      stopMotion(*motion_, driver_, clock_, config_.limits);
+      stopMotion(*motion_, driver_, clock_, kinematics_->limits());
     }
   }
 
@@ -127,6 +123,7 @@ class MotionOperation final : public component::RunningOperation {
   std::shared_ptr<ArmMotion> motion_;
   std::uint64_t id_;
   const ArmConfig& config_;
+  std::shared_ptr<const Kinematics> kinematics_;
   std::string what_;
   TimePoint start_;
 };
@@ -141,13 +138,36 @@ ParamSpec speedParam(double default_speed) {
 }  // namespace
 
 ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::CollisionWorld& collisions,
-                           WaypointStore& waypoints, FrameLookup frames, ArmConfig config)
+                           WaypointStore& waypoints, FrameLookup frames, std::shared_ptr<const Kinematics> kinematics,
+                           ArmConfig config)
     : driver_(driver),
       clock_(clock),
       collisions_(collisions),
       waypoints_(waypoints),
       frames_(std::move(frames)),
+      kinematics_(std::move(kinematics)),
       config_(std::move(config)) {
+  if (kinematics_ == nullptr) {
+    throw std::invalid_argument("ArmComponent '" + config_.name + "': no kinematics");
+  }
+  if (config_.home.size() != kinematics_->jointCount()) {
+    throw std::invalid_argument("ArmComponent '" + config_.name + "': the home configuration has " +
+                                std::to_string(config_.home.size()) + " angles, the arm " +
+                                std::to_string(kinematics_->jointCount()) + " joints");
+  }
+  const auto check_count = [this](const std::vector<std::string>& list, const char* what) {
+    if (!list.empty() && static_cast<int>(list.size()) != kinematics_->jointCount()) {
+      throw std::invalid_argument("ArmComponent '" + config_.name + "': " + std::to_string(list.size()) + " " + what +
+                                  " for " + std::to_string(kinematics_->jointCount()) + " joints");
+    }
+  };
+  check_count(config_.joint_names, "joint names");
+  check_count(config_.joint_labels, "joint labels");
+  if (config_.joint_names.empty()) {
+    for (int j = 1; j <= kinematics_->jointCount(); ++j) {
+      config_.joint_names.push_back("joint_" + std::to_string(j));
+    }
+  }
   description_.name = config_.name;
   description_.type = config_.type;
   description_.implements = {"Arm"};
@@ -166,9 +186,16 @@ ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::Coll
                  {"pose", "joints"}};
   ParamSpec axis_frame{
       "frame", ValueType::kString, "axes of the offset: world or tool", std::string("world"), {"world", "tool"}};
-  ParamSpec joint{"joint", ValueType::kInt, "joint number, 1 (base) to 6 (wrist 3)", {}};
+  const int joint_count = kinematics_->jointCount();
+  const auto label = [this](int j) {
+    return config_.joint_labels.empty() ? std::string() : " (" + config_.joint_labels[j] + ")";
+  };
+  ParamSpec joint{"joint",
+                  ValueType::kInt,
+                  "joint number, 1" + label(0) + " to " + std::to_string(joint_count) + label(joint_count - 1),
+                  {}};
   joint.min = 1;
-  joint.max = 6;
+  joint.max = joint_count;
   ParamSpec degrees{"degrees", ValueType::kDouble, "how far to turn, in degrees", {}};
   degrees.min = -90;
   degrees.max = 90;
@@ -205,61 +232,31 @@ ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::Coll
                              {"at_waypoint", 1, "at_waypoint(w): the tool is at waypoint w"}};
 }
 
-Eigen::VectorXd ArmComponent::toEigen(const JointVector& q) const {
-  return Eigen::Map<const Eigen::Matrix<double, kJointCount, 1>>(q.data());
-}
+Eigen::VectorXd ArmComponent::toEigen(const JointVector& q) const { return q.eigen(); }
 
 world::Pose ArmComponent::endpoint() const {
-  return config_.base_in_world * kinematics_.forward(checkedRead().position) * config_.tcp_in_flange;
+  return config_.base_in_world * kinematics_->forward(checkedRead().position) * config_.tcp_in_flange;
 }
 
 ArmState ArmComponent::checkedRead() const {
   const ArmState state = driver_.read();
-  if (const std::string problem = problemWith(state, clock_.now(), config_.state_timeout); !problem.empty()) {
+  if (const std::string problem = problemWith(state, clock_.now(), config_.state_timeout, config_.joint_names);
+      !problem.empty()) {
     throw std::runtime_error(problem);
   }
   return state;
 }
 
-void ArmComponent::stop() { stopMotion(*motion_, driver_, clock_, config_.limits); }
+void ArmComponent::stop() { stopMotion(*motion_, driver_, clock_, kinematics_->limits()); }
 
 world::Pose ArmComponent::flangeInBase(const world::Pose& tcp_in_world) const {
   return config_.base_in_world.inverse() * tcp_in_world * config_.tcp_in_flange.inverse();
 }
 
 std::vector<JointVector> ArmComponent::solutions(const world::Pose& tcp_in_world, const JointVector& seed) const {
-  std::array<JointVector, Ur5Kinematics::kMaxSolutions> raw;
-  const int count = kinematics_.inverse(flangeInBase(tcp_in_world), raw, seed[5]);
-  std::vector<JointVector> result;
-  for (int s = 0; s < count; ++s) {
-    JointVector q = raw[s];
-    bool within = true;
-    for (int j = 0; j < kJointCount && within; ++j) {
-      // The 2*pi-equivalent nearest the seed, moved inside the limits if it is not.
-      double angle = q[j] + kTwoPi * std::round((seed[j] - q[j]) / kTwoPi);
-      while (angle > config_.limits.max_position[j]) {
-        angle -= kTwoPi;
-      }
-      while (angle < config_.limits.min_position[j]) {
-        angle += kTwoPi;
-      }
-      within = angle <= config_.limits.max_position[j];
-      q[j] = angle;
-    }
-    if (within) {
-      result.push_back(q);
-    }
-  }
-  std::sort(result.begin(), result.end(), [&seed](const JointVector& a, const JointVector& b) {
-    double da = 0;
-    double db = 0;
-    for (int j = 0; j < kJointCount; ++j) {
-      da += (a[j] - seed[j]) * (a[j] - seed[j]);
-      db += (b[j] - seed[j]) * (b[j] - seed[j]);
-    }
-    return da < db;
-  });
-  return result;
+  IkSolutions found;
+  kinematics_->solutionsNear(flangeInBase(tcp_in_world), seed, found);
+  return std::vector<JointVector>(found.begin(), found.end());
 }
 
 MotionPlan ArmComponent::timed(std::vector<JointVector> path, double speed) const {
@@ -267,8 +264,8 @@ MotionPlan ArmComponent::timed(std::vector<JointVector> path, double speed) cons
   try {
     plan.goal = path.back();
     plan.trajectory = std::make_shared<JointTrajectory>(
-        path.size() == 2 ? JointTrajectory::pointToPoint(path.front(), path.back(), config_.limits, speed)
-                         : JointTrajectory::alongPath(path, config_.limits, speed));
+        path.size() == 2 ? JointTrajectory::pointToPoint(path.front(), path.back(), kinematics_->limits(), speed)
+                         : JointTrajectory::alongPath(path, kinematics_->limits(), speed));
   } catch (const std::invalid_argument& e) {
     plan.trajectory.reset();
     plan.failure = e.what();
@@ -277,12 +274,17 @@ MotionPlan ArmComponent::timed(std::vector<JointVector> path, double speed) cons
 }
 
 world::Pose ArmComponent::toolAt(const JointVector& q) const {
-  return config_.base_in_world * kinematics_.forward(q) * config_.tcp_in_flange;
+  return config_.base_in_world * kinematics_->forward(q) * config_.tcp_in_flange;
 }
 
 MotionPlan ArmComponent::planToJoints(const JointVector& start, const JointVector& goal, double speed) const {
-  for (int j = 0; j < kJointCount; ++j) {
-    if (goal[j] < config_.limits.min_position[j] || goal[j] > config_.limits.max_position[j]) {
+  if (goal.size() != kinematics_->limits().size() || start.size() != kinematics_->limits().size()) {
+    return {nullptr, goal,
+            "the goal has " + std::to_string(goal.size()) + " joints and the start " + std::to_string(start.size()) +
+                ", the arm " + std::to_string(kinematics_->limits().size())};
+  }
+  for (int j = 0; j < goal.size(); ++j) {
+    if (goal[j] < kinematics_->limits().min_position[j] || goal[j] > kinematics_->limits().max_position[j]) {
       return {nullptr, goal, "joint " + std::to_string(j + 1) + " would leave its limits"};
     }
   }
@@ -292,9 +294,7 @@ MotionPlan ArmComponent::planToJoints(const JointVector& start, const JointVecto
   }
   std::vector<JointVector> joints;
   for (const auto& q : path.path) {
-    JointVector v;
-    std::copy(q.data(), q.data() + kJointCount, v.begin());
-    joints.push_back(v);
+    joints.push_back(JointVector::fromEigen(q));
   }
   return timed(std::move(joints), speed);
 }
@@ -327,7 +327,7 @@ MotionPlan ArmComponent::planToPose(const world::Pose& tcp_in_world, double spee
 }
 
 MotionPlan ArmComponent::planLine(const JointVector& current, const world::Pose& target, double speed) const {
-  const world::Pose start = config_.base_in_world * kinematics_.forward(current) * config_.tcp_in_flange;
+  const world::Pose start = config_.base_in_world * kinematics_->forward(current) * config_.tcp_in_flange;
   const double distance = (target.translation() - start.translation()).norm();
   const double angle = world::rotationAngle(start, target);
   const int steps =
@@ -344,7 +344,7 @@ MotionPlan ArmComponent::planLine(const JointVector& current, const world::Pose&
     if (options.empty()) {
       return {nullptr, current, "the straight line leaves the arm's reach " + format("%.0f %% of the way", 100.0 * s)};
     }
-    if (maxAbs(options.front(), path.back()) > 0.25) {
+    if (maxAbsDifference(options.front(), path.back()) > 0.25) {
       return {nullptr, current, "the straight line passes too close to a singularity (a joint would have to flip)"};
     }
     path.push_back(options.front());
@@ -372,7 +372,7 @@ std::unique_ptr<component::RunningOperation> ArmComponent::execute(MotionPlan pl
   if (!plan.ok()) {
     return std::make_unique<component::FinishedOperation>(OperationResult::failure(what + ": " + plan.failure));
   }
-  return std::make_unique<MotionOperation>(driver_, clock_, std::move(plan), motion_, config_, what);
+  return std::make_unique<MotionOperation>(driver_, clock_, std::move(plan), motion_, config_, kinematics_, what);
 }
 
 std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::string& operation,
@@ -492,23 +492,22 @@ std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::stri
 world::Report ArmComponent::report() const {
   // A reading that cannot be trusted makes the report throw: the registry then stops the cell.
   const ArmState state = checkedRead();
-  const world::Pose tcp = config_.base_in_world * kinematics_.forward(state.position) * config_.tcp_in_flange;
+  const world::Pose tcp = config_.base_in_world * kinematics_->forward(state.position) * config_.tcp_in_flange;
   const TimePoint now = clock_.now();
   world::Report report;
   report.symbols.push_back({"endpoint", "", now, world::FrameValue{"world", tcp}});
-  report.symbols.push_back({"arm_joints", "", now,
-                            world::JointsValue{std::vector<std::string>(std::begin(kJointNames), std::end(kJointNames)),
-                                               std::vector<double>(state.position.begin(), state.position.end())}});
-  if (maxAbs(state.velocity, JointVector{}) > 0.01) {
+  report.symbols.push_back(
+      {"arm_joints", "", now,
+       world::JointsValue{config_.joint_names, std::vector<double>(state.position.begin(), state.position.end())}});
+  if (maxAbs(state.velocity) > 0.01) {
     report.predicates.push_back({"arm_moving", {}, true, ""});
   }
   for (const Waypoint& waypoint : waypoints_.all()) {
     if (waypoint.kind == Waypoint::Kind::kJoints) {
-      report.symbols.push_back(
-          {waypoint.name, "", now,
-           world::JointsValue{std::vector<std::string>(std::begin(kJointNames), std::end(kJointNames)),
-                              std::vector<double>(waypoint.joints.begin(), waypoint.joints.end())}});
-      if (maxAbs(waypoint.joints, state.position) < config_.at_waypoint_joints) {
+      report.symbols.push_back({waypoint.name, "", now,
+                                world::JointsValue{config_.joint_names, std::vector<double>(waypoint.joints.begin(),
+                                                                                            waypoint.joints.end())}});
+      if (maxAbsDifference(waypoint.joints, state.position) < config_.at_waypoint_joints) {
         report.predicates.push_back({"at_waypoint", {waypoint.name}, true, ""});
       }
       continue;

@@ -1,7 +1,10 @@
 #pragma once
-// The UR5 as a CoSTAR component implementing the abstract Arm (Teach, Move, `endpoint`).
+// A robot arm as a CoSTAR component implementing the abstract Arm (Teach, Move, `endpoint`).
+// The robot is data: its kinematics (arm/kinematics.h: joint count, limits, forward and
+// inverse) and its configuration (base, tool, home, joint names); nothing here is specific to
+// one arm.
 //
-// Every motion is planned before it runs: the goal is solved with the closed-form IK (the
+// Every motion is planned before it runs: the goal is solved with the arm's IK (the
 // nearest solution within the joint limits whose configuration is collision-free), the
 // straight joint-space motion is collision-checked along its whole length against the table,
 // known parts and the arm itself, and when it would collide OMPL plans a way around. The
@@ -20,10 +23,11 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "arm/arm_driver.h"
+#include "arm/kinematics.h"
 #include "arm/trajectory.h"
-#include "arm/ur5_kinematics.h"
 #include "arm/waypoints.h"
 #include "component/component.h"
 #include "planning/collision_world.h"
@@ -33,12 +37,17 @@ namespace costar::arm {
 
 struct ArmConfig {
   std::string name = "arm";
-  std::string type = "UR5";
+  /// The component's concrete type (the robot description's "type", e.g. "UR5").
+  std::string type = "Arm";
   /// Where the robot's base frame is in the world.
   world::Pose base_in_world = world::Pose::Identity();
   /// The tool centre point in the flange frame (between the gripper's finger pads).
-  world::Pose tcp_in_flange = world::Pose(Eigen::Translation3d(0, 0, 0.14));
-  JointLimits limits = JointLimits::ur5();
+  world::Pose tcp_in_flange = world::Pose::Identity();
+  /// The joints' names (in arm_joints and joint waypoints) and labels for people ("wrist 3"),
+  /// base first; empty: "joint_1", "joint_2"... and no labels.
+  std::vector<std::string> joint_names;
+  std::vector<std::string> joint_labels;
+  /// The home configuration (Home), one angle per joint.
   JointVector home{};
   /// Default speed of motions: a fraction of the joint velocity and acceleration limits.
   double default_speed = 0.5;
@@ -77,9 +86,12 @@ class ArmComponent final : public component::LocalComponent {
   using FrameLookup = std::function<std::optional<world::Pose>(const std::string&)>;
 
   /// Everything passed by reference must outlive the component. `collisions` holds the
-  /// table and known parts; the component adds nothing to it.
+  /// table and known parts; the component adds nothing to it. `kinematics` is the arm's
+  /// (its joint count and limits are the arm's).
+  /// Throws std::invalid_argument without kinematics, or when `config.home` does not have one
+  /// angle per joint.
   ArmComponent(ArmDriver& driver, const Clock& clock, planning::CollisionWorld& collisions, WaypointStore& waypoints,
-               FrameLookup frames, ArmConfig config);
+               FrameLookup frames, std::shared_ptr<const Kinematics> kinematics, ArmConfig config);
 
   const component::ComponentDescription& description() const override { return description_; }
   world::Report report() const override;
@@ -118,7 +130,10 @@ class ArmComponent final : public component::LocalComponent {
   std::unique_ptr<component::RunningOperation> execute(MotionPlan plan, const std::string& what);
 
   const ArmConfig& config() const { return config_; }
-  const Ur5Kinematics& kinematics() const { return kinematics_; }
+  /// Number of joints of the arm.
+  int jointCount() const { return kinematics_->jointCount(); }
+  const Kinematics& kinematics() const { return *kinematics_; }
+  const JointLimits& limits() const { return kinematics_->limits(); }
 
  private:
   std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
@@ -134,8 +149,8 @@ class ArmComponent final : public component::LocalComponent {
   planning::CollisionWorld& collisions_;
   WaypointStore& waypoints_;
   FrameLookup frames_;
+  std::shared_ptr<const Kinematics> kinematics_;
   ArmConfig config_;
-  Ur5Kinematics kinematics_;
   std::shared_ptr<ArmMotion> motion_ = std::make_shared<ArmMotion>();
 };
 

@@ -11,8 +11,8 @@
 namespace costar::arm {
 
 struct ArmState {
-  JointVector position{};
-  JointVector velocity{};
+  JointVector position{};  // one angle per joint
+  JointVector velocity{};  // one per joint, or empty from a driver that does not measure them
   /// When the controller measured it; TimePoint{} from a driver that does not stamp its
   /// readings (the Arm component then cannot tell a reading that stopped updating).
   TimePoint stamp{};

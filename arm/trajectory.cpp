@@ -30,7 +30,7 @@ void checkSpeedScale(double speed_scale, const std::string& who) {
 }
 
 void checkFinite(const JointVector& q, const std::string& who, const std::string& what) {
-  for (int j = 0; j < kJointCount; ++j) {
+  for (int j = 0; j < q.size(); ++j) {
     if (!std::isfinite(q[j])) {
       fail(who, what + ": joint " + std::to_string(j + 1) + " is " + number(q[j]));
     }
@@ -39,8 +39,11 @@ void checkFinite(const JointVector& q, const std::string& who, const std::string
 
 // Finite and within the position limits; `what` names the point in the message.
 void checkPosition(const JointVector& q, const JointLimits& limits, const std::string& who, const std::string& what) {
+  if (q.size() != limits.size()) {
+    fail(who, what + " has " + std::to_string(q.size()) + " joints, the limits " + std::to_string(limits.size()));
+  }
   checkFinite(q, who, what);
-  for (int j = 0; j < kJointCount; ++j) {
+  for (int j = 0; j < q.size(); ++j) {
     if (q[j] >= limits.min_position[j] && q[j] <= limits.max_position[j]) {
       continue;
     }
@@ -57,16 +60,16 @@ void checkPosition(const JointVector& q, const JointLimits& limits, const std::s
 }
 
 JointVector scaled(const JointVector& v, double factor) {
-  JointVector result;
-  for (int j = 0; j < kJointCount; ++j) {
+  JointVector result = v;
+  for (int j = 0; j < v.size(); ++j) {
     result[j] = v[j] * factor;
   }
   return result;
 }
 
 JointVector difference(const JointVector& a, const JointVector& b) {
-  JointVector result;
-  for (int j = 0; j < kJointCount; ++j) {
+  JointVector result = a;
+  for (int j = 0; j < a.size(); ++j) {
     result[j] = a[j] - b[j];
   }
   return result;
@@ -82,8 +85,8 @@ double norm(const JointVector& v) {
 
 // origin + distance * direction.
 JointVector along(const JointVector& origin, const JointVector& direction, double distance) {
-  JointVector result;
-  for (int j = 0; j < kJointCount; ++j) {
+  JointVector result = origin;
+  for (int j = 0; j < origin.size(); ++j) {
     result[j] = origin[j] + distance * direction[j];
   }
   return result;
@@ -93,7 +96,7 @@ JointVector along(const JointVector& origin, const JointVector& direction, doubl
 // `per_joint_limit` (velocity or acceleration): min_j limit_j / |direction_j|.
 double rateLimitAlong(const JointVector& direction, const JointVector& per_joint_limit) {
   double limit = std::numeric_limits<double>::infinity();
-  for (int j = 0; j < kJointCount; ++j) {
+  for (int j = 0; j < direction.size(); ++j) {
     if (direction[j] != 0.0) {
       limit = std::min(limit, per_joint_limit[j] / std::abs(direction[j]));
     }
@@ -135,7 +138,7 @@ class JointTrajectory::Builder {
     const double decelerate_distance = 0.5 * (peak + speed_to) * decelerate_time;
     const double cruise_distance = std::max(0.0, distance - accelerate_distance - decelerate_distance);
     const double cruise_time = peak > 0.0 ? cruise_distance / peak : 0.0;
-    const JointVector zero{};
+    const JointVector zero = JointVector::zero(origin.size());
     add(along(origin, direction, offset), scaled(direction, speed_from), scaled(direction, max_acceleration),
         accelerate_time);
     add(along(origin, direction, offset + accelerate_distance), scaled(direction, peak), zero, cruise_time);
@@ -146,7 +149,8 @@ class JointTrajectory::Builder {
   /// The trajectory, ending at rest at `final_position`.
   JointTrajectory finish(const JointVector& final_position) {
     if (phases_.empty()) {
-      phases_.push_back(Phase{0.0, final_position, JointVector{}, JointVector{}});
+      const JointVector zero = JointVector::zero(final_position.size());
+      phases_.push_back(Phase{0.0, final_position, zero, zero});
     }
     return JointTrajectory(std::move(phases_), time_, final_position);
   }
@@ -163,7 +167,16 @@ JointTrajectory::JointTrajectory(std::vector<Phase> phases, double total_seconds
       final_position_(final_position) {}
 
 void JointTrajectory::validate(const JointLimits& limits, const std::string& who) {
-  for (int j = 0; j < kJointCount; ++j) {
+  const int count = limits.min_position.size();
+  if (count == 0 || limits.max_position.size() != count || limits.max_velocity.size() != count ||
+      limits.max_acceleration.size() != count) {
+    fail(who,
+         "the limits need one value per joint in each of min_position, max_position, max_velocity and "
+         "max_acceleration, got " +
+             std::to_string(limits.min_position.size()) + ", " + std::to_string(limits.max_position.size()) + ", " +
+             std::to_string(limits.max_velocity.size()) + " and " + std::to_string(limits.max_acceleration.size()));
+  }
+  for (int j = 0; j < count; ++j) {
     const auto joint = [j] { return "joint " + std::to_string(j + 1) + " "; };
     if (!std::isfinite(limits.min_position[j]) || !std::isfinite(limits.max_position[j]) ||
         limits.min_position[j] > limits.max_position[j]) {
@@ -215,8 +228,8 @@ JointTrajectory JointTrajectory::alongPath(const std::vector<JointVector>& path,
     fail(who, "the path is empty");
   }
   for (std::size_t k = 0; k < path.size(); ++k) {
-    bool valid = true;
-    for (int j = 0; j < kJointCount; ++j) {
+    bool valid = path[k].size() == limits.size();
+    for (int j = 0; valid && j < limits.size(); ++j) {
       valid = valid && path[k][j] >= limits.min_position[j] && path[k][j] <= limits.max_position[j];  // NaN: false
     }
     if (!valid) {
@@ -261,7 +274,7 @@ JointTrajectory JointTrajectory::alongPath(const std::vector<JointVector>& path,
   std::vector<double> turn(segment_count + 1, 0.0);
   for (std::size_t c = 1; c < segment_count; ++c) {
     const JointVector change = difference(direction[c], direction[c - 1]);
-    for (int j = 0; j < kJointCount; ++j) {
+    for (int j = 0; j < change.size(); ++j) {
       turn[c] = std::max(turn[c], std::abs(change[j]) / max_acceleration[j]);
     }
     double bound = std::min(max_speed[c - 1] * max_speed[c - 1], max_speed[c] * max_speed[c]);
@@ -316,8 +329,13 @@ JointTrajectory JointTrajectory::stopFrom(const TrajectoryPoint& state, const Jo
   validate(limits, who);
   checkFinite(state.position, who, "the position");
   checkFinite(state.velocity, who, "the velocity");
+  if (state.position.size() != limits.size() || state.velocity.size() != limits.size()) {
+    fail(who, "the state has " + std::to_string(state.position.size()) + " positions and " +
+                  std::to_string(state.velocity.size()) + " velocities, the limits " + std::to_string(limits.size()) +
+                  " joints");
+  }
   double stop_time = 0.0;
-  for (int j = 0; j < kJointCount; ++j) {
+  for (int j = 0; j < limits.size(); ++j) {
     stop_time = std::max(stop_time, std::abs(state.velocity[j]) / limits.max_acceleration[j]);
   }
   if (stop_time == 0.0) {
@@ -331,7 +349,8 @@ JointTrajectory JointTrajectory::stopFrom(const TrajectoryPoint& state, const Jo
 TrajectoryPoint JointTrajectory::sample(Duration t) const {
   double seconds = toSeconds(t);
   if (t >= duration_ || !(seconds < total_seconds_)) {
-    return TrajectoryPoint{final_position_, JointVector{}, JointVector{}};
+    const JointVector zero = JointVector::zero(final_position_.size());
+    return TrajectoryPoint{final_position_, zero, zero};
   }
   seconds = std::max(seconds, 0.0);
   // The last phase starting at or before `seconds` (the first starts at 0).
@@ -339,8 +358,8 @@ TrajectoryPoint JointTrajectory::sample(Duration t) const {
                                      [](double time, const Phase& phase) { return time < phase.start_time; });
   const Phase& phase = *(next - 1);
   const double tau = seconds - phase.start_time;
-  TrajectoryPoint point;
-  for (int j = 0; j < kJointCount; ++j) {
+  TrajectoryPoint point{phase.position, phase.velocity, phase.acceleration};
+  for (int j = 0; j < phase.position.size(); ++j) {
     point.position[j] = phase.position[j] + tau * (phase.velocity[j] + 0.5 * tau * phase.acceleration[j]);
     point.velocity[j] = phase.velocity[j] + tau * phase.acceleration[j];
     point.acceleration[j] = phase.acceleration[j];

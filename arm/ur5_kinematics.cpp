@@ -1,6 +1,7 @@
 #include "arm/ur5_kinematics.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -45,7 +46,9 @@ DhParameters DhParameters::ur5() {
   return parameters;
 }
 
-Ur5Kinematics::Ur5Kinematics(DhParameters parameters) : parameters_(parameters) {
+Ur5Kinematics::Ur5Kinematics(DhParameters parameters, JointLimits limits)
+    : Kinematics(std::move(limits)), parameters_(parameters) {
+  require(jointCount() == kJointCount, "the limits are for " + std::to_string(jointCount()) + " joints, not 6");
   const auto& [d, a, alpha] = parameters_;
   for (int i = 0; i < kJointCount; ++i) {
     require(std::isfinite(d[i]) && std::isfinite(a[i]) && std::isfinite(alpha[i]),
@@ -84,6 +87,7 @@ world::Pose dhTransform(double cos_theta, double sin_theta, double d, double a, 
 }  // namespace
 
 world::Pose Ur5Kinematics::forward(const JointVector& q) const {
+  assert(q.size() == kJointCount);
   world::Pose pose = world::Pose::Identity();
   for (int i = 0; i < kJointCount; ++i) {
     pose = pose * dhTransform(std::cos(q[i]), std::sin(q[i]), parameters_.d[i], parameters_.a[i], cos_alpha_[i],
@@ -252,17 +256,43 @@ std::vector<JointVector> Ur5Kinematics::inverse(const world::Pose& flange, doubl
   return std::vector<JointVector>(solutions.begin(), solutions.begin() + count);
 }
 
+void Ur5Kinematics::inverse(const world::Pose& flange, const JointVector& seed, IkSolutions& solutions) const {
+  static_assert(kMaxSolutions <= kMaxIkSolutions);
+  std::array<JointVector, kMaxSolutions> found;
+  const int count = inverse(flange, found, seed.size() == kJointCount ? seed[5] : 0.0);
+  solutions.clear();
+  for (int k = 0; k < count; ++k) {
+    solutions.push_back(found[k]);
+  }
+}
+
+std::optional<JointVector> Ur5Kinematics::nearestWithin(const world::Pose& flange, const JointVector& seed,
+                                                        const JointLimits* limits) const {
+  return nearest(flange, seed, limits, nullptr);
+}
+
 std::optional<JointVector> Ur5Kinematics::inverseNearest(const world::Pose& flange, const JointVector& seed,
-                                                         const JointLimits* limits) const {
+                                                         const Acceptable& acceptable) const {
+  return nearest(flange, seed, &limits(), acceptable ? &acceptable : nullptr);
+}
+
+std::optional<JointVector> Ur5Kinematics::nearest(const world::Pose& flange, const JointVector& seed,
+                                                  const JointLimits* limits, const Acceptable* acceptable) const {
+  if (seed.size() != kJointCount) {
+    throw std::invalid_argument("Ur5Kinematics::inverseNearest: the seed has " + std::to_string(seed.size()) +
+                                " joints, not 6");
+  }
   if (!allFinite(seed)) {
     throw std::invalid_argument("Ur5Kinematics::inverseNearest: the seed has a non-finite joint angle");
   }
   std::array<JointVector, kMaxSolutions> solutions;
   const int count = inverse(flange, solutions, seed[5]);
+  std::array<double, kMaxSolutions> distances_squared{};
+  int candidates = 0;
   std::optional<JointVector> nearest;
   double nearest_distance_squared = 0.0;
   for (int k = 0; k < count; ++k) {
-    JointVector candidate;
+    JointVector candidate = JointVector::zero(kJointCount);
     bool within_limits = true;
     double distance_squared = 0.0;
     for (int j = 0; j < kJointCount && within_limits; ++j) {
@@ -282,9 +312,32 @@ std::optional<JointVector> Ur5Kinematics::inverseNearest(const world::Pose& flan
       candidate[j] = angle;
       distance_squared += (angle - seed[j]) * (angle - seed[j]);
     }
-    if (within_limits && (!nearest || distance_squared < nearest_distance_squared)) {
+    if (!within_limits) {
+      continue;
+    }
+    if (acceptable != nullptr) {  // kept, to be asked nearest first below
+      solutions[candidates] = candidate;
+      distances_squared[candidates++] = distance_squared;
+    } else if (!nearest || distance_squared < nearest_distance_squared) {
       nearest = candidate;
       nearest_distance_squared = distance_squared;
+    }
+  }
+  if (acceptable != nullptr) {
+    // Nearest first: the acceptable one with the smallest distance (ties: the earlier one).
+    std::array<int, kMaxSolutions> order{};
+    for (int k = 0; k < candidates; ++k) {
+      order[k] = k;
+    }
+    for (int k = 1; k < candidates; ++k) {  // insertion sort: stable, and no allocation
+      for (int i = k; i > 0 && distances_squared[order[i]] < distances_squared[order[i - 1]]; --i) {
+        std::swap(order[i], order[i - 1]);
+      }
+    }
+    for (int k = 0; k < candidates; ++k) {
+      if ((*acceptable)(solutions[order[k]])) {
+        return solutions[order[k]];
+      }
     }
   }
   return nearest;

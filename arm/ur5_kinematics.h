@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "arm/joints.h"
+#include "arm/kinematics.h"
 #include "world/pose.h"
 
 namespace costar::arm {
@@ -25,9 +26,9 @@ namespace costar::arm {
 /// Standard Denavit-Hartenberg parameters of a six-joint arm: link offsets d and lengths a in
 /// metres, twists alpha in radians, joint 1 first.
 struct DhParameters {
-  std::array<double, kJointCount> d;
-  std::array<double, kJointCount> a;
-  std::array<double, kJointCount> alpha;
+  std::array<double, 6> d;
+  std::array<double, 6> a;
+  std::array<double, 6> alpha;
 
   /// UR5 (CB-series) values published by Universal Robots:
   /// d = {0.089159, 0, 0, 0.10915, 0.09465, 0.0823}, a = {0, -0.425, -0.39225, 0, 0, 0},
@@ -35,10 +36,13 @@ struct DhParameters {
   static DhParameters ur5();
 };
 
-/// Forward and analytic inverse kinematics of a UR-structured arm. Immutable after
-/// construction, so one instance may be shared by threads.
-class Ur5Kinematics {
+/// Forward and analytic inverse kinematics of a UR-structured arm, one implementation of the
+/// Kinematics interface. Immutable after construction, so one instance may be shared by
+/// threads.
+class Ur5Kinematics final : public Kinematics {
  public:
+  /// Joints of a UR-structured arm.
+  static constexpr int kJointCount = 6;
   /// Most solutions a pose has away from singularities.
   static constexpr int kMaxSolutions = 8;
   /// |sin(q5)| below which the wrist is treated as singular (joint 6's axis parallel to those
@@ -48,13 +52,19 @@ class Ur5Kinematics {
 
   /// Throws std::invalid_argument when `parameters` do not have the UR structure the closed
   /// form relies on: a1 = a4 = a5 = a6 = 0, d2 = d3 = 0, alpha = {pi/2, 0, 0, pi/2, -pi/2, 0},
-  /// a2 and a3 non-zero, d6 non-zero, every value finite.
-  explicit Ur5Kinematics(DhParameters parameters = DhParameters::ur5());
+  /// a2 and a3 non-zero, d6 non-zero, every value finite; or when `limits` are not valid
+  /// limits of six joints.
+  explicit Ur5Kinematics(DhParameters parameters = DhParameters::ur5(), JointLimits limits = JointLimits::ur5());
 
   const DhParameters& parameters() const { return parameters_; }
 
-  /// Pose of the flange (frame 6) in the base frame for joint angles `q` (radians, any range).
-  world::Pose forward(const JointVector& q) const;
+  /// Pose of the flange (frame 6) in the base frame for joint angles `q` (radians, any range;
+  /// six of them).
+  world::Pose forward(const JointVector& q) const override;
+
+  /// Kinematics::inverse: the solutions of inverse() below, with q6 at a wrist singularity
+  /// taken from the seed (seed[5]).
+  void inverse(const world::Pose& flange, const JointVector& seed, IkSolutions& solutions) const override;
 
   /// Every analytic solution for the flange pose `flange` (in the base frame), written to
   /// `solutions[0 .. count)`; returns count, 0 to 8. Does not allocate. Each solution
@@ -88,11 +98,19 @@ class Ur5Kinematics {
   /// equivalent within its limits are discarded. At a wrist singularity q6 stays at the seed's
   /// where the arm can reach so (see inverse()).
   /// Returns nullopt when the pose is unreachable or no solution is within limits.
-  /// Throws std::invalid_argument when `seed` has a non-finite entry.
+  /// Throws std::invalid_argument when `seed` has a non-finite entry or not six joints.
+  std::optional<JointVector> nearestWithin(const world::Pose& flange, const JointVector& seed,
+                                           const JointLimits* limits = nullptr) const;
+
+  /// Kinematics::inverseNearest: nearestWithin(flange, seed, &limits()), among the solutions
+  /// that `acceptable` accepts (asked nearest first).
   std::optional<JointVector> inverseNearest(const world::Pose& flange, const JointVector& seed,
-                                            const JointLimits* limits = nullptr) const;
+                                            const Acceptable& acceptable) const override;
+  using Kinematics::inverseNearest;
 
  private:
+  std::optional<JointVector> nearest(const world::Pose& flange, const JointVector& seed, const JointLimits* limits,
+                                     const Acceptable* acceptable) const;
   std::optional<double> wristSingularQ6(const Eigen::Vector3d& wrist_centre, const world::Pose& frame_1_to_4_at_zero,
                                         double q5, double preferred) const;
 

@@ -29,7 +29,7 @@ namespace {
 nlohmann::json toJson(const Waypoint& waypoint) {
   nlohmann::json json = {{"name", waypoint.name}};
   if (waypoint.kind == Waypoint::Kind::kJoints) {
-    json["joints"] = waypoint.joints;
+    json["joints"] = std::vector<double>(waypoint.joints.begin(), waypoint.joints.end());
   } else {
     const Eigen::Quaterniond q(waypoint.pose.linear());
     const Eigen::Vector3d& p = waypoint.pose.translation();
@@ -73,7 +73,7 @@ std::string stringField(const json& value, const std::string& field) {
   return value.get<std::string>();
 }
 
-Waypoint fromJson(const json& item, const std::string& field) {
+Waypoint fromJson(const json& item, const std::string& field, int joint_count) {
   if (!item.is_object()) {
     fail(field, "must be an object {\"name\": ..., ...}, not " + shown(item));
   }
@@ -98,8 +98,17 @@ Waypoint fromJson(const json& item, const std::string& field) {
       }
     }
     waypoint.kind = Waypoint::Kind::kJoints;
-    const auto joints =
-        numbers(item.at("joints"), field + ".joints", kJointCount, std::to_string(kJointCount) + " angles (radians)");
+    const json& list = item.at("joints");
+    const std::size_t count = joint_count > 0 ? static_cast<std::size_t>(joint_count)
+                              : list.is_array() && !list.empty() && list.size() <= kMaxJoints ? list.size()
+                                                                                              : 0;
+    const std::string expected = joint_count > 0 ? std::to_string(joint_count) + " angles (radians)"
+                                                 : "1 to " + std::to_string(kMaxJoints) + " angles (radians)";
+    if (count == 0) {
+      fail(field + ".joints", "must be " + expected + ", not " + shown(list));
+    }
+    const auto joints = numbers(list, field + ".joints", count, expected);
+    waypoint.joints = JointVector(static_cast<int>(joints.size()));
     std::copy(joints.begin(), joints.end(), waypoint.joints.begin());
     return waypoint;
   }
@@ -135,7 +144,12 @@ Waypoint fromJson(const json& item, const std::string& field) {
 
 }  // namespace
 
-WaypointStore::WaypointStore(std::filesystem::path file, bool persist) : file_(std::move(file)), persist_(persist) {
+WaypointStore::WaypointStore(std::filesystem::path file, bool persist, int joint_count)
+    : file_(std::move(file)), persist_(persist), joint_count_(joint_count) {
+  if (joint_count_ < 0 || joint_count_ > kMaxJoints) {
+    throw std::invalid_argument("WaypointStore: joint_count must be 0 (any) to " + std::to_string(kMaxJoints) +
+                                ", not " + std::to_string(joint_count_));
+  }
   if (file_.empty()) {
     return;
   }
@@ -174,7 +188,7 @@ WaypointStore::WaypointStore(std::filesystem::path file, bool persist) : file_(s
     std::map<std::string, std::size_t> index_of;
     for (std::size_t i = 0; i < list.size(); ++i) {
       const std::string field = "waypoints[" + std::to_string(i) + "]";
-      Waypoint waypoint = fromJson(list[i], field);
+      Waypoint waypoint = fromJson(list[i], field, joint_count_);
       if (const auto [previous, added] = index_of.emplace(waypoint.name, i); !added) {
         fail(field + ".name", "'" + waypoint.name + "' is taken already (by waypoints[" +
                                   std::to_string(previous->second) + "]); names must differ");
@@ -202,6 +216,12 @@ std::vector<Waypoint> WaypointStore::all() const {
 void WaypointStore::put(const Waypoint& waypoint) {
   if (const std::string problem = checkWaypointName(waypoint.name); !problem.empty()) {
     throw std::invalid_argument(problem);
+  }
+  if (waypoint.kind == Waypoint::Kind::kJoints &&
+      (waypoint.joints.empty() || (joint_count_ > 0 && waypoint.joints.size() != joint_count_))) {
+    throw std::invalid_argument("waypoint '" + waypoint.name + "' has " + std::to_string(waypoint.joints.size()) +
+                                " joint angles, the arm " +
+                                (joint_count_ > 0 ? std::to_string(joint_count_) : std::string("at least one")));
   }
   auto previous = waypoints_;
   waypoints_[waypoint.name] = waypoint;

@@ -31,8 +31,10 @@ class WaypointStore {
  public:
   /// Loads `file` if it exists (an empty store otherwise). Changes are saved to it when
   /// `persist`; an empty path or persist = false keeps changes in memory only.
+  /// `joint_count`: the number of joints of the arm, which every joint waypoint in the file must
+  /// have; 0 accepts any count from 1 to kMaxJoints (a reader that knows no robot).
   /// @throws std::runtime_error naming the file when it cannot be read.
-  explicit WaypointStore(std::filesystem::path file = {}, bool persist = true);
+  explicit WaypointStore(std::filesystem::path file = {}, bool persist = true, int joint_count = 0);
 
   std::optional<Waypoint> find(const std::string& name) const;
   std::vector<Waypoint> all() const;
@@ -49,6 +51,7 @@ class WaypointStore {
   void save() const;
   std::filesystem::path file_;
   bool persist_ = true;
+  int joint_count_ = 0;
   std::map<std::string, Waypoint> waypoints_;
 };
 

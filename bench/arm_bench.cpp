@@ -24,6 +24,9 @@
 namespace costar::bench {
 namespace {
 
+/// The UR5's joints.
+constexpr int kJointCount = arm::Ur5Kinematics::kJointCount;
+
 using arm::JointVector;
 using arm::Ur5Kinematics;
 
@@ -38,7 +41,7 @@ const std::vector<world::Pose>& randomReachablePoses() {
     std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
     std::vector<world::Pose> result;
     for (int k = 0; k < kPoseCount; ++k) {
-      JointVector q;
+      JointVector q = JointVector::zero(kJointCount);
       for (double& value : q) {
         value = angle(random);
       }
@@ -71,9 +74,10 @@ BENCHMARK(BM_Ur5ClosedFormInverse);
 
 void BM_Ur5ClosedFormInverseNearest(benchmark::State& state) {
   // The usual call in a Cartesian move: the solution nearest the current joint angles, within
-  // the UR5's limits. Seeds are the generating configurations, nudged.
+  // the UR5's limits, through the Kinematics interface (as the arm and SmartMove call it).
+  // Seeds are the generating configurations, nudged.
   const Ur5Kinematics kinematics;
-  const arm::JointLimits limits = arm::JointLimits::ur5();
+  const arm::Kinematics& generic = kinematics;
   const std::vector<world::Pose>& poses = randomReachablePoses();
   std::vector<JointVector> seeds;
   std::mt19937_64 random(7);
@@ -87,7 +91,7 @@ void BM_Ur5ClosedFormInverseNearest(benchmark::State& state) {
   }
   std::size_t next = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(kinematics.inverseNearest(poses[next], seeds[next], &limits));
+    benchmark::DoNotOptimize(generic.inverseNearest(poses[next], seeds[next]));
     next = (next + 1) % poses.size();
   }
   state.counters["solves_per_s"] =
@@ -97,7 +101,7 @@ BENCHMARK(BM_Ur5ClosedFormInverseNearest);
 
 KDL::Chain ur5Chain(const arm::DhParameters& dh) {
   KDL::Chain chain;
-  for (int i = 0; i < arm::kJointCount; ++i) {
+  for (int i = 0; i < kJointCount; ++i) {
     chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotZ), KDL::Frame::DH(dh.a[i], dh.alpha[i], dh.d[i], 0.0)));
   }
   return chain;
@@ -120,19 +124,19 @@ void BM_KdlLmaInverse(benchmark::State& state) {
     targets.push_back(toKdl(pose));
   }
   // Every solve starts from the same seed, a common "ready" configuration of the UR5.
-  KDL::JntArray seed(arm::kJointCount);
-  const double ready[arm::kJointCount] = {
+  KDL::JntArray seed(kJointCount);
+  const double ready[kJointCount] = {
       0.0, -std::numbers::pi / 2, std::numbers::pi / 2, -std::numbers::pi / 2, -std::numbers::pi / 2, 0.0};
-  for (int j = 0; j < arm::kJointCount; ++j) {
+  for (int j = 0; j < kJointCount; ++j) {
     seed(j) = ready[j];
   }
-  KDL::JntArray result(arm::kJointCount);
+  KDL::JntArray result(kJointCount);
   std::vector<int> statuses(poses.size(), 0);
-  std::vector<JointVector> answers(poses.size());
+  std::vector<JointVector> answers(poses.size(), JointVector::zero(kJointCount));
   std::size_t next = 0;
   for (auto _ : state) {
     statuses[next] = solver.CartToJnt(seed, targets[next], result);
-    for (int j = 0; j < arm::kJointCount; ++j) {
+    for (int j = 0; j < kJointCount; ++j) {
       answers[next][j] = result(j);
     }
     next = (next + 1) % poses.size();

@@ -7,6 +7,8 @@
 #include <random>
 
 #include "arm/arm_component.h"
+#include "arm/robot_description.h"
+#include "arm/ur5_kinematics.h"
 #include "core/paths.h"
 #include "smartmove/smartmove.h"
 
@@ -41,11 +43,12 @@ class NoGripper final : public component::LocalComponent {
 struct Cell {
   Cell()
       : robot(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp")),
-        collisions(robot, kBase, {.padding = 0.005}, {Eigen::Map<const Eigen::VectorXd>(kHome.data(), 6)}),
+        collisions(robot, kBase, {.padding = 0.005}, {kHome.eigen()}),
         driver(kHome),
         grasps(dataRoot() / "data/grasps.json", {}),
-        arm(driver, clock, collisions, waypoints, nullptr, config()),
-        smartmove(arm, gripper, world, collisions, world::loadObjectClasses(dataRoot() / "data/objects"), grasps) {
+        arm(driver, clock, collisions, waypoints, nullptr, std::make_shared<arm::Ur5Kinematics>(), config()),
+        smartmove(arm, gripper, world, collisions, world::loadObjectClasses(dataRoot() / "data/objects"), grasps,
+                  smartmoveConfig()) {
     collisions.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
     collisions.allow("base_link", "table");
     // 20 nodes at random on the table, any yaw, 6 cm apart at least.
@@ -72,6 +75,12 @@ struct Cell {
     arm::ArmConfig c;
     c.base_in_world = kBase;
     c.home = kHome;
+    c.tcp_in_flange = world::Pose(Eigen::Translation3d(0, 0, 0.14));
+    return c;
+  }
+  static smartmove::SmartMoveConfig smartmoveConfig() {
+    smartmove::SmartMoveConfig c;
+    c.gripper_links = arm::loadRobotDescription(arm::robotDescriptionFile("ur5")).gripper_links;
     return c;
   }
   static inline const arm::JointVector kHome = {0.0, -2.3, 1.9, -M_PI / 2 + 0.4, -M_PI / 2, 0.0};

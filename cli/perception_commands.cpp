@@ -231,7 +231,7 @@ struct CollectOptions {
 /// Random joint configurations that put the gripper over the table in the camera's view.
 std::optional<sim::ArmJoints> armOverTable(std::mt19937_64& random) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  sim::ArmJoints q{};
+  sim::ArmJoints q = sim::ArmJoints::zero(6);  // the UR5's
   q[0] = -0.9 + 1.8 * unit(random);
   q[1] = -2.3 + 1.3 * unit(random);
   q[2] = 0.6 + 1.6 * unit(random);

@@ -180,9 +180,9 @@ json Engine::buildState() const {
         }
       } else if (const world::JointsValue* joints = symbol->joints()) {
         item["kind"] = "joints";
-        if (arm != nullptr && joints->positions.size() == arm::kJointCount) {
-          arm::JointVector q{};
-          std::copy(joints->positions.begin(), joints->positions.end(), q.begin());
+        if (arm != nullptr && joints->positions.size() == static_cast<std::size_t>(arm->jointCount())) {
+          const arm::JointVector q = arm::JointVector::fromEigen(
+              Eigen::Map<const Eigen::VectorXd>(joints->positions.data(), arm->jointCount()));
           item.update(poseJson(arm->toolAt(q)));
         }
       }

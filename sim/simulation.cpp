@@ -18,9 +18,6 @@ namespace costar::sim {
 
 namespace {
 
-constexpr std::array<const char*, 6> kArmJoints = {"shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint",
-                                                   "wrist_1_joint",      "wrist_2_joint",       "wrist_3_joint"};
-
 // Computed-torque gains: critically damped, 8 Hz bandwidth.
 constexpr double kArmOmega = 50.0;
 constexpr double kArmKp = kArmOmega * kArmOmega;
@@ -78,9 +75,10 @@ std::string partBody(const PartPlacement& part, const world::ObjectClass& object
 
 }  // namespace
 
-const std::array<const char*, 6>& armJointNames() { return kArmJoints; }
-
-ArmJoints Simulation::homeConfiguration() { return {0.0, -2.3, 1.9, -M_PI / 2 + 0.4, -M_PI / 2, 0.0}; }
+ArmJoints Simulation::homeConfiguration() {
+  static const ArmJoints home = arm::loadRobotDescription(arm::robotDescriptionFile(kDefaultRobot)).home;
+  return home;
+}
 
 // --- implementation ------------------------------------------------------------------------
 
@@ -91,8 +89,10 @@ struct Simulation::Impl {
   std::vector<PartPlacement> placements;
   std::vector<int> part_bodies;
 
-  std::array<int, 6> arm_qpos{};
-  std::array<int, 6> arm_dof{};
+  std::vector<std::string> arm_joint_names;
+  int arm_joints = 0;  // the arm's joints, at most arm::kMaxJoints
+  std::array<int, arm::kMaxJoints> arm_qpos{};
+  std::array<int, arm::kMaxJoints> arm_dof{};
   int finger_qpos = 0;
   int finger_dof = 0;
   int finger_actuator = 0;
@@ -103,7 +103,6 @@ struct Simulation::Impl {
   int tcp_site = 0;
   int rgbd_camera = 0;
   int first_arm_body = 0;
-  int tool_body = 0;
 
   std::int64_t steps = 0;         // physics steps since time 0
   std::int64_t settle_steps = 0;  // steps taken before time 0
@@ -163,18 +162,21 @@ struct Simulation::Impl {
   void control() {
     // Arm: computed torque, tau = M (qdd_d + Kp e + Kd de) + bias, clamped by the actuators.
     const TimePoint t = now();
-    const ArmSetpoint setpoint = setpoint_source ? setpoint_source(t) : held;
-    if (setpoint_source) {
-      held = {setpoint.position, {}, {}};
+    ArmSetpoint setpoint = setpoint_source ? setpoint_source(t) : held;
+    if (setpoint.position.size() != arm_joints || setpoint.velocity.size() != arm_joints ||
+        setpoint.acceleration.size() != arm_joints) {
+      setpoint = held;  // a setpoint for another arm: hold where the last good one was
+    } else if (setpoint_source) {
+      held = {setpoint.position, ArmJoints::zero(arm_joints), ArmJoints::zero(arm_joints)};
     }
     std::fill(acceleration.begin(), acceleration.end(), 0.0);
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < arm_joints; ++i) {
       const double error = setpoint.position[i] - data->qpos[arm_qpos[i]];
       const double rate_error = setpoint.velocity[i] - data->qvel[arm_dof[i]];
       acceleration[arm_dof[i]] = setpoint.acceleration[i] + kArmKp * error + kArmKd * rate_error;
     }
     mj_mulM(model, data, torque.data(), acceleration.data());
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < arm_joints; ++i) {
       data->ctrl[i] = torque[arm_dof[i]] + data->qfrc_bias[arm_dof[i]];
     }
     // Gripper: the servo setpoint moves toward the target at the commanded speed.
@@ -235,8 +237,13 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->placements = placeParts(scene, impl->classes, options.placement_seed);
   impl->noise = options.depth_noise;
 
+  // The robot: its description names the model, the joints, home and links. The default
+  // robot's model files are read from `root`, like everything else.
+  const arm::RobotDescription robot =
+      options.robot ? *options.robot : arm::loadRobotDescription(arm::robotDescriptionFile(kDefaultRobot), root);
+
   // Model: the workcell template plus a material per class colour and a body per part.
-  std::string xml = readText(root / "sim" / "models" / "ur5_workcell.xml");
+  std::string xml = readText(robot.mjcf);
   std::string assets;
   for (const auto& object : impl->classes) {
     for (const auto& [color_name, rgb] : object.colors) {
@@ -250,8 +257,8 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
                                      [&](const world::ObjectClass& c) { return c.name == part.object_class; });
     bodies += partBody(part, *object);
   }
-  // Textures and meshes named in the model are files in sim/models.
-  const std::string models = (root / "sim" / "models").string();
+  // Textures and meshes named in the model are files beside it.
+  const std::string models = robot.mjcf.parent_path().string();
   replaceMarker(
       xml, "<compiler angle=\"radian\" autolimits=\"true\"/>",
       "<compiler angle=\"radian\" autolimits=\"true\" texturedir=\"" + models + "\" meshdir=\"" + models + "\"/>");
@@ -275,8 +282,10 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->data = mj_makeData(impl->model);
   mjModel* m = impl->model;
 
-  for (int i = 0; i < 6; ++i) {
-    const int joint = impl->id(mjOBJ_JOINT, kArmJoints[i]);
+  impl->arm_joint_names = robot.joint_names;
+  impl->arm_joints = robot.jointCount();
+  for (int i = 0; i < impl->arm_joints; ++i) {
+    const int joint = impl->id(mjOBJ_JOINT, robot.joint_names[i].c_str());
     impl->arm_qpos[i] = m->jnt_qposadr[joint];
     impl->arm_dof[i] = m->jnt_dofadr[joint];
   }
@@ -290,8 +299,7 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->table_surface_geom = impl->id(mjOBJ_GEOM, "table_surface");
   impl->tcp_site = impl->id(mjOBJ_SITE, "tcp");
   impl->rgbd_camera = impl->id(mjOBJ_CAMERA, "rgbd");
-  impl->first_arm_body = impl->id(mjOBJ_BODY, "shoulder_link");
-  impl->tool_body = impl->id(mjOBJ_BODY, "tool0");
+  impl->first_arm_body = impl->id(mjOBJ_BODY, robot.first_moving_link.c_str());
   for (const auto& part : impl->placements) {
     impl->part_bodies.push_back(impl->id(mjOBJ_BODY, part.name.c_str()));
   }
@@ -303,11 +311,15 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->torque.assign(m->nv, 0.0);
 
   // Start at the initial configuration, fingers open, and let the parts settle.
-  const ArmJoints initial = options.initial_arm.value_or(homeConfiguration());
-  for (int i = 0; i < 6; ++i) {
+  const ArmJoints initial = options.initial_arm.value_or(robot.home);
+  if (initial.size() != impl->arm_joints) {
+    throw std::runtime_error("the initial arm configuration has " + std::to_string(initial.size()) +
+                             " joints, the arm " + std::to_string(impl->arm_joints));
+  }
+  for (int i = 0; i < impl->arm_joints; ++i) {
     impl->data->qpos[impl->arm_qpos[i]] = initial[i];
   }
-  impl->held.position = initial;
+  impl->held = {initial, ArmJoints::zero(impl->arm_joints), ArmJoints::zero(impl->arm_joints)};
   impl->data->qpos[impl->finger_qpos] = kMaxOpening / 2;
   impl->data->qpos[m->jnt_qposadr[impl->id(mjOBJ_JOINT, "right_finger_joint")]] = kMaxOpening / 2;
   mj_forward(m, impl->data);
@@ -348,17 +360,19 @@ void Simulation::detach() {
   }
 }
 
+const std::vector<std::string>& Simulation::armJointNames() const { return impl_->arm_joint_names; }
+
 ArmJoints Simulation::armPositions() const {
-  ArmJoints q{};
-  for (int i = 0; i < 6; ++i) {
+  ArmJoints q = ArmJoints::zero(impl_->arm_joints);
+  for (int i = 0; i < impl_->arm_joints; ++i) {
     q[i] = impl_->data->qpos[impl_->arm_qpos[i]];
   }
   return q;
 }
 
 ArmJoints Simulation::armVelocities() const {
-  ArmJoints v{};
-  for (int i = 0; i < 6; ++i) {
+  ArmJoints v = ArmJoints::zero(impl_->arm_joints);
+  for (int i = 0; i < impl_->arm_joints; ++i) {
     v[i] = impl_->data->qvel[impl_->arm_dof[i]];
   }
   return v;

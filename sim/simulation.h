@@ -25,6 +25,8 @@
 #include <string>
 #include <vector>
 
+#include "arm/joints.h"
+#include "arm/robot_description.h"
 #include "camera/rgbd.h"
 #include "core/clock.h"
 #include "core/image.h"
@@ -34,7 +36,8 @@
 
 namespace costar::sim {
 
-using ArmJoints = std::array<double, 6>;
+/// One value per arm joint (as many as the robot has).
+using ArmJoints = arm::JointVector;
 
 /// Where the arm should be at a given time.
 struct ArmSetpoint {
@@ -43,10 +46,16 @@ struct ArmSetpoint {
   ArmJoints acceleration{};
 };
 
+/// The robot a Simulation has when none is given: robots/ur5/ur5.json.
+inline constexpr const char* kDefaultRobot = "ur5";
+
 struct SimulationOptions {
   /// Folder with data/objects and sim/models (default: the repository, see core/paths.h).
   std::filesystem::path data_root;
-  /// Arm configuration at the start (radians). Default: the "home" pose, tool pointing down.
+  /// The arm: its MuJoCo model (the workcell around it), joint names, home and links. Default:
+  /// kDefaultRobot's description, its model files under `data_root`.
+  std::optional<arm::RobotDescription> robot;
+  /// Arm configuration at the start (radians). Default: the robot's home, tool pointing down.
   std::optional<ArmJoints> initial_arm;
   /// Seed of the random part placement (default: the scene's seed).
   std::optional<std::uint64_t> placement_seed;
@@ -131,8 +140,10 @@ class Simulation {
   std::vector<std::pair<std::string, std::string>> contacts() const;
   const std::vector<world::ObjectClass>& objectClasses() const;
 
-  /// The arm's "home" configuration: tool pointing down above the table.
+  /// The default robot's "home" configuration: tool pointing down above the table.
   static ArmJoints homeConfiguration();
+  /// The arm's joints as the model names them, base first.
+  const std::vector<std::string>& armJointNames() const;
 
  private:
   struct Impl;
@@ -141,6 +152,5 @@ class Simulation {
 };
 
 /// The UR5's joint names in the simulator and the URDF, in order.
-const std::array<const char*, 6>& armJointNames();
 
 }  // namespace costar::sim

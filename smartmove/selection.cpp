@@ -11,7 +11,7 @@ namespace {
 
 double jointDistance(const arm::JointVector& a, const arm::JointVector& b) {
   double sum = 0.0;
-  for (int j = 0; j < arm::kJointCount; ++j) {
+  for (int j = 0; j < a.size(); ++j) {
     sum += std::abs(a[j] - b[j]);
   }
   return sum;

@@ -292,7 +292,7 @@ namespace {
 std::optional<arm::JointVector> freeConfiguration(const std::vector<arm::JointVector>& solutions,
                                                   const planning::CollisionWorld& collisions, std::string& reason) {
   for (const auto& q : solutions) {
-    const auto contact = collisions.check(Eigen::Map<const Eigen::VectorXd>(q.data(), arm::kJointCount));
+    const auto contact = collisions.check(q.eigen());
     if (!contact) {
       return q;
     }

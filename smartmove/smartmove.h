@@ -54,8 +54,9 @@ struct SmartMoveConfig {
   /// part, once put down and detected again (placement and perception error), still satisfies
   /// them rather than sitting in the predicates' dead band.
   double table_spot_margin = 0.02;
-  /// Robot links that may touch the part being grasped (the gripper).
-  std::vector<std::string> gripper_links = {"tool0", "wrist_3_link"};
+  /// Robot links that may touch the part being grasped (the gripper): the robot
+  /// description's links.gripper (arm/robot_description.h).
+  std::vector<std::string> gripper_links;
   CostWeights weights;
 };
 

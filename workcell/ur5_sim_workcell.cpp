@@ -1,6 +1,7 @@
 #include "workcell/ur5_sim_workcell.h"
 
 #include "arm/arm_component.h"
+#include "arm/robot_description.h"
 #include "core/paths.h"
 #include "faults/injector.h"
 #include "gripper/parallel_gripper.h"
@@ -96,18 +97,19 @@ class Ur5SimWorkcell final : public Workcell {
  public:
   explicit Ur5SimWorkcell(const WorkcellOptions& options)
       : Workcell(std::make_unique<SimClock>()),
+        robot_description_(arm::loadRobotDescription(arm::robotDescriptionFile("ur5"))),
         scene_(sim::loadScene(options.scene.empty() ? dataRoot() / "sim/scenes/assembly.json" : options.scene)),
-        simulation_(sim::Simulation::create(scene_, simOptions(options))),
+        simulation_(sim::Simulation::create(scene_, simOptions(options, robot_description_))),
         arm_driver_(*simulation_),
         gripper_driver_(*simulation_),
         camera_(*simulation_, options.seed.value_or(scene_.seed)),
-        robot_(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp")),
-        collisions_(robot_, kBaseInWorld, {.padding = 0.005, .resolution = 0.01},
-                    {toEigen(sim::Simulation::homeConfiguration())}),
+        robot_(planning::RobotModel::fromUrdf(robot_description_.urdf, robot_description_.urdf_base_link,
+                                              robot_description_.urdf_tool_link)),
+        collisions_(robot_, kBaseInWorld, {.padding = 0.005, .resolution = 0.01}, {toEigen(robot_description_.home)}),
         waypoints_(!options.waypoints.empty()
                        ? options.waypoints
                        : (options.memory_only ? std::filesystem::path() : defaultWaypointFile("ur5-sim")),
-                   /*persist=*/!options.memory_only),
+                   /*persist=*/!options.memory_only, robot_description_.jointCount()),
         grasps_(dataRoot() / "data/grasps.json",
                 options.memory_only ? std::filesystem::path() : defaultGraspFile("ur5-sim")),
         faults_(options.faults) {
@@ -123,16 +125,21 @@ class Ur5SimWorkcell final : public Workcell {
       components().add(faults_ ? faults_->wrap(std::move(component)) : std::move(component));
     };
     collisions_.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
-    collisions_.allow("base_link", "table");  // the robot stands on it
+    collisions_.allow(robot_description_.base_link, "table");  // the robot stands on it
     // The tool stays above the table top, within the cell.
     collisions_.setWorkspace(Eigen::AlignedBox3d(Eigen::Vector3d(-0.45, -0.65, 0.0), Eigen::Vector3d(1.05, 0.65, 1.2)));
 
     arm::ArmConfig arm_config;
+    arm_config.type = robot_description_.type;
     arm_config.base_in_world = kBaseInWorld;
-    arm_config.home = sim::Simulation::homeConfiguration();
+    arm_config.home = robot_description_.home;
+    arm_config.tcp_in_flange = robot_description_.tool_in_flange;
+    arm_config.joint_names = robot_description_.joint_names;
+    arm_config.joint_labels = robot_description_.joint_labels;
     auto arm = std::make_shared<arm::ArmComponent>(
         arm_driver, clock(), collisions_, waypoints_,
-        [this](const std::string& frame) { return components().world().worldPose(frame); }, arm_config);
+        [this](const std::string& frame) { return components().world().worldPose(frame); },
+        arm::makeKinematics(robot_description_), arm_config);
     // SmartMove reaches the gripper through its operations, as the tree does: the same (possibly
     // fault-injected) component the registry holds.
     std::shared_ptr<component::Component> gripper = std::make_shared<gripper::ParallelGripper>(gripper_driver, clock());
@@ -152,8 +159,10 @@ class Ur5SimWorkcell final : public Workcell {
       add(std::make_shared<perception::PerceptionComponent>(camera, clock(), threadPipeline(perception_config),
                                                             perception_config));
     }
-    smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(*arm, *gripper, components().world(), collisions_,
-                                                                 simulation_->objectClasses(), grasps_);
+    smartmove::SmartMoveConfig smartmove_config;
+    smartmove_config.gripper_links = robot_description_.gripper_links;
+    smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(
+        *arm, *gripper, components().world(), collisions_, simulation_->objectClasses(), grasps_, smartmove_config);
     add(smartmove_);
     // Last: it derives its predicates from what the others report.
     add(std::make_shared<predicator::Predicator>(components().world(), simulation_->objectClasses()));
@@ -193,13 +202,15 @@ class Ur5SimWorkcell final : public Workcell {
   sim::Simulation* simulation() override { return simulation_.get(); }
 
  private:
-  static sim::SimulationOptions simOptions(const WorkcellOptions& options) {
+  static sim::SimulationOptions simOptions(const WorkcellOptions& options, const arm::RobotDescription& robot) {
     sim::SimulationOptions sim_options;
+    sim_options.robot = robot;
     sim_options.placement_seed = options.seed;
     return sim_options;
   }
-  static Eigen::VectorXd toEigen(const sim::ArmJoints& q) { return Eigen::Map<const Eigen::VectorXd>(q.data(), 6); }
+  static Eigen::VectorXd toEigen(const sim::ArmJoints& q) { return q.eigen(); }
 
+  arm::RobotDescription robot_description_;
   sim::Scene scene_;
   std::unique_ptr<sim::Simulation> simulation_;
   sim::SimArmDriver arm_driver_;

@@ -1,5 +1,6 @@
 // The hot paths allocate nothing: the array overload of the inverse kinematics,
-// inverseNearest(), and sampling a trajectory. Counted, not timed.
+// nearestWithin(), the Kinematics interface's inverse(), solutionsNear() and inverseNearest(),
+// and sampling a trajectory. Counted, not timed.
 
 #include <gtest/gtest.h>
 
@@ -12,13 +13,16 @@
 namespace costar::arm {
 namespace {
 
+/// The UR5's joints.
+constexpr int kJointCount = arm::Ur5Kinematics::kJointCount;
+
 TEST(ArmAllocation, NoneInInverseKinematics) {
   const Ur5Kinematics kinematics;
   std::mt19937_64 random(21);
   std::uniform_real_distribution<double> angle(-3.0, 3.0);
   std::vector<world::Pose> poses;
   for (int k = 0; k < 100; ++k) {
-    JointVector q;
+    JointVector q = JointVector::zero(kJointCount);
     for (double& value : q) {
       value = angle(random);
     }
@@ -30,10 +34,22 @@ TEST(ArmAllocation, NoneInInverseKinematics) {
   const std::uint64_t before = bench::allocations();
   for (const world::Pose& pose : poses) {
     total += kinematics.inverse(pose, solutions);
-    total += kinematics.inverseNearest(pose, JointVector{}, &limits).has_value();
+    total += kinematics.nearestWithin(pose, JointVector::zero(kJointCount), &limits).has_value();
   }
   EXPECT_EQ(bench::allocations() - before, 0u);
   EXPECT_GT(total, 100);
+  // Through the interface, as the arm component and SmartMove call it.
+  const Kinematics& generic = kinematics;
+  IkSolutions found;
+  const JointVector seed = {0.1, -1.5, 1.5, -1.5, -1.5, 0.0};
+  const std::uint64_t before_generic = bench::allocations();
+  for (const world::Pose& pose : poses) {
+    generic.inverse(pose, seed, found);
+    generic.solutionsNear(pose, seed, found);
+    total += found.size();
+    total += generic.inverseNearest(pose, seed).has_value();
+  }
+  EXPECT_EQ(bench::allocations() - before_generic, 0u);
 }
 
 TEST(ArmAllocation, NoneWhenSampling) {

@@ -2,6 +2,7 @@
 // what it refuses and why, cancelling, teaching, waypoints and predicates.
 
 #include "arm/arm_component.h"
+#include "arm/ur5_kinematics.h"
 
 #include <gtest/gtest.h>
 
@@ -53,11 +54,11 @@ class ArmTest : public ::testing::Test {
  protected:
   ArmTest()
       : robot(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp")),
-        collisions(robot, kBase, {.padding = 0.005}, {Eigen::Map<const Eigen::VectorXd>(kHome.data(), 6)}),
+        collisions(robot, kBase, {.padding = 0.005}, {kHome.eigen()}),
         driver(clock, kHome),
         arm(
             driver, clock, collisions, waypoints, [this](const std::string& frame) { return frame_lookup(frame); },
-            config()) {
+            std::make_shared<Ur5Kinematics>(), config()) {
     collisions.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
     collisions.allow("base_link", "table");
   }
@@ -66,6 +67,7 @@ class ArmTest : public ::testing::Test {
     ArmConfig c;
     c.base_in_world = kBase;
     c.home = kHome;
+    c.tcp_in_flange = world::Pose(Eigen::Translation3d(0, 0, 0.14));
     return c;
   }
 
@@ -165,7 +167,7 @@ TEST_F(ArmTest, ABlockedStraightMotionIsPlannedAroundTheObstacle) {
   const auto& trajectory = *driver.executed.back();
   for (Duration t{}; t <= trajectory.duration(); t += std::chrono::milliseconds(5)) {
     const JointVector q = trajectory.sample(t).position;
-    EXPECT_FALSE(collisions.check(Eigen::Map<const Eigen::VectorXd>(q.data(), 6)).has_value());
+    EXPECT_FALSE(collisions.check(q.eigen()).has_value());
   }
 }
 
@@ -180,7 +182,7 @@ TEST_F(ArmTest, MoveRelativeFollowsAStraightLine) {
   const auto& trajectory = *driver.executed.back();
   Ur5Kinematics kinematics;
   for (Duration t{}; t <= trajectory.duration(); t += std::chrono::milliseconds(10)) {
-    const world::Pose tcp = kBase * kinematics.forward(trajectory.sample(t).position) * ArmConfig{}.tcp_in_flange;
+    const world::Pose tcp = kBase * kinematics.forward(trajectory.sample(t).position) * config().tcp_in_flange;
     EXPECT_LT((tcp.translation().head<2>() - Eigen::Vector2d(0.45, 0.1)).norm(), 1e-3);
   }
   const OperationResult into_table =

@@ -15,6 +15,9 @@
 namespace costar::arm {
 namespace {
 
+/// The UR5's joints.
+constexpr int kJointCount = arm::Ur5Kinematics::kJointCount;
+
 using std::chrono::milliseconds;
 using testing::HasSubstr;
 
@@ -32,7 +35,7 @@ double norm(const JointVector& v) {
 }
 
 JointVector minus(const JointVector& a, const JointVector& b) {
-  JointVector result;
+  JointVector result = JointVector::zero(kJointCount);
   for (int j = 0; j < kJointCount; ++j) {
     result[j] = a[j] - b[j];
   }
@@ -69,8 +72,8 @@ double distanceToSegment(const JointVector& point, const JointVector& start, con
 // `visit` sees every sample.
 void checkMotion(const JointTrajectory& trajectory, const JointLimits& limits, double scale, bool check_position_limits,
                  const std::function<void(Duration, const TrajectoryPoint&)>& visit = {}) {
-  JointVector max_velocity;
-  JointVector max_acceleration;
+  JointVector max_velocity = JointVector::zero(kJointCount);
+  JointVector max_acceleration = JointVector::zero(kJointCount);
   for (int j = 0; j < kJointCount; ++j) {
     max_velocity[j] = limits.max_velocity[j] * scale * (1.0 + kLimitSlack);
     max_acceleration[j] = limits.max_acceleration[j] * scale * (1.0 + kLimitSlack);
@@ -147,7 +150,7 @@ void expectAtRestAt(const TrajectoryPoint& point, const JointVector& position, d
 }
 
 JointVector randomInside(std::mt19937_64& random, const JointLimits& limits, double margin = 0.0) {
-  JointVector q;
+  JointVector q = JointVector::zero(kJointCount);
   for (int j = 0; j < kJointCount; ++j) {
     q[j] = std::uniform_real_distribution<double>(limits.min_position[j] + margin,
                                                   limits.max_position[j] - margin)(random);
@@ -177,7 +180,7 @@ std::pair<JointVector, JointVector> randomMove(std::mt19937_64& random, const Jo
   const JointVector from = randomInside(random, limits);
   const double spans[] = {1e-3, 0.3, 20.0};
   const double span = spans[std::uniform_int_distribution<int>(0, 2)(random)];
-  JointVector to;
+  JointVector to = JointVector::zero(kJointCount);
   for (int j = 0; j < kJointCount; ++j) {
     to[j] = from[j] + std::uniform_real_distribution<double>(-span, span)(random);
   }
@@ -277,8 +280,8 @@ TEST(PointToPoint, NoMotionHasZeroDuration) {
 
 TEST(PointToPoint, RejectsInvalidInputWithClearMessages) {
   const JointLimits limits = JointLimits::ur5();
-  const JointVector zero{};
-  JointVector not_finite{};
+  const JointVector zero = JointVector::zero(kJointCount);
+  JointVector not_finite = JointVector::zero(kJointCount);
   not_finite[1] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(JointTrajectory::pointToPoint(zero, not_finite, limits, 1.0), std::invalid_argument);
   EXPECT_THROW(JointTrajectory::pointToPoint(not_finite, zero, limits, 1.0), std::invalid_argument);
@@ -287,7 +290,7 @@ TEST(PointToPoint, RejectsInvalidInputWithClearMessages) {
   }
   EXPECT_NO_THROW(JointTrajectory::pointToPoint(zero, zero, limits, 1.0));
 
-  JointVector beyond{};
+  JointVector beyond = JointVector::zero(kJointCount);
   beyond[2] = 2 * kPi + 0.5;
   try {
     JointTrajectory::pointToPoint(zero, beyond, limits, 1.0);
@@ -326,7 +329,7 @@ TEST(JointTrajectory, SampleClampsOutsideTheMotionAndCopiesAreEqual) {
   }
   const JointTrajectory empty;
   EXPECT_EQ(empty.duration(), Duration(0));
-  expectAtRestAt(empty.sample(Duration(0)), JointVector{}, 0.0);
+  EXPECT_TRUE(empty.sample(Duration(0)).position.empty());  // no joints: the length comes from a robot
 }
 
 // --- alongPath ---------------------------------------------------------------------------------
@@ -349,7 +352,7 @@ std::vector<JointVector> randomPath(std::mt19937_64& random, const JointLimits& 
     for (int step = 1; step <= steps; ++step) {
       world::Pose pose = start;
       pose.translation() += offset * (static_cast<double>(step) / steps);
-      const std::optional<JointVector> next = kinematics.inverseNearest(pose, path.back(), &limits);
+      const std::optional<JointVector> next = kinematics.nearestWithin(pose, path.back(), &limits);
       if (!next || distance(*next, path.back()) > 0.2) {
         break;  // out of reach or through a singularity: keep the path so far
       }
@@ -375,9 +378,9 @@ std::vector<JointVector> randomPath(std::mt19937_64& random, const JointLimits& 
   }
   const int count = std::uniform_int_distribution<int>(20, 200)(random);
   const JointVector centre = randomInside(random, limits, 1.5);
-  JointVector amplitude;
-  JointVector frequency;
-  JointVector phase;
+  JointVector amplitude = JointVector::zero(kJointCount);
+  JointVector frequency = JointVector::zero(kJointCount);
+  JointVector phase = JointVector::zero(kJointCount);
   for (int j = 0; j < kJointCount; ++j) {
     amplitude[j] = std::uniform_real_distribution<double>(0.01, 1.0)(random);
     frequency[j] = std::uniform_real_distribution<double>(0.5, 6.0)(random);
@@ -386,7 +389,7 @@ std::vector<JointVector> randomPath(std::mt19937_64& random, const JointLimits& 
   const double noise = kind == 2 ? std::uniform_real_distribution<double>(1e-4, 3e-3)(random) : 0.0;
   for (int k = 0; k < count; ++k) {
     const double s = static_cast<double>(k) / (count - 1);
-    JointVector point;
+    JointVector point = JointVector::zero(kJointCount);
     for (int j = 0; j < kJointCount; ++j) {
       point[j] = centre[j] + amplitude[j] * std::sin(frequency[j] * s + phase[j]) + noise * unit(random);
     }
@@ -509,7 +512,7 @@ TEST(AlongPath, TwoPointsOrCollinearPointsGiveThePointToPointMotion) {
     std::vector<JointVector> dense;
     const int count = 2 + trial % 300;
     for (int k = 0; k <= count; ++k) {
-      JointVector point;
+      JointVector point = JointVector::zero(kJointCount);
       for (int j = 0; j < kJointCount; ++j) {
         point[j] = from[j] + (to[j] - from[j]) * k / count;
       }
@@ -582,14 +585,14 @@ TEST(AlongPath, ReversalsAndSinglePoints) {
 TEST(AlongPath, RejectsInvalidInputWithClearMessages) {
   const JointLimits limits = JointLimits::ur5();
   EXPECT_THROW(JointTrajectory::alongPath({}, limits, 1.0), std::invalid_argument);
-  const JointVector zero{};
-  JointVector not_finite{};
+  const JointVector zero = JointVector::zero(kJointCount);
+  JointVector not_finite = JointVector::zero(kJointCount);
   not_finite[5] = std::numeric_limits<double>::infinity();
   EXPECT_THROW(JointTrajectory::alongPath({zero, not_finite}, limits, 1.0), std::invalid_argument);
   EXPECT_THROW(JointTrajectory::alongPath({zero, zero}, limits, 0.0), std::invalid_argument);
   EXPECT_THROW(JointTrajectory::alongPath({zero, zero}, limits, 1.0, 0.0), std::invalid_argument);
   EXPECT_THROW(JointTrajectory::alongPath({zero, zero}, limits, 1.0, -1.0), std::invalid_argument);
-  JointVector below{};
+  JointVector below = JointVector::zero(kJointCount);
   below[0] = -2 * kPi - 0.25;
   try {
     JointTrajectory::alongPath({zero, zero, below}, limits, 1.0);
@@ -617,8 +620,8 @@ TEST(StopFrom, StopsAlongTheDirectionOfMotionWithinTheAccelerationLimits) {
     const double scale = 0.2 + 0.8 * unit(random);
     // A state in the middle of a motion: a point-to-point move or a path.
     const bool straight = trial % 3 != 0;
-    JointVector from;
-    JointVector to;
+    JointVector from = JointVector::zero(kJointCount);
+    JointVector to = JointVector::zero(kJointCount);
     JointTrajectory moving;
     if (straight) {
       std::tie(from, to) = randomMove(random, limits);
@@ -668,6 +671,7 @@ TEST(StopFrom, StopsAlongTheDirectionOfMotionWithinTheAccelerationLimits) {
 TEST(StopFrom, AtRestStaysPut) {
   TrajectoryPoint state;
   state.position = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
+  state.velocity = JointVector::zero(kJointCount);
   state.acceleration = {1.0, 0.0, 0.0, 0.0, 0.0, 0.0};  // ignored
   const JointTrajectory stop = JointTrajectory::stopFrom(state, JointLimits::ur5());
   EXPECT_EQ(stop.duration(), Duration(0));
@@ -676,8 +680,46 @@ TEST(StopFrom, AtRestStaysPut) {
 
 TEST(StopFrom, RejectsNonFiniteStates) {
   TrajectoryPoint state;
+  state.position = JointVector::zero(kJointCount);
+  state.velocity = JointVector::zero(kJointCount);
   state.velocity[3] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(JointTrajectory::stopFrom(state, JointLimits::ur5()), std::invalid_argument);
+}
+
+TEST(JointLengths, TrajectoriesTakeTheirLengthFromTheLimits) {
+  // A 7-joint arm: the same generators, the length from the data.
+  JointLimits seven{JointVector(7, -3.0), JointVector(7, 3.0), JointVector(7, 1.5), JointVector(7, 4.0)};
+  const JointVector from = JointVector::zero(7);
+  const JointVector to = {0.5, -0.5, 1.0, 0.2, 0.0, -1.0, 2.0};
+  const JointTrajectory move = JointTrajectory::pointToPoint(from, to, seven, 1.0);
+  EXPECT_EQ(move.sample(Duration(0)).position.size(), 7);
+  EXPECT_EQ(move.finalPosition(), to);
+  // Joint 7 moves furthest (2 rad at 1.5 rad/s at most): it sets the duration.
+  EXPECT_GT(toSeconds(move.duration()), 2.0 / 1.5);
+  const JointTrajectory path = JointTrajectory::alongPath({from, to, from}, seven, 0.5);
+  EXPECT_EQ(path.finalPosition(), from);
+  // A 6-joint point against 7-joint limits is refused, naming both lengths.
+  try {
+    JointTrajectory::pointToPoint(JointVector::zero(6), JointVector::zero(6), seven, 1.0);
+    ADD_FAILURE() << "a 6-joint motion with 7-joint limits was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("has 6 joints, the limits 7"));
+  }
+  // Limits whose vectors differ in length are refused.
+  seven.max_velocity = JointVector(6, 1.5);
+  EXPECT_THROW(JointTrajectory::validate(seven), std::invalid_argument);
+}
+
+TEST(JointLengths, AJointVectorHoldsUpToItsCapacityWithoutAllocating) {
+  const JointVector q = {1, 2, 3, 4, 5, 6, 7, 8};
+  EXPECT_EQ(q.size(), kMaxJoints);
+  EXPECT_EQ(q.eigen().sum(), 36.0);
+  EXPECT_THROW(JointVector(kMaxJoints + 1), std::length_error);
+  EXPECT_THROW((JointVector{1, 2, 3, 4, 5, 6, 7, 8, 9}), std::length_error);
+  EXPECT_NE(JointVector::zero(6), JointVector::zero(7));  // lengths differ
+  EXPECT_EQ(JointVector::fromEigen(q.eigen()), q);
+  EXPECT_THROW(static_cast<void>(q.at(8)), std::out_of_range);
+  EXPECT_TRUE(JointVector().empty());
 }
 
 }  // namespace

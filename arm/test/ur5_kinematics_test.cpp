@@ -3,12 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <stdexcept>
 
 namespace costar::arm {
 namespace {
+
+/// The UR5's joints.
+constexpr int kJointCount = arm::Ur5Kinematics::kJointCount;
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
@@ -18,7 +22,7 @@ constexpr double kPoseTolerance = 1e-9;
 
 JointVector randomJoints(std::mt19937_64& random, double low = -kPi, double high = kPi) {
   std::uniform_real_distribution<double> angle(low, high);
-  JointVector q;
+  JointVector q = JointVector::zero(kJointCount);
   for (double& value : q) {
     value = angle(random);
   }
@@ -81,7 +85,7 @@ TEST(Ur5Kinematics, ForwardMatchesAnIndependentProductOfDhMatrices) {
 
 TEST(Ur5Kinematics, ZeroConfigurationIsTheArmStretchedAlongMinusX) {
   // Published UR5 zero pose: flange at (a2 + a3, -(d4 + d6), d1 - d5), tool z along -y.
-  const world::Pose flange = Ur5Kinematics().forward(JointVector{});
+  const world::Pose flange = Ur5Kinematics().forward(JointVector::zero(kJointCount));
   EXPECT_NEAR(flange.translation().x(), -0.425 - 0.39225, 1e-15);
   EXPECT_NEAR(flange.translation().y(), -0.10915 - 0.0823, 1e-15);
   EXPECT_NEAR(flange.translation().z(), 0.089159 - 0.09465, 1e-15);
@@ -266,7 +270,7 @@ TEST(Ur5Kinematics, UnreachablePosesHaveNoSolution) {
   const auto expect_none = [&](const world::Pose& pose, const char* what) {
     EXPECT_EQ(kinematics.inverse(pose, solutions), 0) << what;
     EXPECT_TRUE(kinematics.inverse(pose).empty()) << what;
-    EXPECT_FALSE(kinematics.inverseNearest(pose, JointVector{})) << what;
+    EXPECT_FALSE(kinematics.nearestWithin(pose, JointVector::zero(kJointCount))) << what;
   };
   expect_none(world::poseFromXyzRpy(2.0, 0.0, 0.3, 0.0, 0.0, 0.0), "beyond the reach");
   expect_none(world::poseFromXyzRpy(0.0, 0.0, 1.2, 0.0, 0.0, 0.0), "straight up, too high");
@@ -301,7 +305,7 @@ std::optional<JointVector> bruteForceNearest(const std::vector<JointVector>& sol
   std::optional<JointVector> best;
   double best_distance = std::numeric_limits<double>::infinity();
   for (const JointVector& solution : solutions) {
-    JointVector candidate;
+    JointVector candidate = JointVector::zero(kJointCount);
     double sum = 0.0;
     for (int j = 0; j < kJointCount; ++j) {
       double best_angle = std::numeric_limits<double>::quiet_NaN();
@@ -345,8 +349,8 @@ TEST(Ur5Kinematics, InverseNearestPicksTheClosestSolutionExpressedNearTheSeed) {
 
     // A seed near q, some joints a whole turn away: the answer is q expressed near the seed,
     // unless another solution is about as close (near a singularity).
-    JointVector seed;
-    JointVector expected;
+    JointVector seed = JointVector::zero(kJointCount);
+    JointVector expected = JointVector::zero(kJointCount);
     for (int j = 0; j < kJointCount; ++j) {
       expected[j] = q[j] + turns(random) * kTwoPi;
       seed[j] = expected[j] + nudge(random);
@@ -354,14 +358,14 @@ TEST(Ur5Kinematics, InverseNearestPicksTheClosestSolutionExpressedNearTheSeed) {
     double gap = std::numeric_limits<double>::infinity();  // to the nearest other solution
     for (const JointVector& solution : solutions) {
       if (maxWrappedDifference(solution, q) > 1e-6) {
-        JointVector difference;
+        JointVector difference = JointVector::zero(kJointCount);
         for (int j = 0; j < kJointCount; ++j) {
           difference[j] = wrapAngle(solution[j] - q[j]);
         }
-        gap = std::min(gap, euclidean(difference, JointVector{}));
+        gap = std::min(gap, euclidean(difference, JointVector::zero(kJointCount)));
       }
     }
-    const std::optional<JointVector> nearest = kinematics.inverseNearest(target, seed);
+    const std::optional<JointVector> nearest = kinematics.nearestWithin(target, seed);
     ASSERT_TRUE(nearest);
     if (gap > 0.2) {
       ++checked_near;
@@ -372,7 +376,7 @@ TEST(Ur5Kinematics, InverseNearestPicksTheClosestSolutionExpressedNearTheSeed) {
 
     // For a random seed, against the exhaustive search.
     const JointVector far_seed = randomJoints(random, -kTwoPi, kTwoPi);
-    const std::optional<JointVector> chosen = kinematics.inverseNearest(target, far_seed);
+    const std::optional<JointVector> chosen = kinematics.nearestWithin(target, far_seed);
     const std::optional<JointVector> best = bruteForceNearest(solutions, far_seed, nullptr);
     ASSERT_TRUE(chosen && best);
     EXPECT_NEAR(euclidean(*chosen, far_seed), euclidean(*best, far_seed), 1e-9) << "trial " << trial;
@@ -392,14 +396,14 @@ TEST(Ur5Kinematics, InverseNearestRespectsJointLimits) {
   const std::vector<JointVector> solutions = kinematics.inverse(target);
 
   // Without limits: q itself.
-  const std::optional<JointVector> free = kinematics.inverseNearest(target, q);
+  const std::optional<JointVector> free = kinematics.nearestWithin(target, q);
   ASSERT_TRUE(free);
   EXPECT_LE(maxWrappedDifference(*free, q), 1e-9);
 
   // Elbow limited to negative angles: another solution, with q3 < 0, the nearest allowed.
   JointLimits limits = JointLimits::ur5();
   limits.max_position[2] = 0.0;
-  const std::optional<JointVector> limited = kinematics.inverseNearest(target, q, &limits);
+  const std::optional<JointVector> limited = kinematics.nearestWithin(target, q, &limits);
   ASSERT_TRUE(limited);
   EXPECT_LT((*limited)[2], 0.0);
   for (int j = 0; j < kJointCount; ++j) {
@@ -423,7 +427,7 @@ TEST(Ur5Kinematics, InverseNearestRespectsJointLimits) {
       random_limits.max_position[j] = random_limits.min_position[j] + bound(random);
     }
     const JointVector seed = randomJoints(random, -kTwoPi, kTwoPi);
-    const std::optional<JointVector> chosen = kinematics.inverseNearest(target, seed, &random_limits);
+    const std::optional<JointVector> chosen = kinematics.nearestWithin(target, seed, &random_limits);
     const std::optional<JointVector> best = bruteForceNearest(solutions, seed, &random_limits);
     ASSERT_EQ(chosen.has_value(), best.has_value()) << "trial " << trial;
     if (chosen) {
@@ -442,10 +446,10 @@ TEST(Ur5Kinematics, InverseNearestRespectsJointLimits) {
   seed[0] = q[0] + kTwoPi - 0.001;
   JointLimits tight = JointLimits::ur5();
   tight.max_position[0] = q[0] + kTwoPi - 0.01;
-  const std::optional<JointVector> unlimited = kinematics.inverseNearest(target, seed);
+  const std::optional<JointVector> unlimited = kinematics.nearestWithin(target, seed);
   ASSERT_TRUE(unlimited);
   EXPECT_NEAR((*unlimited)[0], q[0] + kTwoPi, 1e-9);
-  const std::optional<JointVector> wrapped = kinematics.inverseNearest(target, seed, &tight);
+  const std::optional<JointVector> wrapped = kinematics.nearestWithin(target, seed, &tight);
   ASSERT_TRUE(wrapped);
   EXPECT_LE((*wrapped)[0], tight.max_position[0]);
   EXPECT_NEAR(euclidean(*wrapped, seed), euclidean(*bruteForceNearest(solutions, seed, &tight), seed), 1e-9);
@@ -454,7 +458,7 @@ TEST(Ur5Kinematics, InverseNearestRespectsJointLimits) {
   JointLimits impossible = JointLimits::ur5();
   impossible.min_position[4] = 3.0;
   impossible.max_position[4] = 3.0;
-  EXPECT_FALSE(kinematics.inverseNearest(target, q, &impossible));
+  EXPECT_FALSE(kinematics.nearestWithin(target, q, &impossible));
 }
 
 TEST(Ur5Kinematics, InverseNearestKeepsTheSeedsQ6AtTheWristSingularity) {
@@ -463,22 +467,23 @@ TEST(Ur5Kinematics, InverseNearestKeepsTheSeedsQ6AtTheWristSingularity) {
   const world::Pose target = kinematics.forward(q);
   JointVector seed = q;
   seed[5] = 1.1;
-  const std::optional<JointVector> nearest = kinematics.inverseNearest(target, seed);
+  const std::optional<JointVector> nearest = kinematics.nearestWithin(target, seed);
   ASSERT_TRUE(nearest);
   EXPECT_DOUBLE_EQ((*nearest)[5], 1.1);
   EXPECT_LE(positionError(kinematics.forward(*nearest), target), kPoseTolerance);
   EXPECT_LE(rotationError(kinematics.forward(*nearest), target), kPoseTolerance);
   // Seeded with the configuration itself, it comes back.
-  const std::optional<JointVector> same = kinematics.inverseNearest(target, q);
+  const std::optional<JointVector> same = kinematics.nearestWithin(target, q);
   ASSERT_TRUE(same);
   EXPECT_LE(maxWrappedDifference(*same, q), 1e-9);
 }
 
 TEST(Ur5Kinematics, InverseNearestRejectsANonFiniteSeed) {
   const Ur5Kinematics kinematics;
-  JointVector seed{};
+  JointVector seed = JointVector::zero(kJointCount);
   seed[2] = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(kinematics.inverseNearest(kinematics.forward(JointVector{}), seed), std::invalid_argument);
+  EXPECT_THROW(kinematics.nearestWithin(kinematics.forward(JointVector::zero(kJointCount)), seed),
+               std::invalid_argument);
 }
 
 TEST(Ur5Kinematics, OtherUrArmsWork) {
@@ -511,6 +516,73 @@ TEST(Ur5Kinematics, RejectsParametersWithoutTheUrStructure) {
   DhParameters not_finite = DhParameters::ur5();
   not_finite.d[0] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(Ur5Kinematics{not_finite}, std::invalid_argument);
+}
+
+// --- the Kinematics interface --------------------------------------------------------------
+
+TEST(Kinematics, TheUr5ThroughTheInterfaceGivesItsClosedFormWithinItsLimits) {
+  const std::shared_ptr<const Kinematics> kinematics = std::make_shared<Ur5Kinematics>();
+  EXPECT_EQ(kinematics->jointCount(), 6);
+  EXPECT_EQ(kinematics->limits().max_velocity, JointLimits::ur5().max_velocity);
+  const Ur5Kinematics& concrete = static_cast<const Ur5Kinematics&>(*kinematics);
+  std::mt19937_64 random(5);
+  std::uniform_real_distribution<double> angle(-3.0, 3.0);
+  const JointLimits limits = JointLimits::ur5();
+  for (int trial = 0; trial < 200; ++trial) {
+    JointVector q = JointVector::zero(kJointCount);
+    for (double& value : q) {
+      value = angle(random);
+    }
+    const world::Pose target = kinematics->forward(q);
+    IkSolutions all;
+    kinematics->inverse(target, q, all);
+    EXPECT_EQ(all.size(), static_cast<int>(concrete.inverse(target, q[5]).size()));
+    // Nearest: the same as the closed form's own within the UR5's limits.
+    const auto nearest = kinematics->inverseNearest(target, q);
+    ASSERT_TRUE(nearest) << "trial " << trial;
+    EXPECT_EQ(*nearest, *concrete.nearestWithin(target, q, &limits));
+    EXPECT_LE(maxWrappedDifference(*nearest, q), 1e-9);
+    // solutionsNear: every solution within the limits, nearest first, the first the nearest.
+    IkSolutions near;
+    kinematics->solutionsNear(target, q, near);
+    ASSERT_FALSE(near.empty());
+    EXPECT_LE(maxWrappedDifference(near[0], q), 1e-9);
+    for (int k = 1; k < near.size(); ++k) {
+      EXPECT_LE((near[k - 1].eigen() - q.eigen()).norm(), (near[k].eigen() - q.eigen()).norm());
+    }
+    for (const JointVector& solution : near) {
+      EXPECT_LE(positionError(kinematics->forward(solution), target), kPoseTolerance);
+      for (int j = 0; j < kJointCount; ++j) {
+        EXPECT_GE(solution[j], limits.min_position[j]);
+        EXPECT_LE(solution[j], limits.max_position[j]);
+      }
+    }
+  }
+}
+
+TEST(Kinematics, InverseNearestSkipsWhatTheCallerRejects) {
+  const Ur5Kinematics kinematics;
+  const JointVector q = {0.3, -1.2, 1.4, -0.9, -1.5, 0.2};
+  const world::Pose target = kinematics.forward(q);
+  IkSolutions near;
+  kinematics.solutionsNear(target, q, near);
+  ASSERT_GE(near.size(), 2);
+  // Rejecting the nearest gives the second nearest; rejecting all gives none.
+  const auto second = kinematics.inverseNearest(
+      target, q, [&q](const JointVector& candidate) { return maxWrappedDifference(candidate, q) > 1e-6; });
+  ASSERT_TRUE(second);
+  EXPECT_LE(maxWrappedDifference(*second, near[1]), 1e-9);
+  EXPECT_FALSE(kinematics.inverseNearest(target, q, [](const JointVector&) { return false; }));
+  // The seed must be the arm's length.
+  EXPECT_THROW(kinematics.inverseNearest(target, JointVector::zero(7)), std::invalid_argument);
+}
+
+TEST(Kinematics, LimitsOfTheWrongLengthAreRefused) {
+  JointLimits seven{JointVector(7, -3.0), JointVector(7, 3.0), JointVector(7, 1.0), JointVector(7, 1.0)};
+  EXPECT_THROW(Ur5Kinematics(DhParameters::ur5(), seven), std::invalid_argument);
+  JointLimits broken = JointLimits::ur5();
+  broken.max_velocity[2] = 0.0;
+  EXPECT_THROW(Ur5Kinematics(DhParameters::ur5(), broken), std::invalid_argument);
 }
 
 }  // namespace

@@ -28,11 +28,11 @@ class WaypointFile : public ::testing::Test {
   }
 
   /// The error loading `content` gives, without the "waypoint file 'PATH': " prefix.
-  std::string problem(const std::string& content) {
+  std::string problem(const std::string& content, int joint_count = 6) {
     const auto file = write(content);
     const std::string prefix = "waypoint file '" + file.string() + "': ";
     try {
-      WaypointStore store(file);
+      WaypointStore store(file, /*persist=*/true, joint_count);
     } catch (const std::runtime_error& e) {
       const std::string message = e.what();
       return message.rfind(prefix, 0) == 0 ? message.substr(prefix.size()) : "(no file named) " + message;
@@ -70,6 +70,23 @@ TEST_F(WaypointFile, AZeroOrNonUnitQuaternionIsAnErrorNamingTheField) {
             "waypoints[0].orientation: must be a unit quaternion [w, x, y, z], not [2,0,0,0] (length 2)");
   EXPECT_EQ(problem(R"({"waypoints": [{"name": "p", "position": [0.4, 0, 0.2], "orientation": [1, 0, 0]}]})"),
             "waypoints[0].orientation: must be a unit quaternion [w, x, y, z], not [1,0,0]");
+}
+
+TEST_F(WaypointFile, TheJointCountComesFromTheArmOrIsAnyUpToTheCapacity) {
+  const std::string seven = R"({"waypoints": [{"name": "j", "joints": [0, 0, 0, 0, 0, 0, 0]}]})";
+  EXPECT_EQ(problem(seven, 7), "no error");
+  EXPECT_EQ(problem(seven, 0), "no error");  // a reader that knows no robot
+  EXPECT_EQ(WaypointStore(write(seven), false).find("j")->joints.size(), 7);
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "j", "joints": [0, 0, 0, 0, 0, 0, 0, 0, 0]}]})", 0),
+            "waypoints[0].joints: must be 1 to 8 angles (radians), not [0,0,0,0,0,0,0,0,0]");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "j", "joints": []}]})", 0),
+            "waypoints[0].joints: must be 1 to 8 angles (radians), not []");
+  WaypointStore six({}, false, 6);
+  Waypoint wrong;
+  wrong.name = "w";
+  wrong.kind = Waypoint::Kind::kJoints;
+  wrong.joints = JointVector::zero(7);
+  EXPECT_THROW(six.put(wrong), std::invalid_argument);
 }
 
 TEST_F(WaypointFile, TypeAndShapeErrorsNameTheField) {

@@ -18,6 +18,7 @@ class GoodArm final : public arm::ArmDriver {
   arm::ArmState read() const override {
     arm::ArmState state;
     state.position = {0.1, -1.0, 1.0, -1.5, -1.5, toSeconds(clock_.now())};  // wrist 3 turns with time
+    state.velocity = arm::JointVector::zero(6);
     state.stamp = clock_.now();
     return state;
   }

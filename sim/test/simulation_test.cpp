@@ -69,7 +69,7 @@ double moveArm(Simulation& sim, const ArmJoints& goal, double seconds) {
     const double blend = 3 * s * s - 2 * s * s * s;
     const double rate = (6 * s - 6 * s * s) / seconds;
     const double accel = (6 - 12 * s) / (seconds * seconds) * (s < 1.0 ? 1.0 : 0.0);
-    ArmSetpoint setpoint;
+    ArmSetpoint setpoint{ArmJoints::zero(6), ArmJoints::zero(6), ArmJoints::zero(6)};
     for (int i = 0; i < 6; ++i) {
       setpoint.position[i] = start[i] + (goal[i] - start[i]) * blend;
       setpoint.velocity[i] = (goal[i] - start[i]) * rate;
@@ -82,7 +82,7 @@ double moveArm(Simulation& sim, const ArmJoints& goal, double seconds) {
   for (TimePoint t = t0 + step; t <= t0 + fromSeconds(seconds + 0.3); t += step) {
     sim.stepTo(t);
     const double s = std::clamp(toSeconds(t - t0) / seconds, 0.0, 1.0);
-    ArmJoints expected{};
+    ArmJoints expected = ArmJoints::zero(6);
     for (int i = 0; i < 6; ++i) {
       expected[i] = start[i] + (goal[i] - start[i]) * (3 * s * s - 2 * s * s * s);
     }
@@ -99,7 +99,7 @@ TEST(Simulation, MujocoKinematicsMatchTheDhModelToATenthOfAMillimetre) {
   std::uniform_real_distribution<double> angle(-M_PI, M_PI);
   const Scene empty = sceneOf(R"({"parts": []})");
   for (int trial = 0; trial < 10; ++trial) {
-    ArmJoints q{};
+    ArmJoints q = ArmJoints::zero(6);
     for (double& joint : q) {
       joint = angle(random);
     }
@@ -133,6 +133,20 @@ TEST(Simulation, TheArmTracksItsSetpointsAndHoldsStill) {
   waitSeconds(*sim, 1.0);
   EXPECT_LT((sim->tcpPose().translation() - Eigen::Vector3d(0.55, -0.15, 0.15)).norm(), 2e-4);
   EXPECT_EQ(sim->armTableContactSteps(), 0u);
+}
+
+TEST(Simulation, ASetpointForAnotherArmIsRefusedAndTheArmHolds) {
+  const auto sim = Simulation::create(sceneOf(R"({"parts": []})"));
+  EXPECT_EQ(sim->armJointNames().size(), 6u);  // from robots/ur5/ur5.json
+  EXPECT_EQ(sim->armJointNames().front(), "shoulder_pan_joint");
+  const ArmJoints before = sim->armPositions();
+  // Seven joints for a six-joint arm: the controller keeps the last good setpoint.
+  sim->setArmSetpointSource([](TimePoint) {
+    return ArmSetpoint{ArmJoints(7, 0.5), ArmJoints::zero(7), ArmJoints::zero(7)};
+  });
+  waitSeconds(*sim, 0.5);
+  EXPECT_LT(arm::maxAbsDifference(sim->armPositions(), before), 1e-3);
+  sim->setArmSetpointSource(nullptr);
 }
 
 TEST(Simulation, AGraspIsPhysicalTheFingersHoldThePartByFrictionOnly) {

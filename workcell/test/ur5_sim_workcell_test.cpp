@@ -25,7 +25,7 @@ TEST(Ur5SimWorkcell, TheMujocoModelAndTheUrdfAgreeToATenthOfAMillimetre) {
   std::uniform_real_distribution<double> angle(-M_PI, M_PI);
   const sim::Scene empty = sim::parseScene(R"({"parts": []})", "empty");
   for (int trial = 0; trial < 10; ++trial) {
-    sim::ArmJoints q{};
+    sim::ArmJoints q = sim::ArmJoints::zero(6);
     for (double& joint : q) {
       joint = angle(random);
     }
@@ -33,7 +33,7 @@ TEST(Ur5SimWorkcell, TheMujocoModelAndTheUrdfAgreeToATenthOfAMillimetre) {
     options.initial_arm = q;
     options.settle_seconds = 0.0;
     const auto simulation = sim::Simulation::create(empty, options);
-    const world::Pose urdf = kBaseInWorld * robot.forward(Eigen::Map<const Eigen::VectorXd>(q.data(), 6));
+    const world::Pose urdf = kBaseInWorld * robot.forward(q.eigen());
     const world::Pose mujoco = simulation->tcpPose();
     EXPECT_LT((urdf.translation() - mujoco.translation()).norm(), 1e-4) << "trial " << trial;
     EXPECT_LT(world::rotationAngle(urdf, mujoco), 1e-5);

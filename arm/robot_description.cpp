@@ -1,0 +1,230 @@
+#include "arm/robot_description.h"
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/paths.h"
+
+namespace costar::arm {
+
+namespace {
+
+using nlohmann::json;
+
+/// A problem with one field: "joints[2].max: ...".
+[[noreturn]] void fail(const std::string& field, const std::string& problem) {
+  throw std::runtime_error(field + ": " + problem);
+}
+
+std::string shown(const json& value) {
+  std::string text = value.dump();
+  return text.size() <= 60 ? text : text.substr(0, 57) + "...";
+}
+
+void onlyKnown(const json& object, const std::string& field, const std::set<std::string>& known) {
+  for (const auto& [key, value] : object.items()) {
+    if (!known.contains(key)) {
+      std::string list;
+      for (const std::string& name : known) {
+        list += (list.empty() ? "" : ", ") + name;
+      }
+      fail(field.empty() ? key : field + "." + key, "unknown field (known: " + list + ")");
+    }
+  }
+}
+
+const json& member(const json& object, const std::string& field, const std::string& key) {
+  if (!object.contains(key)) {
+    fail(field.empty() ? key : field + "." + key, "missing");
+  }
+  return object.at(key);
+}
+
+const json& objectAt(const json& object, const std::string& field, const std::string& key) {
+  const json& value = member(object, field, key);
+  const std::string name = field.empty() ? key : field + "." + key;
+  if (!value.is_object()) {
+    fail(name, "must be an object {...}, not " + shown(value));
+  }
+  return value;
+}
+
+std::string text(const json& object, const std::string& field, const std::string& key) {
+  const json& value = member(object, field, key);
+  const std::string name = field.empty() ? key : field + "." + key;
+  if (!value.is_string() || value.get<std::string>().empty()) {
+    fail(name, "must be a non-empty string, not " + shown(value));
+  }
+  return value.get<std::string>();
+}
+
+double number(const json& value, const std::string& field) {
+  if (!value.is_number() || !std::isfinite(value.get<double>())) {
+    fail(field, "must be a finite number, not " + shown(value));
+  }
+  return value.get<double>();
+}
+
+std::vector<double> numbers(const json& value, const std::string& field) {
+  if (!value.is_array()) {
+    fail(field, "must be a list of numbers, not " + shown(value));
+  }
+  std::vector<double> out;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    out.push_back(number(value[i], field + "[" + std::to_string(i) + "]"));
+  }
+  return out;
+}
+
+std::vector<double> numbers(const json& value, const std::string& field, std::size_t size, const std::string& what) {
+  if (!value.is_array() || value.size() != size) {
+    fail(field, "must be " + what + ", not " + shown(value));
+  }
+  return numbers(value, field);
+}
+
+std::filesystem::path modelFile(const json& models, const std::string& key, const std::filesystem::path& root) {
+  const std::string relative = text(models, "models", key);
+  const std::filesystem::path path = root / relative;
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) {
+    fail("models." + key, "no such file '" + path.string() + "' (paths are relative to the data root)");
+  }
+  return path;
+}
+
+RobotDescription parse(const json& root_object, const std::filesystem::path& data_root) {
+  if (!root_object.is_object()) {
+    fail("(top level)", "must be an object {\"name\": ..., \"joints\": [...], ...}, not " + shown(root_object));
+  }
+  onlyKnown(root_object, "",
+            {"name", "type", "label", "notes", "kinematics", "models", "joints", "home", "tool", "links"});
+  RobotDescription robot;
+  robot.name = text(root_object, "", "name");
+  robot.type = text(root_object, "", "type");
+  robot.label = text(root_object, "", "label");
+
+  const json& kinematics = objectAt(root_object, "", "kinematics");
+  robot.solver = text(kinematics, "kinematics", "solver");
+  for (const auto& [key, value] : kinematics.items()) {
+    if (key != "solver") {
+      robot.solver_parameters[key] = numbers(value, "kinematics." + key);
+    }
+  }
+
+  const json& models = objectAt(root_object, "", "models");
+  onlyKnown(models, "models", {"mjcf", "urdf", "urdf_base_link", "urdf_tool_link"});
+  robot.mjcf = modelFile(models, "mjcf", data_root);
+  robot.urdf = modelFile(models, "urdf", data_root);
+  robot.urdf_base_link = text(models, "models", "urdf_base_link");
+  robot.urdf_tool_link = text(models, "models", "urdf_tool_link");
+
+  const json& joints = member(root_object, "", "joints");
+  if (!joints.is_array() || joints.empty() || joints.size() > static_cast<std::size_t>(kMaxJoints)) {
+    fail("joints", "must be a list of 1 to " + std::to_string(kMaxJoints) + " joints, not " + shown(joints));
+  }
+  const int count = static_cast<int>(joints.size());
+  robot.limits = {JointVector(count), JointVector(count), JointVector(count), JointVector(count)};
+  std::set<std::string> names;
+  for (int j = 0; j < count; ++j) {
+    const std::string field = "joints[" + std::to_string(j) + "]";
+    const json& joint = joints[j];
+    if (!joint.is_object()) {
+      fail(field, "must be an object {\"name\": ..., \"min\": ..., ...}, not " + shown(joint));
+    }
+    onlyKnown(joint, field, {"name", "label", "min", "max", "max_velocity", "max_acceleration"});
+    const std::string name = text(joint, field, "name");
+    if (!names.insert(name).second) {
+      fail(field + ".name", "'" + name + "' is taken already; joint names must differ");
+    }
+    robot.joint_names.push_back(name);
+    robot.joint_labels.push_back(text(joint, field, "label"));
+    robot.limits.min_position[j] = number(member(joint, field, "min"), field + ".min");
+    robot.limits.max_position[j] = number(member(joint, field, "max"), field + ".max");
+    robot.limits.max_velocity[j] = number(member(joint, field, "max_velocity"), field + ".max_velocity");
+    robot.limits.max_acceleration[j] = number(member(joint, field, "max_acceleration"), field + ".max_acceleration");
+    if (robot.limits.min_position[j] > robot.limits.max_position[j]) {
+      fail(field, "min " + shown(joint.at("min")) + " is above max " + shown(joint.at("max")));
+    }
+    if (!(robot.limits.max_velocity[j] > 0.0)) {
+      fail(field + ".max_velocity", "must be positive (rad/s), not " + shown(joint.at("max_velocity")));
+    }
+    if (!(robot.limits.max_acceleration[j] > 0.0)) {
+      fail(field + ".max_acceleration", "must be positive (rad/s^2), not " + shown(joint.at("max_acceleration")));
+    }
+  }
+
+  const std::vector<double> home = numbers(member(root_object, "", "home"), "home", joints.size(),
+                                           std::to_string(count) + " angles (radians), one per joint");
+  robot.home = JointVector(count);
+  for (int j = 0; j < count; ++j) {
+    robot.home[j] = home[j];
+    if (home[j] < robot.limits.min_position[j] || home[j] > robot.limits.max_position[j]) {
+      fail("home[" + std::to_string(j) + "]", "is outside joint " + std::to_string(j + 1) + "'s limits");
+    }
+  }
+
+  const json& tool = objectAt(root_object, "", "tool");
+  onlyKnown(tool, "tool", {"position", "orientation"});
+  const auto p = numbers(member(tool, "tool", "position"), "tool.position", 3, "[x, y, z] (m)");
+  const auto q = numbers(member(tool, "tool", "orientation"), "tool.orientation", 4, "a unit quaternion [w, x, y, z]");
+  const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
+  if (std::abs(rotation.norm() - 1.0) > 0.01) {
+    fail("tool.orientation", "must be a unit quaternion [w, x, y, z], not " + shown(tool.at("orientation")));
+  }
+  robot.tool_in_flange = world::Pose::Identity();
+  robot.tool_in_flange.translation() = Eigen::Vector3d(p[0], p[1], p[2]);
+  robot.tool_in_flange.linear() = rotation.normalized().toRotationMatrix();
+
+  const json& links = objectAt(root_object, "", "links");
+  onlyKnown(links, "links", {"base", "first_moving", "gripper"});
+  robot.base_link = text(links, "links", "base");
+  robot.first_moving_link = text(links, "links", "first_moving");
+  const json& gripper = member(links, "links", "gripper");
+  if (!gripper.is_array()) {
+    fail("links.gripper", "must be a list of link names, not " + shown(gripper));
+  }
+  for (std::size_t i = 0; i < gripper.size(); ++i) {
+    if (!gripper[i].is_string() || gripper[i].get<std::string>().empty()) {
+      fail("links.gripper[" + std::to_string(i) + "]", "must be a link name, not " + shown(gripper[i]));
+    }
+    robot.gripper_links.push_back(gripper[i].get<std::string>());
+  }
+  return robot;
+}
+
+}  // namespace
+
+std::filesystem::path robotDescriptionFile(const std::string& name, const std::filesystem::path& data_root) {
+  const std::filesystem::path root = data_root.empty() ? dataRoot() : data_root;
+  return root / "robots" / name / (name + ".json");
+}
+
+RobotDescription loadRobotDescription(const std::filesystem::path& file, const std::filesystem::path& data_root) {
+  const std::string label = "robot description '" + file.string() + "'";
+  std::ifstream in(file);
+  if (!in) {
+    throw std::runtime_error("cannot read " + label + ": no such file or not readable");
+  }
+  std::stringstream content;
+  content << in.rdbuf();
+  try {
+    json parsed;
+    try {
+      parsed = json::parse(content.str());
+    } catch (const json::parse_error& e) {
+      throw std::runtime_error(std::string("not valid JSON: ") + e.what());
+    }
+    RobotDescription robot = parse(parsed, data_root.empty() ? dataRoot() : data_root);
+    robot.file = file;
+    return robot;
+  } catch (const std::exception& e) {
+    throw std::runtime_error(label + ": " + e.what());
+  }
+}
+
+}  // namespace costar::arm

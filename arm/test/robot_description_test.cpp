@@ -1,0 +1,151 @@
+// The robot description files: the UR5's loads as the values the code used to hard-code, and
+// bad files are refused naming the file, the field and the problem.
+
+#include "arm/robot_description.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <random>
+
+#include "arm/ur5_kinematics.h"
+#include "core/paths.h"
+
+namespace costar::arm {
+namespace {
+
+using nlohmann::json;
+
+TEST(RobotDescription, TheUr5FileHoldsTheUr5) {
+  const RobotDescription ur5 = loadRobotDescription(robotDescriptionFile("ur5"));
+  EXPECT_EQ(ur5.name, "ur5");
+  EXPECT_EQ(ur5.type, "UR5");
+  ASSERT_EQ(ur5.jointCount(), 6);
+  EXPECT_EQ(ur5.joint_names.front(), "shoulder_pan_joint");
+  EXPECT_EQ(ur5.joint_names.back(), "wrist_3_joint");
+  EXPECT_EQ(ur5.joint_labels.back(), "wrist 3");
+  // Bit for bit what JointLimits::ur5() and the old hard-coded home were.
+  const JointLimits limits = JointLimits::ur5();
+  EXPECT_EQ(ur5.limits.min_position, limits.min_position);
+  EXPECT_EQ(ur5.limits.max_position, limits.max_position);
+  EXPECT_EQ(ur5.limits.max_velocity, limits.max_velocity);
+  EXPECT_EQ(ur5.limits.max_acceleration, limits.max_acceleration);
+  const JointVector home = {0.0, -2.3, 1.9, -std::numbers::pi / 2 + 0.4, -std::numbers::pi / 2, 0.0};
+  EXPECT_EQ(ur5.home, home);
+  EXPECT_TRUE(ur5.tool_in_flange.isApprox(world::Pose(Eigen::Translation3d(0, 0, 0.14)), 0.0));
+  EXPECT_EQ(ur5.gripper_links, (std::vector<std::string>{"tool0", "wrist_3_link"}));
+  EXPECT_EQ(ur5.base_link, "base_link");
+  EXPECT_TRUE(std::filesystem::is_regular_file(ur5.mjcf));
+  EXPECT_TRUE(std::filesystem::is_regular_file(ur5.urdf));
+}
+
+TEST(RobotDescription, ItsKinematicsAreTheUrClosedFormWithItsDhTable) {
+  const RobotDescription ur5 = loadRobotDescription(robotDescriptionFile("ur5"));
+  const std::shared_ptr<const Kinematics> kinematics = makeKinematics(ur5);
+  ASSERT_NE(dynamic_cast<const Ur5Kinematics*>(kinematics.get()), nullptr);
+  const Ur5Kinematics reference;
+  std::mt19937_64 random(3);
+  std::uniform_real_distribution<double> angle(-3.0, 3.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    JointVector q = JointVector::zero(6);
+    for (double& value : q) {
+      value = angle(random);
+    }
+    EXPECT_TRUE(kinematics->forward(q).isApprox(reference.forward(q), 0.0)) << "trial " << trial;
+  }
+  EXPECT_EQ(kinematicsSolvers(), std::vector<std::string>{"ur"});
+}
+
+class BadRobotFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = std::filesystem::temp_directory_path() /
+              ("costar_robot_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+               ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(folder_);
+    std::ifstream in(robotDescriptionFile("ur5"));
+    good_ = json::parse(in);
+  }
+  void TearDown() override { std::filesystem::remove_all(folder_); }
+
+  /// The error loading `content`, without the "robot description 'PATH': " prefix.
+  std::string problem(const std::string& content) {
+    const auto file = folder_ / "robot.json";
+    std::ofstream(file) << content;
+    const std::string prefix = "robot description '" + file.string() + "': ";
+    try {
+      const RobotDescription robot = loadRobotDescription(file);
+      makeKinematics(robot);
+    } catch (const std::runtime_error& e) {
+      const std::string message = e.what();
+      return message.rfind(prefix, 0) == 0 ? message.substr(prefix.size()) : "(no file named) " + message;
+    }
+    return "no error";
+  }
+  std::string problem(const json& content) { return problem(content.dump(2)); }
+
+  std::filesystem::path folder_;
+  json good_;
+};
+
+TEST_F(BadRobotFile, EachProblemNamesItsField) {
+  EXPECT_EQ(problem(good_), "no error");
+  json j = good_;
+  j.erase("home");
+  EXPECT_EQ(problem(j), "home: missing");
+  j = good_;
+  j["home"].push_back(0.0);
+  EXPECT_EQ(problem(j),
+            "home: must be 6 angles (radians), one per joint, not "
+            "[0.0,-2.3,1.9,-1.1707963267948966,-1.5707963267948966,0.0...");
+  j = good_;
+  j["home"][1] = 7.0;
+  EXPECT_EQ(problem(j), "home[1]: is outside joint 2's limits");
+  j = good_;
+  j["joints"][2]["max_velocity"] = -1;
+  EXPECT_EQ(problem(j), "joints[2].max_velocity: must be positive (rad/s), not -1");
+  j = good_;
+  j["joints"][3]["name"] = "elbow_joint";
+  EXPECT_EQ(problem(j), "joints[3].name: 'elbow_joint' is taken already; joint names must differ");
+  j = good_;
+  j["joints"][0]["min"] = "low";
+  EXPECT_EQ(problem(j), "joints[0].min: must be a finite number, not \"low\"");
+  j = good_;
+  j["gripper_link"] = "tool0";
+  EXPECT_EQ(problem(j),
+            "gripper_link: unknown field (known: home, joints, kinematics, label, links, models, name, notes, tool, "
+            "type)");
+  j = good_;
+  j["models"]["mjcf"] = "sim/models/no_such_robot.xml";
+  EXPECT_EQ(problem(j).rfind("models.mjcf: no such file '", 0), 0u) << problem(j);
+  j = good_;
+  j["kinematics"]["solver"] = "kuka";
+  EXPECT_EQ(problem(j), "kinematics.solver: unknown solver 'kuka' (known: ur)");
+  j = good_;
+  j["kinematics"]["d"] = {0.1, 0.2};
+  EXPECT_EQ(problem(j), "kinematics.d: must be 6 numbers, not 2");
+  j = good_;
+  j["kinematics"]["alpha"][0] = 0.0;  // not a UR arm: the closed form refuses it
+  EXPECT_EQ(problem(j).rfind("Ur5Kinematics: the closed form needs alpha", 0), 0u) << problem(j);
+  j = good_;
+  j["joints"] = json::array();
+  EXPECT_EQ(problem(j), "joints: must be a list of 1 to 8 joints, not []");
+  EXPECT_EQ(problem(std::string("{\"name\": ")).rfind("not valid JSON: ", 0), 0u);
+  EXPECT_EQ(problem(std::string("[1, 2]")),
+            "(top level): must be an object {\"name\": ..., \"joints\": [...], ...}, not [1,2]");
+}
+
+TEST(RobotDescription, AMissingFileIsNamed) {
+  try {
+    loadRobotDescription("/nonexistent/robot.json");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "cannot read robot description '/nonexistent/robot.json': no such file or not readable");
+  }
+}
+
+}  // namespace
+}  // namespace costar::arm
