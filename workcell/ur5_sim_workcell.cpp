@@ -2,6 +2,7 @@
 
 #include "arm/arm_component.h"
 #include "core/paths.h"
+#include "gripper/finger_geometry.h"
 #include "gripper/parallel_gripper.h"
 #include "perception/perception_component.h"
 #include "perception/pipeline.h"
@@ -135,19 +136,23 @@ class Ur5SimWorkcell final : public Workcell {
       components().add(std::make_shared<perception::PerceptionComponent>(
           camera_, clock(), threadPipeline(perception_config), perception_config));
     }
-    smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(*arm, *gripper, components().world(), collisions_,
-                                                                 simulation_->objectClasses(), grasps_);
+    smartmove::SmartMoveConfig smartmove_config;
+    smartmove_config.fingers = gripper::twoFingerGripper();
+    smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(
+        *arm, *gripper, components().world(), collisions_, simulation_->objectClasses(), grasps_, smartmove_config);
     components().add(smartmove_);
     // Last: it derives its predicates from what the others report.
     components().add(std::make_shared<predicator::Predicator>(components().world(), simulation_->objectClasses()));
     smartmove_->setPatternCheck([this](const predicator::Pattern& pattern) { return checkPattern(pattern); });
     registerNodes();
     smartmove_->syncObstacles();
+    smartmove_->syncFingers(gripper_driver_.read().opening);
   }
 
   void beforeTick() override {
     Workcell::beforeTick();
     smartmove_->syncObstacles();
+    smartmove_->syncFingers(gripper_driver_.read().opening);
   }
 
   /// A plan's predicate pattern names a declared predicate with the right number of arguments,
