@@ -297,8 +297,10 @@ std::vector<planning::CollisionShape> SmartMoveComponent::fingerShapes(double op
 }
 
 void SmartMoveComponent::syncFingers(double opening) {
-  if (config_.fingers) {
+  // Every tick: new shapes only when the fingers moved (planning puts them back as they were).
+  if (config_.fingers && std::abs(opening - synced_opening_) > 1e-4) {
     collisions_.setLinkShapes(config_.finger_link, fingerShapes(opening));
+    synced_opening_ = opening;
   }
 }
 
