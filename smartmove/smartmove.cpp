@@ -298,6 +298,10 @@ std::vector<planning::CollisionShape> SmartMoveComponent::fingerShapes(double op
 
 void SmartMoveComponent::syncFingers(double opening) {
   // Every tick: new shapes only when the fingers moved (planning puts them back as they were).
+  // An opening not known (a reading that is not a number) counts as the whole stroke.
+  if (config_.fingers && !std::isfinite(opening)) {
+    opening = config_.fingers->max_opening;
+  }
   if (config_.fingers && std::abs(opening - synced_opening_) > 1e-4) {
     collisions_.setLinkShapes(config_.finger_link, fingerShapes(opening));
     synced_opening_ = opening;

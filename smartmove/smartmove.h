@@ -104,8 +104,8 @@ class SmartMoveComponent final : public component::LocalComponent {
   void syncObstacles();
 
   /// Puts the fingers' collision shapes where they are at `opening` (m), as the gripper reads
-  /// it; nothing without SmartMoveConfig::fingers. Call before planning (the workcell does it
-  /// before every tick).
+  /// it (not a number: unknown, the whole stroke); nothing without SmartMoveConfig::fingers. Call before planning (the
+  /// workcell does it before every tick).
   void syncFingers(double opening);
 
   /// The opening a grasp with the tool centre point at `tcp` needs for a part of `object_class`
