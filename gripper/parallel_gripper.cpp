@@ -67,9 +67,12 @@ class FingerMotion final : public component::RunningOperation {
     }
     const bool settled = still_since_ && now - *still_since_ >= std::chrono::milliseconds(50);
     if (settled || std::abs(reading.opening - target_) < 0.0005) {
-      if (!closing_ && reading.opening < driver_.maxOpening() - ParallelGripper::kOpenMargin) {
-        return OperationResult::failure("the fingers are blocked at " + millimetres(reading.opening) +
-                                        ": they could not open fully");
+      // Opening (or narrowing to an opening): blocked when they stopped short of it.
+      if (!closing_ && std::abs(reading.opening - target_) > ParallelGripper::kOpenMargin) {
+        const bool fully = target_ >= driver_.maxOpening() - ParallelGripper::kOpenMargin;
+        return OperationResult::failure(
+            "the fingers are blocked at " + millimetres(reading.opening) +
+            (fully ? std::string(": they could not open fully") : ": they could not reach " + millimetres(target_)));
       }
       const bool holding = closing_ && reading.opening > ParallelGripper::kClosedBelow;
       return OperationResult::success({{"opening", reading.opening}, {"holding", holding}});
@@ -118,7 +121,11 @@ ParallelGripper::ParallelGripper(GripperDriver& driver, const Clock& clock, Para
   ParamSpec force{"force", ValueType::kDouble, "grip force (N)", options_.force};
   force.min = 5.0;
   force.max = 120.0;
-  description_.operations = {{"Open", "Opens the fingers fully.", {speed}},
+  ParamSpec opening{"opening", ValueType::kDouble, "how far apart the fingers go (m); fully open by default",
+                    driver_.maxOpening()};
+  opening.min = 0.005;
+  opening.max = driver_.maxOpening();
+  description_.operations = {{"Open", "Opens the fingers fully, or as far as `opening`.", {speed, opening}},
                              {"Close", "Closes the fingers until they stop on a part or close fully.", {speed, force}},
                              {"BasicMode", "Selects Basic mode (3-finger grippers only).", {}},
                              {"PinchMode", "Selects Pinch mode, the only mode of a parallel gripper.", {}},
@@ -159,8 +166,8 @@ world::Report ParallelGripper::report() const {
 std::unique_ptr<component::RunningOperation> ParallelGripper::begin(const std::string& operation,
                                                                     const component::ParamMap& params) {
   if (operation == "Open") {
-    return std::make_unique<FingerMotion>(*this, driver_, clock_, driver_.maxOpening(), params.at("speed").asDouble(),
-                                          options_.force, options_.timeout, false);
+    return std::make_unique<FingerMotion>(*this, driver_, clock_, params.at("opening").asDouble(),
+                                          params.at("speed").asDouble(), options_.force, options_.timeout, false);
   }
   if (operation == "Close") {
     return std::make_unique<FingerMotion>(*this, driver_, clock_, 0.0, params.at("speed").asDouble(),

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 
 namespace costar::planning {
 
@@ -37,8 +38,19 @@ bool touches(const fcl::CollisionObjectd& a, const fcl::CollisionObjectd& b) {
 
 struct CollisionWorld::Impl {
   struct LinkObjects {
+    std::vector<CollisionShape> shapes;
     std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
     std::vector<world::Pose> origins;
+
+    void set(const std::vector<CollisionShape>& new_shapes, double padding) {
+      shapes = new_shapes;
+      objects.clear();
+      origins.clear();
+      for (const CollisionShape& shape : shapes) {
+        objects.push_back(std::make_unique<fcl::CollisionObjectd>(geometryOf(shape, padding)));
+        origins.push_back(shape.origin);
+      }
+    }
   };
   std::vector<LinkObjects> links;  // parallel to robot.links()
   std::map<std::string, std::unique_ptr<fcl::CollisionObjectd>> obstacles;
@@ -76,10 +88,7 @@ CollisionWorld::CollisionWorld(const RobotModel& robot, const world::Pose& base_
   impl_->base = base_in_world;
   for (const LinkGeometry& link : robot.links()) {
     Impl::LinkObjects objects;
-    for (const CollisionShape& shape : link.shapes) {
-      objects.objects.push_back(std::make_unique<fcl::CollisionObjectd>(geometryOf(shape, options_.padding)));
-      objects.origins.push_back(shape.origin);
-    }
+    objects.set(link.shapes, options_.padding);
     impl_->links.push_back(std::move(objects));
   }
   // Self-collision pairs: not adjacent, and not touching at any reference configuration.
@@ -123,6 +132,28 @@ std::vector<std::string> CollisionWorld::obstacleNames() const {
     names.push_back(name);
   }
   return names;
+}
+
+namespace {
+
+std::size_t linkIndex(const RobotModel& robot, const std::string& link) {
+  const auto& links = robot.links();
+  for (std::size_t i = 0; i < links.size(); ++i) {
+    if (links[i].link == link) {
+      return i;
+    }
+  }
+  throw std::invalid_argument("the robot has no link '" + link + "' with collision shapes");
+}
+
+}  // namespace
+
+void CollisionWorld::setLinkShapes(const std::string& link, const std::vector<CollisionShape>& shapes) {
+  impl_->links[linkIndex(robot_, link)].set(shapes, options_.padding);
+}
+
+const std::vector<CollisionShape>& CollisionWorld::linkShapes(const std::string& link) const {
+  return impl_->links[linkIndex(robot_, link)].shapes;
 }
 
 void CollisionWorld::allow(const std::string& robot_link, const std::string& obstacle) {

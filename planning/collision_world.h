@@ -52,6 +52,14 @@ class CollisionWorld {
   /// with the tip outside is reported as "tcp would leave the workspace".
   void setWorkspace(const Eigen::AlignedBox3d& box) { workspace_ = box; }
 
+  /// Replaces the collision shapes of a robot link (in its frame, padded like the others): for
+  /// parts that move, such as a gripper's fingers at their opening. Self-collision pairs stay
+  /// those chosen at construction. @throws std::invalid_argument for a link without shapes.
+  void setLinkShapes(const std::string& link, const std::vector<CollisionShape>& shapes);
+  /// The link's shapes now (as read from the robot model, or as last set).
+  /// @throws std::invalid_argument for a link without shapes.
+  const std::vector<CollisionShape>& linkShapes(const std::string& link) const;
+
   /// Lets `robot_link` touch `obstacle` (e.g. the fingers and the part being grasped).
   void allow(const std::string& robot_link, const std::string& obstacle);
   void disallow(const std::string& robot_link, const std::string& obstacle);

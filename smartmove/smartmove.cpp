@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <stdexcept>
 
 namespace costar::smartmove {
@@ -102,6 +103,36 @@ std::unique_ptr<RunningOperation> failed(std::string reason, nlohmann::json data
 world::Pose up(double metres) { return world::Pose(Eigen::Translation3d(0, 0, metres)); }
 
 }  // namespace
+
+/// The fingers' shapes in the collision world put where a plan will have them (at the opening
+/// of the grasp it checks), and back as they were once the plan is made.
+class SmartMoveComponent::PlannedFingers {
+ public:
+  explicit PlannedFingers(SmartMoveComponent& self) : self_(self) {
+    if (self_.config_.fingers) {
+      saved_ = self_.collisions_.linkShapes(self_.config_.finger_link);
+    }
+  }
+  ~PlannedFingers() {
+    if (self_.config_.fingers) {
+      self_.collisions_.setLinkShapes(self_.config_.finger_link, saved_);
+    }
+  }
+  PlannedFingers(const PlannedFingers&) = delete;
+  PlannedFingers& operator=(const PlannedFingers&) = delete;
+
+  void at(double opening) const {
+    if (self_.config_.fingers && opening != opening_) {
+      self_.collisions_.setLinkShapes(self_.config_.finger_link, self_.fingerShapes(opening));
+      opening_ = opening;
+    }
+  }
+
+ private:
+  SmartMoveComponent& self_;
+  std::vector<planning::CollisionShape> saved_;
+  mutable double opening_ = -1.0;
+};
 
 std::string partObstacle(const std::string& object) { return "part:" + object; }
 
@@ -253,6 +284,58 @@ void SmartMoveComponent::allowGripperContact(const std::string& object, bool all
   }
 }
 
+std::vector<planning::CollisionShape> SmartMoveComponent::fingerShapes(double opening) const {
+  std::vector<planning::CollisionShape> shapes;
+  for (const gripper::FingerBox& box : config_.fingers->at(opening)) {
+    planning::CollisionShape shape;
+    shape.kind = planning::CollisionShape::Kind::kBox;
+    shape.size = box.size;
+    shape.origin = world::Pose(Eigen::Translation3d(box.centre));
+    shapes.push_back(shape);
+  }
+  return shapes;
+}
+
+void SmartMoveComponent::syncFingers(double opening) {
+  // Every tick: new shapes only when the fingers moved (planning puts them back as they were).
+  // An opening not known (a reading that is not a number) counts as the whole stroke.
+  if (config_.fingers && !std::isfinite(opening)) {
+    opening = config_.fingers->max_opening;
+  }
+  if (config_.fingers && std::abs(opening - synced_opening_) > 1e-4) {
+    collisions_.setLinkShapes(config_.finger_link, fingerShapes(opening));
+    synced_opening_ = opening;
+  }
+}
+
+component::ParamMap SmartMoveComponent::openParams(double opening) const {
+  component::ParamMap params{{"speed", 0.1}};
+  if (config_.fingers && opening > 0.0) {
+    params["opening"] = opening;
+  }
+  return params;
+}
+
+std::optional<double> SmartMoveComponent::graspOpening(const world::Pose& tcp, const world::Pose& object,
+                                                       const world::ObjectClass& object_class) const {
+  if (!config_.fingers) {
+    return 0.0;
+  }
+  const double stroke = config_.fingers->max_opening;
+  // The part's bounding box in the tool's frame: its extent along y, either side of the TCP.
+  const Eigen::AlignedBox3d bounds = object_class.bounds();
+  const world::Pose part_in_tool = tcp.inverse() * object;
+  double half = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d p = part_in_tool * bounds.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+    half = std::max(half, std::abs(p.y()));
+  }
+  if (2.0 * half > stroke) {
+    return std::nullopt;
+  }
+  return std::min(2.0 * half + config_.grasp_margin, stroke);
+}
+
 SmartMoveComponent::Matches SmartMoveComponent::matching(const std::string& object_class,
                                                          const std::vector<predicator::Pattern>& patterns,
                                                          const std::string& exclude) const {
@@ -332,7 +415,16 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
   syncObstacles();
   const Matches matches = matching(object_class, patterns);
   const arm::JointVector now = arm_.joints();
+  const PlannedFingers fingers(*this);
   const FeasibilityCheck feasible = [&](Candidate& candidate) -> std::string {
+    const auto object_pose = world_.worldPose(candidate.object);
+    const auto opening = graspOpening(candidate.goal, *object_pose, *object);
+    if (!opening) {
+      return "too wide for the fingers";
+    }
+    if (with_approach) {
+      fingers.at(*opening);  // SmartGrasp opens them this far first; SmartMove leaves them
+    }
     allowGripperContact(candidate.object, true);
     struct Restore {
       SmartMoveComponent& self;
@@ -366,8 +458,82 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
     return path.ok() ? std::string() : "no path to the pre-grasp: " + path.failure;
   };
   Selection selection = selectGoal(matches.objects, *object, grasp, armModel(), config_.weights, feasible);
+  if (!selection.ok() && with_approach && config_.fingers) {
+    selection = withShiftedGrasps(std::move(selection), *object, feasible);
+  }
   addRejected(selection, matches);
   return selection;
+}
+
+std::vector<double> SmartMoveComponent::graspShifts(const world::Pose& tcp, const world::Pose& object,
+                                                    const world::ObjectClass& object_class) const {
+  // The part's extent along the tool's x (across the fingers) and the pads' half width.
+  const Eigen::AlignedBox3d bounds = object_class.bounds();
+  const world::Pose part_in_tool = tcp.inverse() * object;
+  double low = 0.0;
+  double high = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d p = part_in_tool * bounds.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+    low = std::min(low, p.x());
+    high = std::max(high, p.x());
+  }
+  double pad = 0.0;
+  for (const gripper::FingerBox& box : config_.fingers->closed) {
+    pad = std::max(pad, std::abs(box.centre.x()) + 0.5 * box.size.x());
+  }
+  const double keep = config_.grasp_shift_keep;
+  std::vector<double> shifts;
+  for (int k = 1; k * config_.grasp_shift_step <= config_.grasp_shift_max + 1e-9; ++k) {
+    const double shift = k * config_.grasp_shift_step;
+    for (const double d : {shift, -shift}) {
+      const double limited = d > 0 ? std::min(d, high - pad - keep) : std::max(d, low + pad + keep);
+      if (limited * d > 1e-6 &&
+          std::none_of(shifts.begin(), shifts.end(), [&](double s) { return std::abs(s - limited) < 1e-6; })) {
+        shifts.push_back(limited);
+      }
+    }
+  }
+  return shifts;
+}
+
+Selection SmartMoveComponent::withShiftedGrasps(Selection centred, const world::ObjectClass& object_class,
+                                                const FeasibilityCheck& feasible) {
+  // Grasps shifted across the fingers, nearest the centre first, of the centred candidates
+  // that failed for something in the way (not reach, not width).
+  std::map<double, std::vector<Candidate>> by_shift;
+  for (const Candidate& candidate : centred.candidates) {
+    if (candidate.symmetry < 0 || candidate.rejected.starts_with("no IK solution") ||
+        candidate.rejected.starts_with("too wide")) {
+      continue;
+    }
+    const auto pose = world_.worldPose(candidate.object);
+    for (const double shift : graspShifts(candidate.goal, *pose, object_class)) {
+      Candidate shifted;
+      shifted.object = candidate.object;
+      shifted.symmetry = candidate.symmetry;
+      shifted.goal = candidate.goal * Eigen::Translation3d(shift, 0, 0);
+      by_shift[std::abs(shift)].push_back(std::move(shifted));
+    }
+  }
+  Selection merged = std::move(centred);
+  for (auto& [shift, candidates] : by_shift) {
+    Selection selection = selectAmong(std::move(candidates), armModel(), config_.weights, feasible);
+    const std::size_t offset = merged.candidates.size();
+    for (Candidate& candidate : selection.candidates) {
+      merged.candidates.push_back(std::move(candidate));
+    }
+    merged.seconds += selection.seconds;
+    if (selection.chosen) {
+      merged.chosen = offset + *selection.chosen;
+      break;
+    }
+  }
+  if (merged.chosen) {
+    merged.failure.clear();
+  } else {
+    merged.summarizeFailure();
+  }
+  return merged;
 }
 
 std::string SmartMoveComponent::spotFailsPattern(const Eigen::Vector3d& spot,
@@ -436,6 +602,7 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
     }
     const Candidate chosen = selection.best();
     const world::Pose object_pose = *world_.worldPose(chosen.object);
+    const double opening = graspOpening(chosen.goal, object_pose, *objectClass(object_class)).value_or(0.0);
     if (!grasping) {
       return std::make_unique<Script>(
           std::vector<Script::Step>{
@@ -454,9 +621,7 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
     const std::string object = chosen.object;
     std::vector<Script::Step> steps;
     steps.push_back({"open the gripper",
-                     [this] {
-                       return std::make_unique<ComponentStep>(gripper_, "Open", component::ParamMap{{"speed", 0.1}});
-                     },
+                     [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); },
                      nullptr});
     steps.push_back({"move above " + object,
                      [this, pregrasp, chosen, speed] {
@@ -470,21 +635,23 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
                        return arm_.execute(arm_.planLine(chosen.goal, config_.approach_speed), "approach");
                      },
                      nullptr});
-    steps.push_back({"close on " + object,
-                     [this] {
-                       return std::make_unique<ComponentStep>(gripper_, "Close",
-                                                              component::ParamMap{{"speed", 0.1}, {"force", 40.0}});
-                     },
-                     [this, object, object_class, object_pose, chosen](const OperationResult& result) -> std::string {
-                       if (!result.data.value("holding", false)) {
-                         return "the fingers closed on nothing: " + object + " was not where it was seen";
-                       }
-                       held_ = object;
-                       held_class_ = object_class;
-                       held_grasp_ = object_pose.inverse() * chosen.goal;
-                       collisions_.remove(partObstacle(object));
-                       return {};
-                     }});
+    steps.push_back(
+        {"close on " + object,
+         [this] {
+           return std::make_unique<ComponentStep>(gripper_, "Close",
+                                                  component::ParamMap{{"speed", 0.1}, {"force", 40.0}});
+         },
+         [this, object, object_class, object_pose, chosen, opening](const OperationResult& result) -> std::string {
+           if (!result.data.value("holding", false)) {
+             return "the fingers closed on nothing: " + object + " was not where it was seen";
+           }
+           held_ = object;
+           held_class_ = object_class;
+           held_grasp_ = object_pose.inverse() * chosen.goal;
+           held_opening_ = opening;
+           collisions_.remove(partObstacle(object));
+           return {};
+         }});
     steps.push_back({"lift " + object,
                      [this] {
                        return arm_.execute(arm_.planLine(up(config_.retreat) * arm_.endpoint(), config_.approach_speed),
@@ -609,6 +776,9 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
         }
       }
     }
+    // Checked with the fingers at the opening they release to: wider than they hold.
+    const PlannedFingers fingers(*this);
+    fingers.at(held_opening_ > 0.0 ? held_opening_ : config_.fingers ? config_.fingers->max_opening : 0.0);
     const FeasibilityCheck feasible = [&](Candidate& candidate) -> std::string {
       allowGripperContact(candidate.object, true);
       struct Restore {
@@ -657,8 +827,8 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
                      },
                      nullptr});
     steps.push_back({"release " + released,
-                     [this] {
-                       return std::make_unique<ComponentStep>(gripper_, "Open", component::ParamMap{{"speed", 0.1}});
+                     [this, opening = held_opening_] {
+                       return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening));
                      },
                      [this](const OperationResult&) -> std::string {
                        held_.reset();

@@ -30,6 +30,7 @@
 
 #include "arm/arm_component.h"
 #include "component/component.h"
+#include "gripper/finger_geometry.h"
 #include "planning/collision_world.h"
 #include "predicator/predicator.h"
 #include "smartmove/grasps.h"
@@ -57,6 +58,23 @@ struct SmartMoveConfig {
   /// Robot links that may touch the part being grasped (the gripper): the robot
   /// description's links.gripper (arm/robot_description.h).
   std::vector<std::string> gripper_links;
+  /// The gripper's fingers where they are at an opening. When given, they replace the shapes of
+  /// `finger_link` in the collision world (syncFingers), grasps are planned with the fingers
+  /// opened only as far as the part needs plus `grasp_margin`, and the gripper opens that far
+  /// (its Open takes an `opening`) before a grasp and to release. When not, the robot model's
+  /// finger shapes stay and the gripper opens fully.
+  std::optional<gripper::FingerGeometry> fingers;
+  std::string finger_link = "fingers";
+  /// m added to the part's width between the fingers: covers perception error (a few mm, a few
+  /// degrees of yaw) and the fingers' tracking.
+  double grasp_margin = 0.016;
+  /// When no centred grasp is feasible, grasps shifted across the fingers (along the tool's x)
+  /// are tried, nearest the centre first: in steps of grasp_shift_step up to grasp_shift_max,
+  /// keeping the pads grasp_shift_keep inside the part's end (a link gripped off its middle, a
+  /// node off its centre line). Only with `fingers`.
+  double grasp_shift_step = 0.01;
+  double grasp_shift_max = 0.04;
+  double grasp_shift_keep = 0.003;
   CostWeights weights;
 };
 
@@ -86,6 +104,18 @@ class SmartMoveComponent final : public component::LocalComponent {
   /// workcell does it before every tick).
   void syncObstacles();
 
+  /// Puts the fingers' collision shapes where they are at `opening` (m), as the gripper reads
+  /// it (not a number: unknown, the whole stroke); nothing without SmartMoveConfig::fingers. Call before planning (the
+  /// workcell does it before every tick).
+  void syncFingers(double opening);
+
+  /// The opening a grasp with the tool centre point at `tcp` needs for a part of `object_class`
+  /// at `object`: the part's width between the fingers (its extent along the tool's y) plus
+  /// grasp_margin, at most the gripper's stroke; nullopt when the part is wider than the stroke;
+  /// 0 (open fully) when the fingers are not modelled.
+  std::optional<double> graspOpening(const world::Pose& tcp, const world::Pose& object,
+                                     const world::ObjectClass& object_class) const;
+
   /// Sets what plan validation checks of each predicate pattern (the workcell knows which
   /// predicates are declared and which frames exist). Call before the node types are made.
   void setPatternCheck(PatternCheck check) { *pattern_check_ = std::move(check); }
@@ -113,6 +143,16 @@ class SmartMoveComponent final : public component::LocalComponent {
   std::string spotFailsPattern(const Eigen::Vector3d& spot, const predicator::Pattern& pattern) const;
   ArmModel armModel() const;
   void allowGripperContact(const std::string& object, bool allowed);
+  /// Shifts (m along the tool's x) of a grasp at `tcp` that keep the pads on the part.
+  std::vector<double> graspShifts(const world::Pose& tcp, const world::Pose& object,
+                                  const world::ObjectClass& object_class) const;
+  /// `centred` (none feasible) with the shifted grasps of its candidates tried after it.
+  Selection withShiftedGrasps(Selection centred, const world::ObjectClass& object_class,
+                              const FeasibilityCheck& feasible);
+  /// Shapes of the fingers at `opening`, in the finger link's frame.
+  std::vector<planning::CollisionShape> fingerShapes(double opening) const;
+  /// The Open operation's parameters: at `opening` when the fingers are modelled, else fully.
+  component::ParamMap openParams(double opening) const;
   /// Starts a joint-space motion to the collision-free IK solution for `pose` nearest `seed`
   /// (the arm's operation named `what`), or an operation that fails with `none` and the reason.
   std::unique_ptr<component::RunningOperation> moveToFreeConfiguration(const world::Pose& pose,
@@ -121,6 +161,7 @@ class SmartMoveComponent final : public component::LocalComponent {
                                                                        const std::string& none);
 
   friend class SmartStep;
+  class PlannedFingers;
   component::ComponentDescription description_;
   arm::ArmComponent& arm_;
   component::Component& gripper_;
@@ -133,6 +174,8 @@ class SmartMoveComponent final : public component::LocalComponent {
   std::optional<std::string> held_;
   std::string held_class_;
   world::Pose held_grasp_ = world::Pose::Identity();  // the TCP in the held part's frame
+  double held_opening_ = 0.0;                         // the opening of its grasp, m (0: fully)
+  double synced_opening_ = -1.0;                      // the fingers' shapes are at this opening
   std::vector<std::string> obstacles_;
   std::shared_ptr<PatternCheck> pattern_check_ = std::make_shared<PatternCheck>();
 };

@@ -1,9 +1,12 @@
 #include "workcell/ur5_sim_workcell.h"
 
+#include <limits>
+
 #include "arm/arm_component.h"
 #include "arm/robot_description.h"
 #include "core/paths.h"
 #include "faults/injector.h"
+#include "gripper/finger_geometry.h"
 #include "gripper/parallel_gripper.h"
 #include "perception/perception_component.h"
 #include "perception/pipeline.h"
@@ -120,6 +123,7 @@ class Ur5SimWorkcell final : public Workcell {
     // The drivers and components as the cell uses them: wrapped by the fault injector, if any.
     arm::ArmDriver& arm_driver = faults_ ? faults_->wrap(arm_driver_) : arm_driver_;
     gripper::GripperDriver& gripper_driver = faults_ ? faults_->wrap(gripper_driver_) : gripper_driver_;
+    cell_gripper_driver_ = &gripper_driver;
     camera::RgbdCamera& camera = faults_ ? faults_->wrap(camera_) : camera_;
     const auto add = [this](std::shared_ptr<component::Component> component) {
       components().add(faults_ ? faults_->wrap(std::move(component)) : std::move(component));
@@ -161,6 +165,7 @@ class Ur5SimWorkcell final : public Workcell {
     }
     smartmove::SmartMoveConfig smartmove_config;
     smartmove_config.gripper_links = robot_description_.gripper_links;
+    smartmove_config.fingers = gripper::twoFingerGripper();
     smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(
         *arm, *gripper, components().world(), collisions_, simulation_->objectClasses(), grasps_, smartmove_config);
     add(smartmove_);
@@ -175,11 +180,25 @@ class Ur5SimWorkcell final : public Workcell {
     smartmove_->setPatternCheck([this](const predicator::Pattern& pattern) { return checkPattern(pattern); });
     registerNodes();
     smartmove_->syncObstacles();
+    syncFingers();
   }
 
   void beforeTick() override {
     Workcell::beforeTick();
     smartmove_->syncObstacles();
+    syncFingers();
+  }
+
+  /// The fingers' collision shapes at the opening the gripper reads (as the cell sees it, faults
+  /// included); a reading that fails counts as unknown: SmartMove takes the whole stroke.
+  void syncFingers() {
+    double opening = std::numeric_limits<double>::quiet_NaN();
+    try {
+      opening = cell_gripper_driver_->read().opening;
+    } catch (const std::exception&) {
+      // unknown: see syncFingers
+    }
+    smartmove_->syncFingers(opening);
   }
 
   /// A plan's predicate pattern names a declared predicate with the right number of arguments,
@@ -215,6 +234,7 @@ class Ur5SimWorkcell final : public Workcell {
   std::unique_ptr<sim::Simulation> simulation_;
   sim::SimArmDriver arm_driver_;
   sim::SimGripperDriver gripper_driver_;
+  gripper::GripperDriver* cell_gripper_driver_ = &gripper_driver_;  // as the cell uses it (faults)
   sim::SimRgbdCamera camera_;
   planning::RobotModel robot_;
   planning::CollisionWorld collisions_;

@@ -36,7 +36,7 @@ TEST(RobotDescription, TheUr5FileHoldsTheUr5) {
   const JointVector home = {0.0, -2.3, 1.9, -std::numbers::pi / 2 + 0.4, -std::numbers::pi / 2, 0.0};
   EXPECT_EQ(ur5.home, home);
   EXPECT_TRUE(ur5.tool_in_flange.isApprox(world::Pose(Eigen::Translation3d(0, 0, 0.14)), 0.0));
-  EXPECT_EQ(ur5.gripper_links, (std::vector<std::string>{"tool0", "wrist_3_link"}));
+  EXPECT_EQ(ur5.gripper_links, (std::vector<std::string>{"tool0", "wrist_3_link", "fingers"}));
   EXPECT_EQ(ur5.base_link, "base_link");
   EXPECT_TRUE(std::filesystem::is_regular_file(ur5.mjcf));
   EXPECT_TRUE(std::filesystem::is_regular_file(ur5.urdf));

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "component/registry.h"
 
 namespace costar::gripper {
@@ -117,6 +119,43 @@ TEST_F(GripperTest, OpenFailsWithAReasonWhenBlocked) {
   fingers.obstacle_at = 1.0;
   EXPECT_EQ(run("Open").state, OperationState::kSuccess);
   EXPECT_TRUE(holds("gripper_open"));
+}
+
+TEST_F(GripperTest, OpenGoesOnlyAsFarAsAskedFromEitherSide) {
+  // From fully open the fingers narrow to the opening; from closed they open to it.
+  OperationResult result = run("Open", {{"opening", 0.06}});
+  ASSERT_EQ(result.state, OperationState::kSuccess) << result.reason;
+  EXPECT_NEAR(fingers.read().opening, 0.06, 0.001);
+  EXPECT_FALSE(holds("gripper_open"));
+  EXPECT_FALSE(holds("gripper_closed"));
+  run("Close");
+  result = run("Open", {{"opening", 0.045}});
+  ASSERT_EQ(result.state, OperationState::kSuccess) << result.reason;
+  EXPECT_NEAR(result.data.at("opening").get<double>(), 0.045, 0.001);
+  // Something in the way short of the opening asked for.
+  fingers.obstacle_at = 0.03;
+  run("Close");
+  result = run("Open", {{"opening", 0.045}});
+  EXPECT_EQ(result.state, OperationState::kFailure);
+  EXPECT_EQ(result.reason, "the fingers are blocked at 30.0 mm: they could not reach 45.0 mm");
+  // A part between the fingers stops them narrowing.
+  fingers.obstacle_at = 1.0;
+  run("Open");
+  fingers.object_width = 0.05;
+  result = run("Open", {{"opening", 0.03}});
+  EXPECT_EQ(result.state, OperationState::kFailure);
+  EXPECT_EQ(result.reason, "the fingers are blocked at 50.0 mm: they could not reach 30.0 mm");
+}
+
+TEST_F(GripperTest, OpenRefusesAnOpeningBeyondTheStroke) {
+  const auto* open = gripper.description().operation("Open");
+  ASSERT_NE(open, nullptr);
+  const auto spec = std::find_if(open->params.begin(), open->params.end(),
+                                 [](const component::ParamSpec& p) { return p.name == "opening"; });
+  ASSERT_NE(spec, open->params.end());
+  EXPECT_FALSE(spec->check("0.09").empty());
+  EXPECT_FALSE(spec->check("-0.01").empty());
+  EXPECT_TRUE(spec->check("0.05").empty());
 }
 
 TEST_F(GripperTest, OnlyPinchModeIsSupported) {

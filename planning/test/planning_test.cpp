@@ -53,7 +53,7 @@ TEST(RobotModel, TheUrdfChainMatchesTheDhModel) {
     EXPECT_LT((actual.translation() - expected.translation()).norm(), 1e-9);
     EXPECT_LT(world::rotationAngle(actual, expected), 1e-9);
   }
-  EXPECT_EQ(robot.links().size(), 8u);  // base, shoulder, upper arm, forearm, 3 wrists, tool
+  EXPECT_EQ(robot.links().size(), 9u);  // base, shoulder, upper arm, forearm, 3 wrists, tool, fingers
 }
 
 TEST(RobotModel, NumericInverseKinematicsReachesReachablePoses) {
@@ -103,7 +103,7 @@ TEST_F(Collisions, SelfCollisionsAreFound) {
   folded[2] = 2.4;
   const auto contact = world.check(folded);
   ASSERT_TRUE(contact.has_value());
-  EXPECT_EQ(contact->str(), "shoulder_link would touch tool0");
+  EXPECT_EQ(contact->str(), "shoulder_link would touch fingers");
 }
 
 TEST_F(Collisions, AllowedContactsAreIgnoredAndObstaclesCanBeRemoved) {
@@ -112,11 +112,43 @@ TEST_F(Collisions, AllowedContactsAreIgnoredAndObstaclesCanBeRemoved) {
   ASSERT_TRUE(world.check(kHome).has_value());
   EXPECT_EQ(world.check(kHome)->other, "part_1");
   world.allow("tool0", "part_1");
+  world.allow("fingers", "part_1");
   EXPECT_FALSE(world.check(kHome).has_value());
   world.disallowAll();
   world.allow("base_link", "table");
   world.removeAll("part_");
   EXPECT_FALSE(world.check(kHome).has_value());
+}
+
+TEST_F(Collisions, ALinksShapesCanBeReplacedAndPutBack) {
+  // A 2 cm block 5 cm from the tool centre point along the fingers' closing direction (the
+  // tool's y): inside the box over the fingers' whole travel (60 mm + padding either side).
+  const world::Pose tcp = kBaseInWorld * robot.forward(kHome);
+  world.setBox("block", tcp * Eigen::Translation3d(0, 0.05, 0), {0.02, 0.02, 0.02});
+  const auto contact = world.check(kHome);
+  ASSERT_TRUE(contact.has_value());
+  EXPECT_EQ(contact->str(), "fingers would touch block");
+  const std::vector<CollisionShape> travel = world.linkShapes("fingers");
+  ASSERT_EQ(travel.size(), 1u);
+  // Two 8 mm pads 40 mm apart (their inner faces) miss it; 80 mm apart they reach it.
+  const auto pads = [](double opening) {
+    std::vector<CollisionShape> shapes(2);
+    for (int side = 0; side < 2; ++side) {
+      shapes[side].size = {0.026, 0.008, 0.04};
+      shapes[side].origin = world::Pose(Eigen::Translation3d(0, (side == 0 ? 1 : -1) * (opening / 2 + 0.004), 0.14));
+    }
+    return shapes;
+  };
+  world.setLinkShapes("fingers", pads(0.04));
+  EXPECT_FALSE(world.check(kHome).has_value());
+  world.setLinkShapes("fingers", pads(0.08));
+  ASSERT_TRUE(world.check(kHome).has_value());
+  EXPECT_EQ(world.check(kHome)->str(), "fingers would touch block");
+  world.setLinkShapes("fingers", travel);
+  EXPECT_EQ(world.linkShapes("fingers").size(), 1u);
+  EXPECT_TRUE(world.check(kHome).has_value());
+  EXPECT_THROW(world.setLinkShapes("tcp", {}), std::invalid_argument);  // a link without shapes
+  EXPECT_THROW(world.linkShapes("gripper"), std::invalid_argument);
 }
 
 /// The tool over the table at 25 cm, swung to the left or right by the shoulder pan.

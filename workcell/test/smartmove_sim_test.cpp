@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
 
 #include "bt/builder.h"
 #include "bt/executor.h"
@@ -101,6 +102,53 @@ TEST_F(SmartMoveSim, PutsAPartDownOnAFreeSpotOfTheTableThatSatisfiesThePredicate
       <SmartRelease target="table" predicates="on(table_center)"/></Sequence>)x")
                 .failure_reason,
             "only left_of, right_of, in_front_of, behind, near(?, frame) can choose a spot on the table: on");
+}
+
+// Issue 12: a node boxed in by four links 30 mm from its faces (a pinwheel). A box over the
+// fingers' whole travel (60 mm either side of the centre line, plus padding) reaches every link
+// from every side, so all grasps were refused as "collision at the goal"; fingers opened only
+// as far as the node needs (its 50 mm + margin) fit between it and the links.
+TEST_F(SmartMoveSim, GraspsANodeBoxedInByLinksWithTheFingersOpenedOnlyAsFarAsItNeeds) {
+  open(R"x({"parts": [{"class": "node", "color": "red", "at": [0.45, -0.2, 0]},
+                     {"class": "link", "at": [0.42, -0.1325, 0]},
+                     {"class": "link", "at": [0.5175, -0.17, 90]},
+                     {"class": "link", "at": [0.48, -0.2675, 0]},
+                     {"class": "link", "at": [0.3825, -0.23, 90]}]})x");
+  std::map<std::string, Eigen::Vector3d> before;
+  for (const auto& state : cell->simulation()->parts()) {
+    before[state.name] = state.pose.translation();
+  }
+  const bt::RunResult result = run(R"x(<SmartGrasp object_class="node"/>)x");
+  ASSERT_EQ(result.status, bt::Status::kSuccess) << result.failure_path << ": " << result.failure_reason;
+  EXPECT_GT(part("node_0").pose.translation().z(), 0.1);  // up in the gripper
+  for (const char* link : {"link_0", "link_1", "link_2", "link_3"}) {
+    EXPECT_LT((part(link).pose.translation() - before[link]).norm(), 0.003) << link << " was pushed";
+  }
+  const sim::FingerState fingers = cell->simulation()->fingers();
+  EXPECT_NEAR(fingers.opening, 0.05, 0.004);  // squeezing the node
+  EXPECT_EQ(cell->simulation()->armTableContactSteps(), 0u);
+}
+
+// Issue 12: a link with a node 10 mm from either side of its middle. The centred grasp has no
+// room for the pads; the link is taken 40 mm off its middle, and put down centred on a node all
+// the same (the grasp is remembered as it was).
+TEST_F(SmartMoveSim, TakesALinkOffItsMiddleWhenNeighboursLeaveNoRoomThereAndPlacesItCentred) {
+  open(R"x({"parts": [{"class": "link", "at": [0.45, -0.2, 0]},
+                     {"class": "node", "color": "red", "at": [0.44, -0.1525, 0]},
+                     {"class": "node", "color": "blue", "at": [0.44, -0.2475, 0]},
+                     {"class": "node", "color": "green", "at": [0.45, 0.2, 20]}]})x");
+  const bt::RunResult result = run(R"x(<Sequence>
+      <SmartGrasp object_class="link" grasp="middle"/>
+      <SmartRelease target_class="node" predicates="left_of(table_center)"/>
+      <Home/></Sequence>)x");
+  ASSERT_EQ(result.status, bt::Status::kSuccess) << result.failure_path << ": " << result.failure_reason;
+  cell->simulation()->stepTo(cell->simulation()->time() + std::chrono::seconds(1));
+  const auto link = part("link_0");
+  const auto base = part("node_2");
+  EXPECT_NEAR(link.pose.translation().z(), 0.05 + 0.0125, 0.004);
+  EXPECT_LT((link.pose.translation() - base.pose.translation()).head<2>().norm(), 0.015);
+  EXPECT_LT((part("node_0").pose.translation() - Eigen::Vector3d(0.44, -0.1525, 0.025)).norm(), 0.003);
+  EXPECT_LT((part("node_1").pose.translation() - Eigen::Vector3d(0.44, -0.2475, 0.025)).norm(), 0.003);
 }
 
 TEST_F(SmartMoveSim, NoMatchingPartFailsWithTheReasonsOfEveryCandidate) {
