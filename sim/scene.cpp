@@ -27,7 +27,74 @@ Region parseRegion(const nlohmann::json& json) {
   return region;
 }
 
+/// "camera_offset": fixed {"xyz", "rpy_deg"} or random {"distance", "angle_deg", "seed"}.
+CameraOffset parseCameraOffset(const nlohmann::json& json) {
+  if (!json.is_object()) {
+    throw std::runtime_error("camera_offset must be an object: {\"xyz\": [x, y, z], \"rpy_deg\": [r, p, y]} or "
+                             "{\"distance\": m, \"angle_deg\": deg}");
+  }
+  const auto vector3 = [&json](const char* key) {
+    const auto& v = json.at(key);
+    if (!v.is_array() || v.size() != 3) {
+      throw std::runtime_error(std::string("camera_offset.") + key + " must be 3 numbers");
+    }
+    return Eigen::Vector3d(v.at(0).get<double>(), v.at(1).get<double>(), v.at(2).get<double>());
+  };
+  CameraOffset offset;
+  const bool fixed = json.contains("xyz") || json.contains("rpy_deg");
+  offset.random = json.contains("distance") || json.contains("angle_deg");
+  if (fixed == offset.random) {
+    throw std::runtime_error("camera_offset needs either \"xyz\"/\"rpy_deg\" (fixed) or \"distance\"/\"angle_deg\" "
+                             "(random direction), not both");
+  }
+  for (const auto& [key, value] : json.items()) {
+    if (key != "xyz" && key != "rpy_deg" && key != "distance" && key != "angle_deg" && key != "seed") {
+      throw std::runtime_error("camera_offset: unknown field '" + key + "' (known: xyz, rpy_deg, distance, angle_deg, seed)");
+    }
+  }
+  if (json.contains("xyz")) {
+    offset.xyz = vector3("xyz");
+  }
+  if (json.contains("rpy_deg")) {
+    offset.rpy_deg = vector3("rpy_deg");
+  }
+  offset.distance = json.value("distance", 0.0);
+  offset.angle_deg = json.value("angle_deg", 0.0);
+  if (json.contains("seed")) {
+    offset.seed = json.at("seed").get<std::uint64_t>();
+  }
+  if (offset.xyz.norm() > 0.5 || offset.distance < 0 || offset.distance > 0.5) {
+    throw std::runtime_error("camera_offset: the camera may move at most 0.5 m");
+  }
+  if (offset.rpy_deg.cwiseAbs().maxCoeff() > 45 || offset.angle_deg < 0 || offset.angle_deg > 45) {
+    throw std::runtime_error("camera_offset: the camera may turn at most 45 degrees");
+  }
+  return offset;
+}
+
 }  // namespace
+
+world::Pose cameraOffsetPose(const CameraOffset& offset, std::uint64_t seed) {
+  world::Pose pose = world::Pose::Identity();
+  if (!offset.random) {
+    const Eigen::Vector3d rpy = offset.rpy_deg * M_PI / 180.0;
+    pose = world::poseFromXyzRpy(offset.xyz.x(), offset.xyz.y(), offset.xyz.z(), rpy.x(), rpy.y(), rpy.z());
+    return pose;
+  }
+  // Directions uniform on the sphere: normalized Gaussian vectors.
+  std::mt19937_64 random(offset.seed.value_or(seed) ^ 0x63616d657261ULL);  // "camera": apart from placement
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const auto direction = [&] {
+    Eigen::Vector3d v;
+    do {
+      v = Eigen::Vector3d(normal(random), normal(random), normal(random));
+    } while (v.norm() < 1e-6);
+    return v.normalized();
+  };
+  pose.translation() = offset.distance * direction();
+  pose.linear() = Eigen::AngleAxisd(offset.angle_deg * M_PI / 180.0, direction()).toRotationMatrix();
+  return pose;
+}
 
 Scene parseScene(const std::string& text, const std::string& label) {
   try {
@@ -38,6 +105,9 @@ Scene parseScene(const std::string& text, const std::string& label) {
     scene.seed = json.value("seed", std::uint64_t{0});
     scene.min_gap = json.value("min_gap", 0.02);
     scene.regions = defaultRegions();
+    if (json.contains("camera_offset")) {
+      scene.camera_offset = parseCameraOffset(json.at("camera_offset"));
+    }
     for (const auto& [name, region] : json.value("regions", nlohmann::json::object()).items()) {
       scene.regions[name] = parseRegion(region);
     }
