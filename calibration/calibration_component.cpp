@@ -39,9 +39,11 @@ nlohmann::json residualSummary(const Residuals& r) {
 /// started, and accepts the result or keeps the previous calibration.
 class CalibrationRun final : public component::RunningOperation {
  public:
-  CalibrationRun(CalibrationComponent& component, bool marker_stage, int views, HandEyeMethod method, double speed)
+  CalibrationRun(CalibrationComponent& component, bool marker_stage, int views, HandEyeMethod method, bool refine,
+                 double speed)
       : c_(component),
         marker_stage_(marker_stage),
+        refine_(refine),
         wanted_(views),
         method_(method),
         speed_(speed),
@@ -171,16 +173,16 @@ class CalibrationRun final : public component::RunningOperation {
       const world::Pose before = c_.cameraPose();
       nlohmann::json data;
       if (marker_stage_) {
-        const MarkerCalibration result = solveMarker(views_, intrinsics, method_, /*refine=*/true, options);
+        const MarkerCalibration result = solveMarker(views_, intrinsics, method_, refine_, options);
         next.marker_in_flange = result.marker_in_flange;
-        next.marker_method = methodName(method_) + "+reprojection";
+        next.marker_method = methodName(method_) + (refine_ ? "+reprojection" : "");
         next.marker_residuals = result.residuals;
         next.marker_views = result.views;
         next.camera_in_world = result.camera_in_world;
         next.camera_residuals = result.residuals;
         next.camera_views = result.views;
         data["marker_in_flange"] = poseSummary(result.marker_in_flange);
-        data["method"] = methodName(method_);
+        data["method"] = next.marker_method;
         // The unrefined solution of every method on the same views, for comparison.
         nlohmann::json methods = nlohmann::json::object();
         for (const HandEyeMethod method : allMethods()) {
@@ -215,7 +217,14 @@ class CalibrationRun final : public component::RunningOperation {
       if (const std::string problem = c_.accept(next); !problem.empty()) {
         data["warning"] = problem;
       }
+      char summary[240];
+      std::snprintf(summary, sizeof summary,
+                    "camera moved %.1f mm and turned %.2f deg from the previous calibration; the marker's corners fit to "
+                    "%.2f px RMS over %zu views",
+                    data["camera_moved_mm"].get<double>(), data["camera_turned_deg"].get<double>(),
+                    (marker_stage_ ? next.marker_residuals : next.camera_residuals).reprojection_rms_px, views_.size());
       result_ = OperationResult::success(std::move(data));
+      result_.reason = summary;
     } catch (const CalibrationError& e) {
       nlohmann::json data = {{"views", views_.size()},
                              {"poses_tried", tried_},
@@ -250,6 +259,7 @@ class CalibrationRun final : public component::RunningOperation {
 
   CalibrationComponent& c_;
   bool marker_stage_;
+  bool refine_;
   int wanted_;
   HandEyeMethod method_;
   double speed_;
@@ -303,6 +313,10 @@ CalibrationComponent::CalibrationComponent(arm::ArmComponent& arm, camera::RgbdC
                    "hand-eye method: daniilidis (dual quaternions, the paper's), tsai, park, horaud, andreff, or the "
                    "robot-world shah, li; refined on the corners' reprojection",
                    std::string("daniilidis"), methods};
+  ParamSpec refine{"refine", ValueType::kBool,
+                   "refine the hand-eye solution on the marker corners' reprojection error (off: the method's own "
+                   "solution, for comparison)",
+                   true};
   description_.operations = {
       {"Calibrate",
        "Finds where the camera is: the arm shows the marker on the gripper to the camera from a few poses it chooses; "
@@ -311,7 +325,7 @@ CalibrationComponent::CalibrationComponent(arm::ArmComponent& arm, camera::RgbdC
       {"CalibrateMarker",
        "Once, after fixing the marker to the gripper: finds where it is on the flange by hand-eye calibration (the arm "
        "shows it to the camera from many poses), and the camera with it.",
-       {marker_views, method, speed}}};
+       {marker_views, method, refine, speed}}};
   description_.symbols = {{"camera", world::SymbolKind::kFrame, "the RGB-D camera's optical frame, as calibrated"}};
   description_.predicates = {{"camera_calibrated", 0, "the camera's pose comes from a calibration"}};
 }
@@ -369,6 +383,8 @@ std::unique_ptr<component::RunningOperation> CalibrationComponent::begin(const s
   const int views =
       static_cast<int>(number("views", marker_stage ? config_.marker_views : config_.camera_views));
   const double speed = number("speed", config_.speed);
+  const auto refine_it = params.find("refine");
+  const bool refine = refine_it == params.end() || refine_it->second.asBool();
   HandEyeMethod method = HandEyeMethod::kDaniilidis;
   if (const auto it = params.find("method"); it != params.end()) {
     try {
@@ -389,7 +405,7 @@ std::unique_ptr<component::RunningOperation> CalibrationComponent::begin(const s
     }
     running_ = true;
   }
-  return std::make_unique<CalibrationRun>(*this, marker_stage, views, method, speed);
+  return std::make_unique<CalibrationRun>(*this, marker_stage, views, method, refine, speed);
 }
 
 }  // namespace costar::calibration

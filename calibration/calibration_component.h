@@ -41,8 +41,8 @@ struct CalibrationConfig {
   world::Pose marker_in_flange_guess = world::Pose::Identity();
   /// Where the marker's centre may be put, in the world (in front of the camera, above the
   /// table and the parts).
-  Eigen::Vector3d region_min{0.35, -0.25, 0.12};
-  Eigen::Vector3d region_max{0.65, 0.25, 0.35};
+  Eigen::Vector3d region_min{0.35, -0.25, 0.18};
+  Eigen::Vector3d region_max{0.65, 0.25, 0.36};
   /// Largest angle between the marker's normal and the direction to the camera (degrees).
   double max_view_angle_deg = 50.0;
   /// Stage (a): the views differ by at least this rotation from each other (degrees), and

@@ -88,7 +88,7 @@ struct SolveOptions {
   int min_camera_views = 3;
   double min_position_spread = 0.15;
   /// A solution whose corner reprojection error exceeds this (pixels, RMS) is refused.
-  double max_reprojection_rms_px = 1.5;
+  double max_reprojection_rms_px = 3.0;
 };
 
 /// Stage (a) with `method`; refined on the corners' reprojection when `refine`.

@@ -13,8 +13,8 @@ namespace costar::calibration {
 
 struct ViewPlanOptions {
   /// Where the marker's centre may be, in the world.
-  Eigen::Vector3d region_min{0.35, -0.25, 0.12};
-  Eigen::Vector3d region_max{0.65, 0.25, 0.35};
+  Eigen::Vector3d region_min{0.35, -0.25, 0.18};
+  Eigen::Vector3d region_max{0.65, 0.25, 0.36};
   /// Marker poses turned away from facing the camera by up to tilt (about the marker's x and
   /// y) and roll (about its normal), degrees. Zero: facing the camera squarely, upright.
   double tilt_deg = 0.0;

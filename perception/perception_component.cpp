@@ -71,6 +71,9 @@ class DetectObjectsOperation final : public component::RunningOperation {
  private:
   void capture() {
     frames_.push_back(component_.camera_.capture());
+    if (component_.config_.camera_pose) {
+      frames_.back().camera_pose = component_.config_.camera_pose();
+    }
     next_capture_ = component_.clock_.now() + component_.camera_.framePeriod();
   }
 
