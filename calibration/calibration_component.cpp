@@ -173,7 +173,9 @@ class CalibrationRun final : public component::RunningOperation {
       const world::Pose before = c_.cameraPose();
       nlohmann::json data;
       if (marker_stage_) {
-        const MarkerCalibration result = solveMarker(views_, intrinsics, method_, refine_, options);
+        SolveOptions with_guess = options;
+        with_guess.marker_in_flange_guess = c_.config_.marker_in_flange_guess;
+        const MarkerCalibration result = solveMarker(views_, intrinsics, method_, refine_, with_guess);
         next.marker_in_flange = result.marker_in_flange;
         next.marker_method = methodName(method_) + (refine_ ? "+reprojection" : "");
         next.marker_residuals = result.residuals;

@@ -326,6 +326,28 @@ MarkerCalibration solveMarker(const std::vector<MarkerView>& views, const camera
   if (refine_result) {
     refine(views, intrinsics, options.marker_size, result.marker_in_flange, result.camera_in_world, true);
     result.refined = true;
+    if (options.marker_in_flange_guess) {
+      // A second start: the drawings' marker, the camera that fits it best.
+      SolveOptions loose = options;
+      loose.max_reprojection_rms_px = 1e9;
+      loose.min_camera_views = 1;
+      loose.min_position_spread = 0.0;
+      try {
+        world::Pose x = *options.marker_in_flange_guess;
+        world::Pose y = solveCamera(views, intrinsics, x, loose).camera_in_world;
+        refine(views, intrinsics, options.marker_size, x, y, true);
+        const double other = residualsOf(views, intrinsics, x, y, options.marker_size).reprojection_rms_px;
+        const double mine = residualsOf(views, intrinsics, result.marker_in_flange, result.camera_in_world,
+                                        options.marker_size)
+                                .reprojection_rms_px;
+        if (other < mine) {
+          result.marker_in_flange = x;
+          result.camera_in_world = y;
+        }
+      } catch (const CalibrationError&) {
+        // keep the method's start
+      }
+    }
   }
   result.residuals =
       residualsOf(views, intrinsics, result.marker_in_flange, result.camera_in_world, options.marker_size);

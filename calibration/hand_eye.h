@@ -89,6 +89,10 @@ struct SolveOptions {
   double min_position_spread = 0.15;
   /// A solution whose corner reprojection error exceeds this (pixels, RMS) is refused.
   double max_reprojection_rms_px = 3.0;
+  /// Stage (a): where the marker roughly is on the flange (the drawings). When set, the
+  /// refinement also starts from it (with the camera by PnP) and keeps the better fit: a
+  /// small marker's ArUco tilt is often off by many degrees, and the hand-eye methods with it.
+  std::optional<world::Pose> marker_in_flange_guess;
 };
 
 /// Stage (a) with `method`; refined on the corners' reprojection when `refine`.
