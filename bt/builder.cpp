@@ -11,13 +11,70 @@ namespace costar::bt {
 namespace {
 
 // Attributes BehaviorTree.CPP evaluates as scripts: they need a blackboard, which CoSTAR
-// plans do not have (the paper: no user variables, no scope).
-constexpr std::string_view kScriptAttributes[] = {"_skipIf",    "_failureIf", "_successIf", "_while",
-                                                  "_onSuccess", "_onFailure", "_onHalted",  "_post"};
+// plans do not have (the paper: no user variables, no scope). Each with what to use instead.
+struct ScriptAttribute {
+  std::string_view key;
+  std::string_view instead;
+};
+constexpr std::string_view kUseConditionBefore =
+    "put a condition (CheckPredicate) before the node instead, in a Sequence, IfThenElse or WhileDoElse";
+constexpr std::string_view kUseResult =
+    "there are no variables to update: act on the node's result instead (Fallback, IfThenElse, TryCatch)";
+constexpr ScriptAttribute kScriptAttributes[] = {
+    {"_skipIf", kUseConditionBefore},    {"_failureIf", kUseConditionBefore},
+    {"_successIf", kUseConditionBefore}, {"_while", kUseConditionBefore},
+    {"_onSuccess", kUseResult},          {"_onFailure", kUseResult},
+    {"_onHalted", kUseResult},           {"_post", kUseResult}};
 
-bool isScriptAttribute(std::string_view key) {
-  return std::find(std::begin(kScriptAttributes), std::end(kScriptAttributes), key) != std::end(kScriptAttributes);
+const ScriptAttribute* findScriptAttribute(std::string_view key) {
+  for (const ScriptAttribute& attribute : kScriptAttributes) {
+    if (attribute.key == key) {
+      return &attribute;
+    }
+  }
+  return nullptr;
 }
+
+// BehaviorTree.CPP built-ins that read or write the blackboard: refused by design, each with
+// what a CoSTAR plan uses instead.
+struct BlackboardNode {
+  std::string_view id;
+  std::string_view instead;
+};
+constexpr std::string_view kUseCondition = "test the world state with a condition (CheckPredicate) instead";
+constexpr std::string_view kUseBranch =
+    "branch on conditions instead: IfThenElse, WhileDoElse or a Fallback over CheckPredicate nodes";
+constexpr std::string_view kUseLoop = "loop with Repeat, RepeatRuns or RetryUntilSuccessful instead";
+constexpr std::string_view kUseParameters = "write each value as a parameter of the node that uses it instead";
+constexpr BlackboardNode kBlackboardNodes[] = {{"Script", kUseParameters},
+                                               {"ScriptCondition", kUseCondition},
+                                               {"Precondition", kUseBranch},
+                                               {"SetBlackboard", kUseParameters},
+                                               {"UnsetBlackboard", kUseParameters},
+                                               {"Switch2", kUseBranch},
+                                               {"Switch3", kUseBranch},
+                                               {"Switch4", kUseBranch},
+                                               {"Switch5", kUseBranch},
+                                               {"Switch6", kUseBranch},
+                                               {"LoopInt", kUseLoop},
+                                               {"LoopDouble", kUseLoop},
+                                               {"LoopString", kUseLoop},
+                                               {"LoopBool", kUseLoop},
+                                               {"WasEntryUpdated", kUseCondition},
+                                               {"SkipUnlessUpdated", kUseCondition},
+                                               {"WaitValueUpdate", kUseCondition}};
+
+const BlackboardNode* findBlackboardNode(std::string_view id) {
+  for (const BlackboardNode& node : kBlackboardNodes) {
+    if (node.id == id) {
+      return &node;
+    }
+  }
+  return nullptr;
+}
+
+constexpr std::string_view kByDesign =
+    "CoSTAR plans have no blackboard, by design (the paper: no user variables, no scope)";
 
 bool isBlackboardReference(std::string_view value) {
   const auto open = value.find('{');
@@ -165,7 +222,10 @@ class Validator {
     const NodeSpec* spec = registry_.find(node.id);
     if (spec == nullptr) {
       std::string message = "unknown node '" + node.id + "'";
-      if (const auto suggestion = registry_.suggest(node.id)) {
+      if (const BlackboardNode* blackboard = findBlackboardNode(node.id)) {
+        message = "'" + node.id + "' is a BehaviorTree.CPP node that works on the blackboard; " +
+                  std::string(kByDesign) + ": " + std::string(blackboard->instead);
+      } else if (const auto suggestion = registry_.suggest(node.id)) {
         message += " (did you mean '" + *suggestion + "'?)";
       }
       error(node.location, message);
@@ -177,6 +237,12 @@ class Validator {
       }
       if (node.id == "ReactiveSequence" || node.id == "ReactiveFallback") {
         checkReactive(node);
+      }
+      if (node.id == "WhileDoElse" && !node.children.empty() && mayRun(node.children.front())) {
+        error(node.children.front().location,
+              node.children.front().id +
+                  " can be RUNNING, but WhileDoElse re-checks its first child on every tick while a branch runs: "
+                  "the condition must complete at once (use a condition such as CheckPredicate)");
       }
     }
     for (const PlanNode& child : node.children) {
@@ -207,24 +273,26 @@ class Validator {
   void checkAttributes(const NodeSpec& spec, const PlanNode& node) {
     bool ports_valid = true;
     for (const auto& [key, value] : node.attributes) {
-      if (key == "name" || key == "_description") {
+      if (key == "name") {
         continue;
       }
-      if (isScriptAttribute(key)) {
-        error(node.location, "'" + key +
-                                 "' is a BehaviorTree.CPP script, which CoSTAR plans do not "
-                                 "support (no variables): use a Condition node instead");
+      if (const ScriptAttribute* script = findScriptAttribute(key)) {
+        error(node.location, "'" + key + "' is a BehaviorTree.CPP script; " + std::string(kByDesign) + ": " +
+                                 std::string(script->instead));
         ports_valid = false;
         continue;
       }
-      if (spec.kind == NodeKind::kSubTree && key == "_autoremap") {
-        continue;  // meaningless without a blackboard; accepted for Groot2's files
+      if (key.starts_with("_")) {
+        // BehaviorTree.CPP's own attributes (_description, _uid, _fullpath, _autoremap, ...):
+        // metadata for tools, not parameters; BehaviorTree.CPP accepts any, and so do we.
+        continue;
       }
       const PortSpec* port = spec.port(key);
       if (port == nullptr) {
         std::string message = node.id + " has no parameter '" + key + "'";
         if (spec.kind == NodeKind::kSubTree) {
-          message += ": SubTree port remapping needs a blackboard, which CoSTAR plans do not have";
+          message += ": SubTree port remapping needs a blackboard; " + std::string(kByDesign) +
+                     ": write the values as parameters of the nodes inside the subtree instead";
         } else {
           message += " (" + portList(spec) + ")";
         }
@@ -233,9 +301,8 @@ class Validator {
         continue;
       }
       if (isBlackboardReference(value)) {
-        error(node.location, "parameter '" + key + "' of " + node.id + " is '" + value +
-                                 "': blackboard references are not supported (no variables); "
-                                 "write the value itself");
+        error(node.location, "parameter '" + key + "' of " + node.id + " is '" + value + "', a blackboard reference; " +
+                                 std::string(kByDesign) + ": write the value itself instead");
         ports_valid = false;
         continue;
       }

@@ -12,6 +12,8 @@ Status Inverter::onTick() {
     case Status::kFailure:
       child_->halt();
       return Status::kSuccess;
+    case Status::kSkipped:
+      return Status::kSkipped;
     default:
       return Status::kRunning;
   }
@@ -19,7 +21,7 @@ Status Inverter::onTick() {
 
 Status ForceSuccess::onTick() {
   const Status status = child_->tick();
-  if (status == Status::kRunning) {
+  if (status == Status::kRunning || status == Status::kSkipped) {
     return status;
   }
   child_->halt();
@@ -28,7 +30,7 @@ Status ForceSuccess::onTick() {
 
 Status ForceFailure::onTick() {
   const Status status = child_->tick();
-  if (status == Status::kRunning) {
+  if (status == Status::kRunning || status == Status::kSkipped) {
     return status;
   }
   child_->halt();
@@ -44,6 +46,10 @@ Repeat::Repeat(std::string id, std::string name, int num_cycles)
 Status Repeat::onTick() {
   const Status status = child_->tick();
   if (status == Status::kRunning) {
+    return status;
+  }
+  if (status == Status::kSkipped) {
+    count_ = 0;
     return status;
   }
   child_->halt();
@@ -75,6 +81,10 @@ Status RepeatRuns::onTick() {
   if (status == Status::kRunning) {
     return status;
   }
+  if (status == Status::kSkipped) {
+    count_ = 0;
+    return status;
+  }
   child_->halt();
   ++count_;
   if (num_runs_ >= 0 && count_ >= num_runs_) {
@@ -100,7 +110,7 @@ Status Reset::onTick() {
     return failFrom(*child_);  // budget spent: pass the last FAILURE on, child untouched
   }
   const Status status = child_->tick();
-  if (status == Status::kRunning) {
+  if (status == Status::kRunning || status == Status::kSkipped) {
     return status;
   }
   if (status == Status::kSuccess) {
@@ -145,7 +155,7 @@ Status Timeout::onTick() {
   }
   started_ = false;
   child_->halt();
-  return status == Status::kSuccess ? status : failFrom(*child_);
+  return status == Status::kFailure ? failFrom(*child_) : status;
 }
 
 void Timeout::onHalt() {
@@ -161,6 +171,10 @@ RetryUntilSuccessful::RetryUntilSuccessful(std::string id, std::string name, int
 Status RetryUntilSuccessful::onTick() {
   const Status status = child_->tick();
   if (status == Status::kRunning) {
+    return status;
+  }
+  if (status == Status::kSkipped) {
+    attempts_ = 0;
     return status;
   }
   child_->halt();
@@ -197,7 +211,82 @@ Status SubTreeNode::onTick() {
     return status;
   }
   child_->halt();
-  return status == Status::kSuccess ? status : failFrom(*child_);
+  return status == Status::kFailure ? failFrom(*child_) : status;
+}
+
+// --- KeepRunningUntilFailure ------------------------------------------------------------
+
+Status KeepRunningUntilFailure::onTick() {
+  const Status status = child_->tick();
+  switch (status) {
+    case Status::kFailure:
+      child_->halt();
+      return failFrom(*child_);
+    case Status::kSuccess:
+      child_->halt();
+      return Status::kRunning;  // run it again on the next tick
+    default:
+      return status;
+  }
+}
+
+// --- Delay -------------------------------------------------------------------------------
+
+Delay::Delay(std::string id, std::string name, Duration delay)
+    : DecoratorNode(std::move(id), std::move(name)), delay_(delay) {}
+
+Status Delay::onTick() {
+  const TimePoint now = context().now();
+  if (!started_) {
+    started_ = true;
+    ticking_child_ = false;
+    deadline_ = now + delay_;
+  }
+  if (!ticking_child_) {
+    if (now < deadline_) {
+      return Status::kRunning;
+    }
+    ticking_child_ = true;
+  }
+  const Status status = child_->tick();
+  if (status == Status::kRunning) {
+    return status;
+  }
+  started_ = false;
+  child_->halt();
+  return status == Status::kFailure ? failFrom(*child_) : status;
+}
+
+void Delay::onHalt() {
+  child_->halt();
+  started_ = false;
+}
+
+// --- RunOnce -------------------------------------------------------------------------------
+
+RunOnce::RunOnce(std::string id, std::string name, bool then_skip)
+    : DecoratorNode(std::move(id), std::move(name)), then_skip_(then_skip) {}
+
+Status RunOnce::onTick() {
+  if (done_) {
+    if (then_skip_) {
+      return Status::kSkipped;
+    }
+    return result_ == Status::kFailure ? failFrom(*child_) : result_;
+  }
+  const Status status = child_->tick();
+  if (status == Status::kRunning || status == Status::kSkipped) {
+    return status;
+  }
+  done_ = true;
+  result_ = status;
+  child_->halt();
+  return status == Status::kFailure ? failFrom(*child_) : status;
+}
+
+void RunOnce::onReset() {
+  done_ = false;
+  result_ = Status::kIdle;
 }
 
 }  // namespace costar::bt

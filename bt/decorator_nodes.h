@@ -112,6 +112,50 @@ class RetryUntilSuccessful final : public DecoratorNode {
   int attempts_ = 0;
 };
 
+/// BehaviorTree.CPP's KeepRunningUntilFailure: re-runs its child while it succeeds, one run
+/// per tick at most (returns RUNNING after each successful run); a FAILURE ends it with that
+/// FAILURE. Never returns SUCCESS.
+class KeepRunningUntilFailure final : public DecoratorNode {
+ public:
+  using DecoratorNode::DecoratorNode;
+
+ private:
+  Status onTick() override;
+};
+
+/// BehaviorTree.CPP's Delay: RUNNING until `delay_msec` of clock time have passed since its
+/// first tick, then ticks its child (in the same tick) and returns the child's result. With
+/// the simulated clock the wait costs no wall time. A halt cancels the wait.
+class Delay final : public DecoratorNode {
+ public:
+  Delay(std::string id, std::string name, Duration delay);
+
+ private:
+  Status onTick() override;
+  void onHalt() override;
+  void onReset() override { started_ = false; }
+  Duration delay_;
+  TimePoint deadline_{};
+  bool started_ = false;
+  bool ticking_child_ = false;
+};
+
+/// BehaviorTree.CPP's RunOnce: runs its child once (to completion, however many ticks);
+/// afterwards, without ticking the child again, it is skipped (`then_skip=true`, the default)
+/// or returns the same result again (`then_skip=false`). Only reset() (a Reset ancestor, a new
+/// run of the plan) lets it run again; a halt while the child is RUNNING does not count as a run.
+class RunOnce final : public DecoratorNode {
+ public:
+  RunOnce(std::string id, std::string name, bool then_skip);
+
+ private:
+  Status onTick() override;
+  void onReset() override;
+  bool then_skip_;
+  bool done_ = false;
+  Status result_ = Status::kIdle;
+};
+
 /// An instance of another BehaviorTree of the plan; transparent: returns its child's value.
 class SubTreeNode final : public DecoratorNode {
  public:

@@ -43,6 +43,13 @@ RunResult Executor::run() {
     }
     const Status status = tree_.tick();
     ++result.ticks;
+    if (status == Status::kSkipped) {
+      // BehaviorTree.CPP returns SKIPPED from the root; a run that did nothing did not succeed.
+      result.status = Status::kFailure;
+      result.failure_path = tree_.root().path();
+      result.failure_reason = "the whole tree was skipped: nothing in it ran (RunOnce had run already)";
+      break;
+    }
     if (isCompleted(status)) {
       result.status = status;
       if (status == Status::kFailure) {

@@ -14,6 +14,8 @@ const char* toString(Status status) {
       return "SUCCESS";
     case Status::kFailure:
       return "FAILURE";
+    case Status::kSkipped:
+      return "SKIPPED";
   }
   return "?";
 }
@@ -38,7 +40,7 @@ TreeNode::TreeNode(std::string id, std::string name) : id_(std::move(id)), name_
 Status TreeNode::tick() {
   context_->countNodeTick();
   const Status status = onTick();
-  setStatus(status);
+  setStatus(status == Status::kSkipped ? Status::kIdle : status);  // a skipped node did not run
   return status;
 }
 

@@ -17,9 +17,13 @@
 
 namespace costar::bt {
 
-enum class Status : std::uint8_t { kIdle, kRunning, kSuccess, kFailure };
+/// kSkipped is BehaviorTree.CPP's SKIPPED: a node that did not run at all this time (RunOnce
+/// after its run). It is only ever *returned* to the parent: the node's recorded status stays
+/// IDLE, so observers never see it. Parents pass over a skipped child; a node whose children
+/// were all skipped is skipped itself (docs/BEHAVIOR_TREES.md).
+enum class Status : std::uint8_t { kIdle, kRunning, kSuccess, kFailure, kSkipped };
 
-/// "IDLE", "RUNNING", "SUCCESS", "FAILURE".
+/// "IDLE", "RUNNING", "SUCCESS", "FAILURE", "SKIPPED".
 const char* toString(Status status);
 inline bool isCompleted(Status status) { return status == Status::kSuccess || status == Status::kFailure; }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -76,11 +77,14 @@ class FileParser {
         }
       } else if (key == "main_tree_to_execute") {
         file_.main_tree = attribute->Value();
-      } else {
-        error(root.GetLineNum(), "unknown attribute '" + std::string(key) + "' on <root>");
       }
+      // Other attributes (Groot2's project_name, ...) are ignored, as BehaviorTree.CPP does.
     }
     std::set<std::string> tree_ids;
+    for (const auto* tree = root.FirstChildElement("BehaviorTree"); tree != nullptr;
+         tree = tree->NextSiblingElement("BehaviorTree")) {
+      ++tree_count_;
+    }
     for (const auto* element = root.FirstChildElement(); element != nullptr; element = element->NextSiblingElement()) {
       const std::string_view name = element->Name();
       if (name == "BehaviorTree") {
@@ -112,11 +116,19 @@ class FileParser {
     PlanTree tree;
     tree.location = {file_.path, element.GetLineNum()};
     const char* id = element.Attribute("ID");
-    if (id == nullptr || *id == '\0') {
-      error(element.GetLineNum(), "<BehaviorTree> needs an ID attribute");
+    if (id == nullptr && tree_count_ > 1) {
+      error(element.GetLineNum(), "<BehaviorTree> needs an ID attribute: the file has " + std::to_string(tree_count_) +
+                                      " trees (only a file's single tree may leave it out)");
       return;
+    } else if (id == nullptr) {
+      // A file's single tree may leave the ID out; BehaviorTree.CPP then names it "BehaviorTree_<k>".
+      tree.id = "BehaviorTree_" + std::to_string(unnamed_trees_++);
+    } else if (*id == '\0') {
+      error(element.GetLineNum(), "<BehaviorTree ID=\"\"> has an empty ID: name the tree, or leave ID out");
+      return;
+    } else {
+      tree.id = id;
     }
-    tree.id = id;
     for (const auto* attribute = element.FirstAttribute(); attribute != nullptr; attribute = attribute->Next()) {
       const std::string_view key = attribute->Name();
       if (key != "ID" && !key.starts_with("_")) {
@@ -179,6 +191,8 @@ class FileParser {
 
   PlanFile file_;
   std::vector<Diagnostic> diagnostics_;
+  int unnamed_trees_ = 0;
+  int tree_count_ = 0;
 };
 
 std::optional<std::string> readFile(const std::filesystem::path& path, std::size_t max_bytes,
@@ -205,22 +219,39 @@ std::optional<std::string> readFile(const std::filesystem::path& path, std::size
 }
 
 /// Follows includes depth-first, each file once; a file already on the stack is a cycle.
+/// Iterative (an explicit stack of files), so a chain of any length cannot overflow the call
+/// stack. Included files are listed after the files they include.
 class IncludeLoader {
  public:
   explicit IncludeLoader(const LoadOptions& options) : options_(options) {}
 
-  void follow(const PlanFile& file, const std::filesystem::path& base_dir) {
-    stack_.push_back(file.path);
-    for (const PlanInclude& include : file.includes) {
+  void follow(const PlanFile& root, const std::filesystem::path& base_dir) {
+    std::vector<Frame> frames;
+    frames.push_back({&root, nullptr, base_dir});
+    stack_.push_back(root.path);
+    while (!frames.empty()) {
+      if (frames.back().next == frames.back().file->includes.size()) {
+        Frame done = std::move(frames.back());
+        frames.pop_back();
+        stack_.pop_back();
+        if (done.owned) {
+          on_stack_.erase(stack_keys_.back());
+          stack_keys_.pop_back();
+          files_.push_back(std::move(*done.owned));
+        }
+        continue;
+      }
+      Frame& frame = frames.back();
+      const PlanInclude& include = frame.file->includes[frame.next++];
       const SourceLocation& where = include.location;
       if (!options_.follow_includes) {
         diagnostics_.push_back({where, "includes are not allowed here ('" + include.path + "')"});
         continue;
       }
-      const std::filesystem::path target = base_dir / include.path;
+      const std::filesystem::path target = frame.base_dir / include.path;
       std::error_code ec;
       const std::string key = std::filesystem::weakly_canonical(target, ec).string();
-      if (std::find(stack_keys_.begin(), stack_keys_.end(), key) != stack_keys_.end()) {
+      if (on_stack_.contains(key)) {
         std::string cycle;
         for (const auto& step : stack_) {
           cycle += step + " -> ";
@@ -236,22 +267,23 @@ class IncludeLoader {
         continue;
       }
       try {
-        PlanFile included = parsePlanFile(*text, target.string());
+        auto included = std::make_unique<PlanFile>(parsePlanFile(*text, target.string()));
         stack_keys_.push_back(key);
-        follow(included, target.parent_path());
-        stack_keys_.pop_back();
-        files_.push_back(std::move(included));
+        on_stack_.insert(key);
+        stack_.push_back(included->path);
+        const PlanFile* file = included.get();
+        frames.push_back({file, std::move(included), target.parent_path()});  // `frame` is invalid now
       } catch (const PlanError& error) {
         diagnostics_.insert(diagnostics_.end(), error.diagnostics().begin(), error.diagnostics().end());
       }
     }
-    stack_.pop_back();
   }
 
   void markRoot(const std::filesystem::path& path) {
     std::error_code ec;
     const std::string key = std::filesystem::weakly_canonical(path, ec).string();
     stack_keys_.push_back(key);
+    on_stack_.insert(key);
     loaded_.insert(key);
   }
 
@@ -259,9 +291,17 @@ class IncludeLoader {
   std::vector<Diagnostic> diagnostics_;
 
  private:
+  struct Frame {
+    const PlanFile* file;
+    std::unique_ptr<PlanFile> owned;  // null for the root file, which the caller owns
+    std::filesystem::path base_dir;
+    std::size_t next = 0;  // the next of file->includes to follow
+  };
+
   const LoadOptions& options_;
-  std::vector<std::string> stack_;
-  std::vector<std::string> stack_keys_;
+  std::vector<std::string> stack_;       // paths of the files being followed, for messages
+  std::vector<std::string> stack_keys_;  // their canonical paths
+  std::set<std::string> on_stack_;       // the same, for lookup
   std::set<std::string> loaded_;
 };
 

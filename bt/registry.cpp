@@ -343,10 +343,31 @@ int toInt(long long value) { return static_cast<int>(value); }
 
 void registerBuiltinNodes(NodeRegistry& registry) {
   // Nodes that BehaviorTree.CPP v4 has under the same ID and semantics.
-  static const std::set<std::string, std::less<>> kBehaviorTreeCpp = {
-      "Sequence", "SequenceWithMemory", "ReactiveSequence", "Fallback", "ReactiveFallback", "Parallel",
-      "Inverter", "ForceSuccess",       "ForceFailure",     "Repeat",   "Timeout",          "RetryUntilSuccessful",
-      "SubTree",  "AlwaysSuccess",      "AlwaysFailure",    "Sleep"};
+  static const std::set<std::string, std::less<>> kBehaviorTreeCpp = {"Sequence",
+                                                                      "SequenceWithMemory",
+                                                                      "ReactiveSequence",
+                                                                      "Fallback",
+                                                                      "ReactiveFallback",
+                                                                      "Parallel",
+                                                                      "AsyncSequence",
+                                                                      "AsyncFallback",
+                                                                      "ParallelAll",
+                                                                      "IfThenElse",
+                                                                      "WhileDoElse",
+                                                                      "TryCatch",
+                                                                      "Inverter",
+                                                                      "ForceSuccess",
+                                                                      "ForceFailure",
+                                                                      "Repeat",
+                                                                      "Timeout",
+                                                                      "RetryUntilSuccessful",
+                                                                      "Delay",
+                                                                      "RunOnce",
+                                                                      "KeepRunningUntilFailure",
+                                                                      "SubTree",
+                                                                      "AlwaysSuccess",
+                                                                      "AlwaysFailure",
+                                                                      "Sleep"};
   const auto add = [&registry](NodeSpec spec) {
     spec.btcpp_builtin = kBehaviorTreeCpp.contains(spec.id);
     registry.add(std::move(spec));
@@ -400,6 +421,77 @@ void registerBuiltinNodes(NodeRegistry& registry) {
     };
     add(std::move(spec));
   }
+  add(asynchronous(control("AsyncSequence",
+                           "Sequence that gives the tick back after each child that completed at once (RUNNING, "
+                           "then resumes immediately), so a long chain stays interruptible.",
+                           plain<AsyncSequence>())));
+  add(asynchronous(control("AsyncFallback",
+                           "Fallback that gives the tick back after each child that failed at once (RUNNING, then "
+                           "resumes immediately).",
+                           plain<AsyncFallback>())));
+  {
+    NodeSpec spec =
+        control("ParallelAll",
+                "Ticks all children together until every one has completed (none is halted early); "
+                "FAILURE if at least max_failures failed, else SUCCESS.",
+                [](const NodeArgs& args) {
+                  return std::make_unique<ParallelAll>(args.spec().id, args.name(), toInt(args.getInt("max_failures")));
+                });
+    spec.ports = {PortSpec::integer("max_failures",
+                                    "failed children that make it fail (negative: from the end, -1 = all)", "1",
+                                    -kMaxCount, kMaxCount)};
+    spec.check_instance = [](const NodeArgs& args, std::size_t child_count) -> std::string {
+      const long long n = static_cast<long long>(child_count);
+      const long long count = args.getInt("max_failures");
+      const long long resolved = count < 0 ? std::max(n + count + 1, 0LL) : count;
+      if (resolved > n) {
+        return "max_failures=" + std::to_string(count) + " is more than its " + std::to_string(n) +
+               " children: it could never fail";
+      }
+      return {};
+    };
+    add(std::move(spec));
+  }
+  const auto two_or_three = [](const NodeArgs&, std::size_t child_count) -> std::string {
+    if (child_count == 2 || child_count == 3) {
+      return {};
+    }
+    return "needs 2 or 3 children (the condition, then-branch, optional else-branch), has " +
+           std::to_string(child_count);
+  };
+  {
+    NodeSpec spec = control("IfThenElse",
+                            "2 or 3 children: runs the first (the condition) to completion; SUCCESS runs the second, "
+                            "FAILURE the third (or fails without one). Returns the branch's result.",
+                            plain<IfThenElse>());
+    spec.check_instance = two_or_three;
+    add(std::move(spec));
+  }
+  {
+    NodeSpec spec = control("WhileDoElse",
+                            "2 or 3 children: re-checks the first (the condition) on every tick; while it succeeds "
+                            "runs the second, else the third (halting the other). Returns the branch's result.",
+                            plain<WhileDoElse>());
+    spec.check_instance = two_or_three;
+    add(std::move(spec));
+  }
+  {
+    NodeSpec spec =
+        control("TryCatch",
+                "Runs children 1..n-1 as a Sequence (try); if one fails, runs the last child (catch, e.g. "
+                "open the gripper and retreat) and returns FAILURE whatever it returned.",
+                [](const NodeArgs& args) {
+                  return std::make_unique<TryCatch>(args.spec().id, args.name(), args.getBool("catch_on_halt"));
+                });
+    spec.ports = {
+        PortSpec::boolean("catch_on_halt", "also tick the catch child once when halted during the try block", "false")};
+    spec.check_instance = [](const NodeArgs&, std::size_t child_count) -> std::string {
+      return child_count >= 2 ? std::string()
+                              : "needs at least 2 children (the try block, then the catch child), has " +
+                                    std::to_string(child_count);
+    };
+    add(std::move(spec));
+  }
   add(control("Iterator",
               "CoSTAR's Iterator: runs each child once, in order, ignoring failures; "
               "SUCCESS after the last.",
@@ -445,6 +537,27 @@ void registerBuiltinNodes(NodeRegistry& registry) {
         return std::make_unique<RetryUntilSuccessful>(args.spec().id, args.name(), toInt(args.getInt("num_attempts")));
       },
       {PortSpec::integer("num_attempts", "runs allowed in all (-1 = unlimited)", std::nullopt, 1, kMaxCount, -1)})));
+  add(asynchronous(decorator("KeepRunningUntilFailure",
+                             "Re-runs the child while it succeeds (RUNNING in between, one run per tick at most); "
+                             "FAILURE when it fails. Never succeeds.",
+                             plain<KeepRunningUntilFailure>())));
+  add(asynchronous(decorator("Delay",
+                             "Waits delay_msec milliseconds of clock time, then ticks the child and returns its "
+                             "result.",
+                             [](const NodeArgs& args) {
+                               return std::make_unique<Delay>(args.spec().id, args.name(),
+                                                              std::chrono::milliseconds(args.getInt("delay_msec")));
+                             },
+                             {PortSpec::integer("delay_msec", "wait before ticking the child, in milliseconds",
+                                                std::nullopt, 0, kMaxCount)})));
+  add(decorator(
+      "RunOnce",
+      "Runs the child once; afterwards it is skipped (then_skip=true) or returns that first result "
+      "again without ticking the child (then_skip=false).",
+      [](const NodeArgs& args) {
+        return std::make_unique<RunOnce>(args.spec().id, args.name(), args.getBool("then_skip"));
+      },
+      {PortSpec::boolean("then_skip", "after the first run: skipped (true) or same result (false)", "true")}));
   {
     NodeSpec spec;
     spec.id = "SubTree";

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Quick start 2: set up, build, and run every test: unit and end-to-end tests (CTest), the
-# plan-parser and API fuzz targets in smoke mode (libFuzzer, clang, address + UB sanitizers),
+# plan-parser, API and end-to-end server fuzz targets in smoke mode (libFuzzer, clang, address + UB sanitizers),
 # and the editor's page (Vitest, then end to end in headless Chromium).
 #   FUZZ_RUNS=20000 (default) sets the smoke run's length; FUZZ_RUNS=0 skips it.
 set -euo pipefail
@@ -36,6 +36,15 @@ if [[ "$FUZZ_RUNS" -gt 0 ]]; then
   "$BUILD_DIR-fuzz/server/api_fuzz" -dict=server/fuzz/api.dict -max_len=4096 -seed=1 \
     -runs="$FUZZ_RUNS" -artifact_prefix="$api_corpus/" "$api_corpus" 2>&1 | tail -n 3
   rm -rf "$api_corpus"
+
+  echo
+  echo "test: fuzzing the server end to end (raw bytes over loopback: HTTP parser, router, handlers, WebSocket), $FUZZ_RUNS runs (smoke mode)"
+  cmake --build "$BUILD_DIR-fuzz" --target http_fuzz -j "$(nproc)"
+  http_corpus=$(mktemp -d)
+  cp server/fuzz/http_corpus/* "$http_corpus/"
+  "$BUILD_DIR-fuzz/server/http_fuzz" -dict=server/fuzz/http.dict -max_len=4096 -seed=1 \
+    -runs="$FUZZ_RUNS" -artifact_prefix="$http_corpus/" "$http_corpus" 2>&1 | tail -n 3
+  rm -rf "$http_corpus"
 fi
 
 # The task editor's page (web/): Vitest unit tests, the production build, then the end-to-end

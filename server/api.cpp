@@ -12,7 +12,10 @@ namespace costar::server {
 HttpResponse errorResponse(int status, const std::string& message) {
   HttpResponse response;
   response.status = status;
-  response.body = nlohmann::json{{"error", message}}.dump();
+  // Messages quote what requests held (names, actions, the bytes a JSON parser stopped at),
+  // which may be cut inside a UTF-8 character: replaced with U+FFFD here, the one place
+  // errors become answers, rather than thrown as json::type_error 316.
+  response.body = nlohmann::json{{"error", message}}.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   if (status == 401) {
     response.headers.emplace_back("WWW-Authenticate", "Bearer");
   }
@@ -217,6 +220,17 @@ bool Api::authorized(std::string_view authorization) const {
 bool Api::tokenMatches(std::string_view token) const { return sameToken(token, options_.token); }
 
 HttpResponse Api::handle(const HttpRequest& request) {
+  try {
+    return answer(request);
+  } catch (...) {  // e.g. out of memory while building an error answer
+    HttpResponse response;
+    response.status = 500;
+    response.body = R"({"error":"internal error"})";
+    return response;
+  }
+}
+
+HttpResponse Api::answer(const HttpRequest& request) {
   try {
     if (request.body.size() > options_.max_body_bytes) {
       return errorResponse(413, "the body is larger than " + std::to_string(options_.max_body_bytes) + " bytes");

@@ -59,6 +59,8 @@ class Api {
   const ApiOptions& options() const { return options_; }
 
  private:
+  /// handle() without its last guard: every failure it knows becomes a 4xx or 5xx answer.
+  HttpResponse answer(const HttpRequest& request);
   HttpResponse route(const HttpRequest& request);
 
   Backend& backend_;

@@ -1,6 +1,6 @@
 #pragma once
-// What the HTTP API needs from the system behind it. The Engine (engine.h) implements it on
-// a workcell; the API fuzz target implements it without one.
+// What the HTTP API and its live stream need from the system behind it. The Engine (engine.h)
+// implements it on a workcell; the fuzz targets and some tests implement it without one.
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -72,6 +72,12 @@ class Backend {
   virtual std::optional<nlohmann::json> groundTruth() = 0;
   /// Points seen by the cell's RGB-D camera, in the world frame (nullopt without one).
   virtual std::optional<nlohmann::json> pointCloud(std::size_t max_points) = 0;
+
+  // --- the live stream (the WebSocket of http_server.cpp) ------------------------------------
+  /// The messages since the last call, in order (JSON texts). One caller (the broadcaster).
+  virtual std::vector<std::string> drainStream() = 0;
+  /// The first message for a newly connected client (JSON text).
+  virtual std::string helloMessage() = 0;
 };
 
 }  // namespace costar::server

@@ -10,6 +10,7 @@
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "component/nodes.h"
+#include "server/guard.h"
 #include "sim/simulation.h"
 #include "smartmove/grasps.h"
 #include "workcell/workcell.h"
@@ -169,8 +170,15 @@ void Engine::startThread() {
     }
     started_ = true;
   }
-  log_thread_ = std::thread([this] { logWriterLoop(); });
-  thread_ = std::thread([this] { loop(); });
+  // An exception that escapes a loop is logged and the loop goes on (guard.h).
+  log_thread_ = std::thread([this] {
+    while (!guarded("run log writer", [this] { logWriterLoop(); })) {
+    }
+  });
+  thread_ = std::thread([this] {
+    while (!guarded("engine thread", [this] { loop(); })) {
+    }
+  });
 }
 
 void Engine::shutdown() {

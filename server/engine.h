@@ -96,10 +96,16 @@ class Engine final : public Backend {
   /// The messages since the last call, in order: run_started, statuses (each changed node's
   /// current and last status, failure reason, operation data), run_ended, and the newest
   /// state snapshot if there is a new one. One caller (the broadcaster).
-  std::vector<std::string> drainStream();
+  std::vector<std::string> drainStream() override;
   /// The first message for a newly connected client: info, the active (or last) run with
   /// every node's status, and the latest snapshot.
-  std::string helloMessage();
+  std::string helloMessage() override;
+
+  /// The fatal-error path (fatal.h): asks the engine thread to stop the active run (which
+  /// cancels its operations: the arm decelerates and stops). Async-signal-safe.
+  void requestStop() noexcept { stop_requested_ = true; }
+  /// Whether a run or an operation is active. Async-signal-safe.
+  bool runActive() const noexcept { return active_run_.load() != 0; }
 
   EngineStats stats() const;
   /// Changes the pace (thread-safe).

@@ -21,7 +21,8 @@
 #include <vector>
 
 #include "server/api.h"
-#include "server/engine.h"
+#include "server/backend.h"
+#include "server/guard.h"
 #include "server/plan_json.h"
 
 namespace costar::server {
@@ -154,6 +155,8 @@ class StreamSession : public std::enable_shared_from_this<StreamSession> {
   void onRead(beast::error_code error, std::size_t bytes);
   void handleMessage(const std::string& text);
   void enqueue(std::shared_ptr<const std::string> message);
+  /// Ends the session after an error: closes the socket, sends nothing more.
+  void fail() noexcept;
   void write();
   void onWrite(beast::error_code error, std::size_t bytes);
 
@@ -167,11 +170,11 @@ class StreamSession : public std::enable_shared_from_this<StreamSession> {
 };
 
 struct HttpServer::Impl {
-  Impl(Api& api_, Engine& engine_, HttpServerOptions options_)
-      : api(api_), engine(engine_), options(std::move(options_)), acceptor(ioc), timer(ioc) {}
+  Impl(Api& api_, Backend& backend_, HttpServerOptions options_)
+      : api(api_), backend(backend_), options(std::move(options_)), acceptor(ioc), timer(ioc) {}
 
   Api& api;
-  Engine& engine;
+  Backend& backend;
   HttpServerOptions options;
   bool loopback = true;
   net::io_context ioc;
@@ -185,7 +188,10 @@ struct HttpServer::Impl {
   std::uint16_t port = 0;
 
   void accept();
+  /// Sends what the backend has for the stream, then waits for the next round.
   void broadcast();
+  void broadcastOnce();
+  void scheduleBroadcast();
   void addSession(const std::shared_ptr<StreamSession>& session) {
     const std::lock_guard lock(sessions_mutex);
     sessions.push_back(session);
@@ -212,27 +218,43 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     http::async_read(stream_, buffer_, *parser_, beast::bind_front_handler(&HttpSession::onRead, shared_from_this()));
   }
 
-  void onRead(beast::error_code error, std::size_t /*bytes*/) {
+  void onRead(beast::error_code error, std::size_t bytes) {
+    // Whatever a handler throws becomes a 500 answer (or, failing that, a closed connection).
+    bool answered = false;
+    const bool ok = guarded("HTTP request", [&] { answered = handleRead(error, bytes); });
+    if (!ok && !answered) {
+      guarded("HTTP error answer", [&] {
+        answered = true;
+        reply(errorResponse(500, "internal error while answering the request"), 11, false, false);
+      });
+    }
+    if (!answered) {
+      close();
+    }
+  }
+
+  /// Answers what was read. Returns false when nothing was (or will be) written: the caller
+  /// closes the connection.
+  bool handleRead(beast::error_code error, std::size_t /*bytes*/) {
     if (error == http::error::end_of_stream || error == beast::error::timeout || error == net::error::eof ||
         error == net::error::connection_reset || error == net::error::operation_aborted) {
-      close();
-      return;
+      return false;
     }
     if (error == http::error::body_limit) {
       reply(errorResponse(413, "the body is larger than " + std::to_string(server_.options.max_body_bytes) + " bytes"),
             11, false, false);
-      return;
+      return true;
     }
     if (error) {
       reply(errorResponse(400, "malformed HTTP request: " + error.message()), 11, false, false);
-      return;
+      return true;
     }
     http::request<http::string_body> request = parser_->release();
     const std::string host(request[http::field::host]);
     if (!server_.hostAllowed(host)) {
       reply(errorResponse(421, "this server answers only requests to 127.0.0.1 or localhost"), request.version(), false,
             false);
-      return;
+      return true;
     }
     const std::string target(request.target());
     if (websocket::is_upgrade(request)) {
@@ -243,13 +265,13 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
         reply(errorResponse(origin_ok ? 404 : 403,
                             origin_ok ? "the stream is at /api/stream" : "WebSocket from another site refused"),
               request.version(), false, false);
-        return;
+        return true;
       }
       stream_.expires_never();
       auto session = std::make_shared<StreamSession>(stream_.release_socket(), server_);
       server_.addSession(session);
       session->run(std::move(request));
-      return;
+      return true;  // the WebSocket session owns the socket now
     }
     const bool head = request.method() == http::verb::head;
     HttpResponse response;
@@ -267,6 +289,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       response = errorResponse(405, "only GET for the page's files");
     }
     reply(std::move(response), request.version(), request.keep_alive(), head);
+    return true;
   }
 
   void reply(HttpResponse response, unsigned version, bool keep_alive, bool head) {
@@ -289,15 +312,13 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     response_ = message;
     http::async_write(stream_, *message, [self = shared_from_this(), keep_alive](beast::error_code error, std::size_t) {
       self->response_.reset();
-      if (error || !keep_alive) {
+      if (error || !keep_alive || !guarded("HTTP read", [&] { self->read(); })) {
         self->close();
-        return;
       }
-      self->read();
     });
   }
 
-  void close() {
+  void close() noexcept {
     beast::error_code ignored;
     stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
   }
@@ -320,11 +341,21 @@ void StreamSession::onAccept(beast::error_code error) {
   if (error) {
     return;
   }
-  if (!server_.api.options().reads_need_token) {
-    enqueue(std::make_shared<const std::string>(server_.engine.helloMessage()));
-    ready_ = true;
+  const bool ok = guarded("WebSocket hello", [this] {
+    if (!server_.api.options().reads_need_token) {
+      enqueue(std::make_shared<const std::string>(server_.backend.helloMessage()));
+      ready_ = true;
+    }
+    read();
+  });
+  if (!ok) {
+    fail();
   }
-  read();
+}
+
+void StreamSession::fail() noexcept {
+  closing_ = true;
+  beast::get_lowest_layer(ws_).close();
 }
 
 void StreamSession::read() {
@@ -335,10 +366,15 @@ void StreamSession::onRead(beast::error_code error, std::size_t /*bytes*/) {
   if (error) {
     return;  // closed, timed out or oversize: the session ends
   }
-  const std::string text = beast::buffers_to_string(buffer_.data());
-  buffer_.consume(buffer_.size());
-  handleMessage(text);
-  read();
+  const bool ok = guarded("WebSocket message", [this] {
+    const std::string text = beast::buffers_to_string(buffer_.data());
+    buffer_.consume(buffer_.size());
+    handleMessage(text);
+    read();
+  });
+  if (!ok) {
+    fail();
+  }
 }
 
 void StreamSession::handleMessage(const std::string& text) {
@@ -365,7 +401,7 @@ void StreamSession::handleMessage(const std::string& text) {
     if (ok && !authenticated_) {
       authenticated_ = true;
       if (!ready_) {
-        enqueue(std::make_shared<const std::string>(server_.engine.helloMessage()));
+        enqueue(std::make_shared<const std::string>(server_.backend.helloMessage()));
         ready_ = true;
       }
     }
@@ -387,7 +423,7 @@ void StreamSession::handleMessage(const std::string& text) {
       answer({{"type", "error"}, {"error", "action must be pause, resume, step or stop"}});
       return;
     }
-    const bool ok = server_.engine.control(it->second);
+    const bool ok = server_.backend.control(it->second);
     answer({{"type", "control"}, {"action", it->first}, {"ok", ok}});
     return;
   }
@@ -399,8 +435,11 @@ void StreamSession::handleMessage(const std::string& text) {
 }
 
 void StreamSession::send(std::shared_ptr<const std::string> message) {
-  net::post(ws_.get_executor(),
-            [self = shared_from_this(), message = std::move(message)]() mutable { self->enqueue(std::move(message)); });
+  net::post(ws_.get_executor(), [self = shared_from_this(), message = std::move(message)]() mutable {
+    if (!guarded("WebSocket send", [&] { self->enqueue(std::move(message)); })) {
+      self->fail();
+    }
+  });
 }
 
 void StreamSession::enqueue(std::shared_ptr<const std::string> message) {
@@ -408,8 +447,7 @@ void StreamSession::enqueue(std::shared_ptr<const std::string> message) {
     return;
   }
   if (queue_.size() >= kMaxQueuedMessages) {
-    closing_ = true;  // too slow: drop it; it reconnects and starts from a fresh hello
-    beast::get_lowest_layer(ws_).close();
+    fail();  // too slow: drop it; it reconnects and starts from a fresh hello
     return;
   }
   queue_.push_back(std::move(message));
@@ -430,8 +468,8 @@ void StreamSession::onWrite(beast::error_code error, std::size_t /*bytes*/) {
   }
   server_.sent.fetch_add(1);
   queue_.pop_front();
-  if (!queue_.empty()) {
-    write();
+  if (!queue_.empty() && !guarded("WebSocket write", [this] { write(); })) {
+    fail();
   }
 }
 
@@ -441,13 +479,30 @@ void HttpServer::Impl::accept() {
       return;
     }
     if (!error) {
-      std::make_shared<HttpSession>(std::move(socket), *this)->run();
+      guarded("accepting a connection", [&] { std::make_shared<HttpSession>(std::move(socket), *this)->run(); });
     }
-    accept();
+    if (!guarded("accept loop", [this] { accept(); })) {
+      // Cannot wait for the next connection now (e.g. out of memory): try again shortly.
+      auto retry = std::make_shared<net::steady_timer>(ioc, std::chrono::milliseconds(100));
+      retry->async_wait([this, retry](beast::error_code wait_error) {
+        if (!wait_error && !stopped) {
+          guarded("accept loop", [this] { accept(); });
+        }
+      });
+    }
   });
 }
 
 void HttpServer::Impl::broadcast() {
+  // A failure to stream one round (the backend threw) is logged; the next round comes anyway.
+  guarded("stream broadcast", [this] { broadcastOnce(); });
+  if (stopped) {
+    return;
+  }
+  guarded("stream timer", [this] { scheduleBroadcast(); });
+}
+
+void HttpServer::Impl::broadcastOnce() {
   std::vector<std::shared_ptr<StreamSession>> live;
   {
     const std::lock_guard lock(sessions_mutex);
@@ -458,15 +513,15 @@ void HttpServer::Impl::broadcast() {
       }
     }
   }
-  for (std::string& text : engine.drainStream()) {
+  for (std::string& text : backend.drainStream()) {
     auto message = std::make_shared<const std::string>(std::move(text));
     for (const auto& session : live) {
       session->send(message);
     }
   }
-  if (stopped) {
-    return;
-  }
+}
+
+void HttpServer::Impl::scheduleBroadcast() {
   const auto period = std::chrono::duration_cast<net::steady_timer::duration>(
       std::chrono::duration<double>(0.5 / std::max(1.0, options.stream_hz)));  // twice per snapshot
   const auto now = net::steady_timer::clock_type::now();
@@ -478,8 +533,8 @@ void HttpServer::Impl::broadcast() {
   });
 }
 
-HttpServer::HttpServer(Api& api, Engine& engine, HttpServerOptions options)
-    : impl_(std::make_unique<Impl>(api, engine, std::move(options))) {
+HttpServer::HttpServer(Api& api, Backend& backend, HttpServerOptions options)
+    : impl_(std::make_unique<Impl>(api, backend, std::move(options))) {
   impl_->loopback = isLoopback(impl_->options.address);
   beast::error_code error;
   const std::string address = impl_->options.address == "localhost" ? "127.0.0.1" : impl_->options.address;
@@ -511,7 +566,11 @@ void HttpServer::start() {
   impl_->accept();
   net::post(impl_->ioc, [this] { impl_->broadcast(); });
   for (int i = 0; i < std::max(1, impl_->options.threads); ++i) {
-    impl_->threads.emplace_back([this] { impl_->ioc.run(); });
+    impl_->threads.emplace_back([this] {
+      // A handler that throws ends run() with its exception: log it and go on serving.
+      while (!guarded("I/O thread", [this] { impl_->ioc.run(); })) {
+      }
+    });
   }
 }
 

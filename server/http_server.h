@@ -7,8 +7,12 @@
 // is not this machine 421 when listening on loopback (DNS rebinding). API requests go to
 // Api::handle on the I/O threads; nothing here touches the workcell.
 //
+// No exception ends a thread here: one thrown while answering a request becomes a 500 answer,
+// one thrown anywhere else (the stream, the accept loop, the broadcaster) is logged and the
+// connection concerned is closed; the I/O threads and the broadcaster go on (guard.h).
+//
 // WebSocket: the server sends "hello" (the active run with each node's status, and the latest
-// state), then every 1/(2 stream_hz) s the messages of Engine::drainStream() (so each snapshot
+// state), then every 1/(2 stream_hz) s the messages of Backend::drainStream() (so each snapshot
 // goes out within half a period of being taken). A client sends
 // {"type":"auth","token":T} to be allowed commands ({"type":"control","action":"pause" |
 // "resume" | "step" | "stop"}); when reads need the token, nothing is sent before it.
@@ -22,7 +26,7 @@
 namespace costar::server {
 
 class Api;
-class Engine;
+class Backend;
 
 struct HttpServerOptions {
   std::string address = "127.0.0.1";
@@ -37,9 +41,10 @@ struct HttpServerOptions {
 
 class HttpServer {
  public:
-  /// `api` and `engine` must outlive the server. Binds at once.
+  /// `api` and `backend` (the stream's source, and run control from WebSocket commands) must
+  /// outlive the server. Binds at once.
   /// @throws std::runtime_error when the address cannot be bound.
-  HttpServer(Api& api, Engine& engine, HttpServerOptions options);
+  HttpServer(Api& api, Backend& backend, HttpServerOptions options);
   ~HttpServer();
   HttpServer(const HttpServer&) = delete;
   HttpServer& operator=(const HttpServer&) = delete;

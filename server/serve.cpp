@@ -9,6 +9,7 @@
 #include "server/api.h"
 #include "server/auth.h"
 #include "server/engine.h"
+#include "server/fatal.h"
 #include "server/http_server.h"
 #include "server/store.h"
 
@@ -99,6 +100,8 @@ int runServe(const ServeOptions& options, std::ostream& out, std::ostream& err) 
     out << "  open the editor at " << server->url() << " (token in " << options.token_file.string() << ")\n";
   }
   out << "listening on " << server->url() << "\n" << std::flush;
+  // From here on, a crash stops the arm before the process dies.
+  const FatalStop fatal_stop(server->engine());
   int signal = 0;
   sigwait(&signals, &signal);
   out << "costar serve: stopping (signal " << signal << ")\n" << std::flush;

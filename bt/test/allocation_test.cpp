@@ -45,5 +45,22 @@ TEST(Allocation, NoneWhenHaltingAndRestartingRunningLoops) {
   EXPECT_EQ(allocationsForRuns(plan, 20, std::chrono::milliseconds(10)), 0u);
 }
 
+TEST(Allocation, NoneInTheNodesAddedFromBehaviorTreeCpp) {
+  using bench::node;
+  const auto sleep = [] { return node("Sleep", {}, {{"msec", "5"}}); };
+  const Plan plan = bench::planOf(node(
+      "Sequence", {node("AsyncSequence", {node("AlwaysSuccess"),
+                                          node("Delay", {node("AlwaysSuccess")}, {{"delay_msec", "5"}}), sleep()}),
+                   node("AsyncFallback", {node("AlwaysFailure"), node("AlwaysSuccess")}),
+                   node("ParallelAll", {sleep(), node("AlwaysFailure")}, {{"max_failures", "2"}}),
+                   node("IfThenElse", {node("AlwaysFailure"), node("AlwaysFailure"), sleep()}),
+                   node("WhileDoElse", {node("AlwaysSuccess"), sleep()}),
+                   node("ForceSuccess", {node("TryCatch", {sleep(), node("AlwaysFailure"), sleep()})}),
+                   node("ForceSuccess", {node("Timeout", {node("KeepRunningUntilFailure", {node("AlwaysSuccess")})},
+                                              {{"msec", "20"}})}),
+                   node("RunOnce", {node("AlwaysSuccess")}), node("RunOnce", {sleep()}, {{"then_skip", "false"}})}));
+  EXPECT_EQ(allocationsForRuns(plan, 20, std::chrono::milliseconds(5)), 0u);
+}
+
 }  // namespace
 }  // namespace costar::bt

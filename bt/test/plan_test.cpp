@@ -176,13 +176,81 @@ TEST(Validation, UnknownAndRecursiveSubtrees) {
 }
 
 TEST(Validation, NoVariablesNoScripts) {
-  EXPECT_NE(problem(planXml(R"(<Sleep msec="{delay}"/>)")).find("blackboard references are not supported"),
+  EXPECT_NE(problem(planXml(R"(<Sleep msec="{delay}"/>)"))
+                .find("a blackboard reference; CoSTAR plans have no "
+                      "blackboard, by design"),
             std::string::npos);
   EXPECT_NE(problem(planXml(R"(<AlwaysSuccess _skipIf="x == 1"/>)")).find("script"), std::string::npos);
   EXPECT_NE(problem(planXml(R"(<SubTree ID="main2" target="{t}"/>)",
                             R"(<BehaviorTree ID="main2"><AlwaysSuccess/></BehaviorTree>)"))
                 .find("remapping needs a blackboard"),
             std::string::npos);
+}
+
+TEST(Validation, BlackboardNodesAreRefusedByDesignSayingWhatToUseInstead) {
+  EXPECT_EQ(problem(planXml(R"(<Script code="a := 1"/>)")),
+            "1: 'Script' is a BehaviorTree.CPP node that works on the blackboard; CoSTAR plans have no blackboard, "
+            "by design (the paper: no user variables, no scope): write each value as a parameter of the node that "
+            "uses it instead");
+  EXPECT_NE(problem(planXml(R"(<Switch2 variable="{v}" case_1="1"><AlwaysSuccess/><AlwaysSuccess/>)"
+                            R"(<AlwaysSuccess/></Switch2>)"))
+                .find("IfThenElse, WhileDoElse or a Fallback over CheckPredicate nodes"),
+            std::string::npos);
+  EXPECT_NE(problem(planXml(R"(<ScriptCondition code="x == 1"/>)")).find("CheckPredicate"), std::string::npos);
+  EXPECT_NE(problem(planXml(R"(<AlwaysSuccess _while="busy"/>)")).find("by design"), std::string::npos);
+}
+
+TEST(Validation, NewControlNodesCheckTheirChildren) {
+  EXPECT_EQ(problem(planXml(R"(<IfThenElse><AlwaysSuccess/></IfThenElse>)")),
+            "1: IfThenElse: needs 2 or 3 children (the condition, then-branch, optional else-branch), has 1");
+  EXPECT_NE(problem(planXml(R"(<WhileDoElse><AlwaysSuccess/><AlwaysSuccess/><AlwaysSuccess/><AlwaysSuccess/>)"
+                            R"(</WhileDoElse>)"))
+                .find("needs 2 or 3 children"),
+            std::string::npos);
+  EXPECT_EQ(problem(planXml(R"(<TryCatch><AlwaysSuccess/></TryCatch>)")),
+            "1: TryCatch: needs at least 2 children (the try block, then the catch child), has 1");
+  EXPECT_EQ(problem(planXml(R"(<ParallelAll max_failures="3"><AlwaysSuccess/><AlwaysSuccess/></ParallelAll>)")),
+            "1: ParallelAll: max_failures=3 is more than its 2 children: it could never fail");
+  EXPECT_TRUE(
+      problems(planXml(R"(<ParallelAll max_failures="-1"><AlwaysSuccess/><AlwaysSuccess/></ParallelAll>)")).empty());
+  EXPECT_NE(problem(planXml(R"(<Delay><AlwaysSuccess/></Delay>)")).find("needs parameter 'delay_msec'"),
+            std::string::npos);
+  EXPECT_NE(problem(planXml(R"(<RunOnce then_skip="maybe"><AlwaysSuccess/></RunOnce>)")).find("not true or false"),
+            std::string::npos);
+  // WhileDoElse re-checks its condition on every tick: the condition must not take time.
+  EXPECT_NE(problem(planXml(R"(<WhileDoElse><TestLeaf/><AlwaysSuccess/></WhileDoElse>)"))
+                .find("WhileDoElse re-checks its first child on every tick"),
+            std::string::npos);
+  EXPECT_TRUE(problems(planXml(R"(<WhileDoElse><TestCondition/><TestLeaf/><TestLeaf/></WhileDoElse>)")).empty());
+}
+
+TEST(PlanXml, AcceptsBehaviorTreeCppsPrivateAttributesAndUnknownRootAttributes) {
+  // Forms BehaviorTree.CPP 4.10 accepts (checked with the peer): underscore attributes are
+  // metadata, unknown <root> attributes (Groot2's project_name) are ignored.
+  EXPECT_TRUE(problems(R"(<root BTCPP_format="4" project_name="demo"><BehaviorTree ID="m" _description="x">)"
+                       R"(<Sequence _uid="3" _fullpath="m/seq"><AlwaysSuccess _description="y"/></Sequence>)"
+                       R"(</BehaviorTree></root>)")
+                  .empty());
+  EXPECT_TRUE(problems(R"(<root><BehaviorTree ID="m"><AlwaysSuccess/></BehaviorTree></root>)").empty());
+  // ... but not BehaviorTree.CPP's scripts.
+  EXPECT_NE(problem(planXml(R"(<AlwaysSuccess _skipIf="a"/>)")).find("by design"), std::string::npos);
+}
+
+TEST(PlanXml, ATreeWithoutAnIdIsNamedAsBehaviorTreeCppNamesIt) {
+  const std::string xml = R"(<?xml version="1.0"?>
+    <root BTCPP_format="4"><BehaviorTree><Sequence><AlwaysSuccess/></Sequence></BehaviorTree></root>)";
+  const Plan plan = loadPlanText(xml, "unnamed.xml");
+  EXPECT_EQ(plan.mainTreeId(), "BehaviorTree_0");
+  SimClock clock;
+  Tree tree = buildTree(plan, builtinRegistry(), clock);
+  EXPECT_EQ(tree.tick(), Status::kSuccess);
+  // As BehaviorTree.CPP: only a file's single tree may leave its ID out.
+  EXPECT_EQ(problem("<root BTCPP_format=\"4\"><BehaviorTree ID=\"a\"><AlwaysSuccess/></BehaviorTree>\n"
+                    "<BehaviorTree><AlwaysFailure/></BehaviorTree></root>"),
+            "2: <BehaviorTree> needs an ID attribute: the file has 2 trees (only a file's single tree may leave it "
+            "out)");
+  EXPECT_EQ(problem(R"(<root BTCPP_format="4"><BehaviorTree ID=""><AlwaysSuccess/></BehaviorTree></root>)"),
+            "1: <BehaviorTree ID=\"\"> has an empty ID: name the tree, or leave ID out");
 }
 
 TEST(Validation, ReactiveNodesOnlyLetTheirLastChildRun) {
@@ -279,6 +347,32 @@ TEST_F(IncludeTest, ACycleOfIncludesIsAnErrorNamingTheCycle) {
     EXPECT_EQ(error.diagnostics()[0].where.line, 3);
     EXPECT_NE(error.diagnostics()[0].message.find("cycle of includes"), std::string::npos);
     EXPECT_NE(error.diagnostics()[0].where.file.find("a.xml"), std::string::npos);
+  }
+}
+
+TEST_F(IncludeTest, AChainOf20000IncludesLoadsWithoutExhaustingTheStack) {
+  // Each file includes the next: the loader once recursed per level and overflowed near 20,000.
+  constexpr int kFiles = 20000;
+  for (int i = 0; i < kFiles; ++i) {
+    const std::string next = i + 1 < kFiles ? "<include path=\"f" + std::to_string(i + 1) + ".xml\"/>" : "";
+    write("f" + std::to_string(i) + ".xml", "<root BTCPP_format=\"4\">" + next + "<BehaviorTree ID=\"t" +
+                                                std::to_string(i) + "\"><AlwaysSuccess/></BehaviorTree></root>");
+  }
+  const Plan plan = loadPlan(dir_ / "f0.xml");
+  ASSERT_EQ(plan.included.size(), static_cast<std::size_t>(kFiles - 1));
+  EXPECT_EQ(plan.included.front().trees.front().id, "t" + std::to_string(kFiles - 1));  // deepest first
+  EXPECT_NE(plan.findTree("t12345"), nullptr);
+  // A cycle at the end of the chain is still found, and named.
+  write("f" + std::to_string(kFiles - 1) + ".xml",
+        "<root BTCPP_format=\"4\"><include path=\"f0.xml\"/><BehaviorTree ID=\"last\"><AlwaysSuccess/>"
+        "</BehaviorTree></root>");
+  try {
+    loadPlan(dir_ / "f0.xml");
+    FAIL() << "expected a PlanError";
+  } catch (const PlanError& error) {
+    ASSERT_EQ(error.diagnostics().size(), 1u);
+    EXPECT_NE(error.diagnostics()[0].where.file.find("f19999.xml"), std::string::npos);
+    EXPECT_NE(error.diagnostics()[0].message.find("cycle of includes"), std::string::npos);
   }
 }
 

@@ -11,9 +11,8 @@
 #include <string>
 #include <string_view>
 
-#include "bt/builder.h"
 #include "server/api.h"
-#include "server/backend.h"
+#include "server/fuzz/fuzz_backend.h"
 #include "server/store.h"
 
 using namespace costar;
@@ -22,55 +21,10 @@ namespace {
 
 constexpr const char* kToken = "fuzz-token-0123456789abcdef";
 
-/// The API's backend without a workcell: plans are validated against the built-in nodes and
-/// "started" without running.
-class FuzzBackend final : public server::Backend {
- public:
-  nlohmann::json info() override { return {{"workcell", "fuzz"}}; }
-  const std::string& nodesJson() override { return nodes_; }
-  nlohmann::json choices() override { return nlohmann::json::object(); }
-  std::vector<bt::Diagnostic> validate(const bt::Plan& plan) override {
-    return bt::validatePlan(plan, registry_, limits_);
-  }
-  server::StartResult start(server::RunRequest request) override {
-    server::StartResult result;
-    auto diagnostics = validate(request.plan);
-    if (!diagnostics.empty()) {
-      result.status = 422;
-      result.diagnostics = std::move(diagnostics);
-      return result;
-    }
-    SimClock clock;
-    bt::Tree tree = bt::buildTree(request.plan, registry_, clock, {}, limits_);
-    for (int tick = 0; tick < 8 && tree.tick() == bt::Status::kRunning; ++tick) {
-      clock.advanceBy(std::chrono::milliseconds(10));
-    }
-    tree.halt();
-    result.run_id = ++runs_;
-    return result;
-  }
-  bool control(server::RunControl) override { return false; }
-  nlohmann::json state() override { return {{"type", "state"}}; }
-  std::optional<nlohmann::json> runStatus(std::optional<std::int64_t> id) override {
-    if (!id || *id > runs_) {
-      return std::nullopt;
-    }
-    return nlohmann::json{{"id", *id}, {"active", false}};
-  }
-  std::optional<nlohmann::json> groundTruth() override { return std::nullopt; }
-  std::optional<nlohmann::json> pointCloud(std::size_t) override { return std::nullopt; }
-
- private:
-  bt::NodeRegistry registry_ = bt::builtinRegistry();
-  bt::BuildLimits limits_{.max_nodes = 20'000, .max_depth = 300};
-  std::string nodes_ = "[]";
-  std::int64_t runs_ = 0;
-};
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static FuzzBackend backend;
+  static server::fuzzing::FuzzBackend backend;
   static std::unique_ptr<server::Store> store;
   static std::unique_ptr<server::Api> api;
   static std::size_t inputs = 0;

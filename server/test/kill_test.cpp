@@ -20,6 +20,7 @@
 #include "core/paths.h"
 #include "server/auth.h"
 #include "server/store.h"
+#include "server/test/child_process.h"
 #include "server/test/http_client.h"
 
 namespace costar::server {
@@ -27,64 +28,7 @@ namespace {
 
 using nlohmann::json;
 
-/// A server child process; killed with SIGKILL on destruction if still alive.
-class Child {
- public:
-  explicit Child(const std::vector<std::string>& args) {
-    int out[2];
-    if (::pipe2(out, O_CLOEXEC) != 0) {
-      throw std::runtime_error("pipe");
-    }
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::dup2(out[1], STDOUT_FILENO);
-      std::vector<char*> argv;
-      for (const auto& arg : args) {
-        argv.push_back(const_cast<char*>(arg.c_str()));
-      }
-      argv.push_back(nullptr);
-      ::execv(argv[0], argv.data());
-      ::_exit(127);
-    }
-    ::close(out[1]);
-    out_ = out[0];
-  }
-  ~Child() {
-    kill();
-    ::close(out_);
-  }
-  /// Reads stdout until "listening on http://127.0.0.1:PORT/"; 0 if the child ended first.
-  std::uint16_t waitForPort() {
-    std::string text;
-    char buffer[4096];
-    while (true) {
-      const ssize_t n = ::read(out_, buffer, sizeof(buffer));
-      if (n <= 0) {
-        return 0;
-      }
-      text.append(buffer, static_cast<std::size_t>(n));
-      const auto at = text.find("listening on http://127.0.0.1:");
-      if (at != std::string::npos) {
-        const auto start = at + std::string("listening on http://127.0.0.1:").size();
-        const auto end = text.find('/', start);
-        if (end != std::string::npos) {
-          return static_cast<std::uint16_t>(std::stoi(text.substr(start, end - start)));
-        }
-      }
-    }
-  }
-  void kill() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-      pid_ = -1;
-    }
-  }
-
- private:
-  pid_t pid_ = -1;
-  int out_ = -1;
-};
+using testing::Child;
 
 struct Acknowledged {
   std::mutex mutex;

@@ -2,10 +2,17 @@
 // process and kill it (kill_test.cpp). Arguments: --NAME VALUE pairs of ServeOptions
 // (workcell, scene, waypoints, store, token-file, pace, port, memory-only) and the flag
 // --test-endpoints and --test-oracle-perception. Prints what `costar serve` prints, including "listening on URL".
+// --test-terminate-on-sigusr1: on SIGUSR1 an exception escapes a thread (std::terminate), to
+// test that the arm is stopped before the process dies (fatal_test.cpp).
+
+#include <pthread.h>
+#include <signal.h>
 
 #include <cstring>
 #include <iostream>
+#include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "server/serve.h"
 
@@ -20,6 +27,19 @@ int main(int argc, char** argv) {
     }
     if (key == "--memory-only") {
       options.workcell.memory_only = true;
+      continue;
+    }
+    if (key == "--test-terminate-on-sigusr1") {
+      // Blocked here, so in every thread the server starts; this one waits for it.
+      sigset_t usr1;
+      sigemptyset(&usr1);
+      sigaddset(&usr1, SIGUSR1);
+      pthread_sigmask(SIG_BLOCK, &usr1, nullptr);
+      std::thread([usr1] {
+        int signal = 0;
+        sigwait(&usr1, &signal);
+        throw std::runtime_error("TEST: an exception escapes a thread");
+      }).detach();
       continue;
     }
     if (key == "--test-oracle-perception") {  // TEST ONLY: true part poses as object symbols
