@@ -220,11 +220,12 @@ class CalibrationRun final : public component::RunningOperation {
         data["warning"] = problem;
       }
       char summary[240];
-      std::snprintf(summary, sizeof summary,
-                    "camera moved %.1f mm and turned %.2f deg from the previous calibration; the marker's corners fit to "
-                    "%.2f px RMS over %zu views",
-                    data["camera_moved_mm"].get<double>(), data["camera_turned_deg"].get<double>(),
-                    (marker_stage_ ? next.marker_residuals : next.camera_residuals).reprojection_rms_px, views_.size());
+      std::snprintf(
+          summary, sizeof summary,
+          "camera moved %.1f mm and turned %.2f deg from the previous calibration; the marker's corners fit to "
+          "%.2f px RMS over %zu views",
+          data["camera_moved_mm"].get<double>(), data["camera_turned_deg"].get<double>(),
+          (marker_stage_ ? next.marker_residuals : next.camera_residuals).reprojection_rms_px, views_.size());
       result_ = OperationResult::success(std::move(data));
       result_.reason = summary;
     } catch (const CalibrationError& e) {
@@ -345,8 +346,8 @@ CellCalibration CalibrationComponent::calibration() const {
 world::Report CalibrationComponent::report() const {
   std::lock_guard lock(mutex_);
   world::Report report;
-  report.symbols.push_back(
-      {"camera", "", clock_.now(), world::FrameValue{"world", calibration_.camera_in_world.value_or(drawn_camera_pose_)}});
+  report.symbols.push_back({"camera", "", clock_.now(),
+                            world::FrameValue{"world", calibration_.camera_in_world.value_or(drawn_camera_pose_)}});
   if (calibration_.camera_in_world) {
     report.predicates.push_back({"camera_calibrated", {}, true, ""});
   }
@@ -382,8 +383,7 @@ std::unique_ptr<component::RunningOperation> CalibrationComponent::begin(const s
     const auto it = params.find(name);
     return it == params.end() ? fallback : it->second.asDouble();
   };
-  const int views =
-      static_cast<int>(number("views", marker_stage ? config_.marker_views : config_.camera_views));
+  const int views = static_cast<int>(number("views", marker_stage ? config_.marker_views : config_.camera_views));
   const double speed = number("speed", config_.speed);
   const auto refine_it = params.find("refine");
   const bool refine = refine_it == params.end() || refine_it->second.asBool();

@@ -131,8 +131,8 @@ struct ReprojectionFunctor {
       const world::Pose marker_in_camera = world_to_camera * view.flange_in_world * x;
       for (int k = 0; k < 4; ++k) {
         const Eigen::Vector3d c = marker_in_camera * corners[static_cast<std::size_t>(k)];
-        const Eigen::Vector2d e =
-            c.z() > 1e-6 ? project(intrinsics, c) - view.corners[static_cast<std::size_t>(k)] : Eigen::Vector2d(1e3, 1e3);
+        const Eigen::Vector2d e = c.z() > 1e-6 ? project(intrinsics, c) - view.corners[static_cast<std::size_t>(k)]
+                                               : Eigen::Vector2d(1e3, 1e3);
         residual(r++) = e.x();
         residual(r++) = e.y();
       }
@@ -143,8 +143,8 @@ struct ReprojectionFunctor {
 
 void refine(const std::vector<MarkerView>& views, const camera::Intrinsics& intrinsics, double marker_size,
             world::Pose& marker_in_flange, world::Pose& camera_in_world, bool solve_marker) {
-  ReprojectionFunctor functor{&views, intrinsics, markerCorners(marker_size), marker_in_flange, camera_in_world,
-                              solve_marker};
+  ReprojectionFunctor functor{&views,           intrinsics,      markerCorners(marker_size),
+                              marker_in_flange, camera_in_world, solve_marker};
   Eigen::NumericalDiff<ReprojectionFunctor> numeric(functor, 1e-7);
   Eigen::LevenbergMarquardt<Eigen::NumericalDiff<ReprojectionFunctor>, double> solver(numeric);
   solver.parameters.maxfev = 4000;
@@ -260,9 +260,10 @@ MarkerCalibration solveMarker(const std::vector<MarkerView>& views, const camera
   }
   const auto [largest, axis_spread] = rotationSpread(views);
   if (largest < options.min_rotation_spread_deg) {
-    throw CalibrationError(format("marker calibration: the views differ by at most %.1f degrees of rotation, at least "
-                                  "%.0f needed: the poses are too similar",
-                                  largest, options.min_rotation_spread_deg));
+    throw CalibrationError(
+        format("marker calibration: the views differ by at most %.1f degrees of rotation, at least "
+               "%.0f needed: the poses are too similar",
+               largest, options.min_rotation_spread_deg));
   }
   if (axis_spread < 0.05) {
     throw CalibrationError(
@@ -306,11 +307,12 @@ MarkerCalibration solveMarker(const std::vector<MarkerView>& views, const camera
         r_b.push_back(rotationToCv(view.marker_in_camera.linear()));
         t_b.push_back(vectorToCv(view.marker_in_camera.translation()));
       }
-      const cv::HandEyeCalibrationMethod cv_method = method == HandEyeMethod::kDaniilidis ? cv::CALIB_HAND_EYE_DANIILIDIS
-                                                     : method == HandEyeMethod::kTsai     ? cv::CALIB_HAND_EYE_TSAI
-                                                     : method == HandEyeMethod::kPark     ? cv::CALIB_HAND_EYE_PARK
-                                                     : method == HandEyeMethod::kHoraud   ? cv::CALIB_HAND_EYE_HORAUD
-                                                                                          : cv::CALIB_HAND_EYE_ANDREFF;
+      const cv::HandEyeCalibrationMethod cv_method = method == HandEyeMethod::kDaniilidis
+                                                         ? cv::CALIB_HAND_EYE_DANIILIDIS
+                                                     : method == HandEyeMethod::kTsai   ? cv::CALIB_HAND_EYE_TSAI
+                                                     : method == HandEyeMethod::kPark   ? cv::CALIB_HAND_EYE_PARK
+                                                     : method == HandEyeMethod::kHoraud ? cv::CALIB_HAND_EYE_HORAUD
+                                                                                        : cv::CALIB_HAND_EYE_ANDREFF;
       cv::Mat r;
       cv::Mat t;
       cv::calibrateHandEye(r_a, t_a, r_b, t_b, r, t, cv_method);
@@ -337,9 +339,9 @@ MarkerCalibration solveMarker(const std::vector<MarkerView>& views, const camera
         world::Pose y = solveCamera(views, intrinsics, x, loose).camera_in_world;
         refine(views, intrinsics, options.marker_size, x, y, true);
         const double other = residualsOf(views, intrinsics, x, y, options.marker_size).reprojection_rms_px;
-        const double mine = residualsOf(views, intrinsics, result.marker_in_flange, result.camera_in_world,
-                                        options.marker_size)
-                                .reprojection_rms_px;
+        const double mine =
+            residualsOf(views, intrinsics, result.marker_in_flange, result.camera_in_world, options.marker_size)
+                .reprojection_rms_px;
         if (other < mine) {
           result.marker_in_flange = x;
           result.camera_in_world = y;
@@ -363,8 +365,8 @@ MarkerCalibration solveMarker(const std::vector<MarkerView>& views, const camera
 CameraCalibration solveCamera(const std::vector<MarkerView>& views, const camera::Intrinsics& intrinsics,
                               const world::Pose& marker_in_flange, const SolveOptions& options) {
   if (static_cast<int>(views.size()) < options.min_camera_views) {
-    throw CalibrationError("Calibrate: " + std::to_string(views.size()) + " view(s) of the gripper's marker, at least " +
-                           std::to_string(options.min_camera_views) +
+    throw CalibrationError("Calibrate: " + std::to_string(views.size()) +
+                           " view(s) of the gripper's marker, at least " + std::to_string(options.min_camera_views) +
                            " needed (is the marker in the camera's view? is the path to it free?)");
   }
   // Where the corners are in the world, and where they are seen.
@@ -384,9 +386,10 @@ CameraCalibration solveCamera(const std::vector<MarkerView>& views, const camera
     }
   }
   if ((highest - lowest).norm() < options.min_position_spread) {
-    throw CalibrationError(format("Calibrate: the marker's positions span %.3f m, at least %.2f m needed to fix the "
-                                  "camera's orientation",
-                                  (highest - lowest).norm(), options.min_position_spread));
+    throw CalibrationError(
+        format("Calibrate: the marker's positions span %.3f m, at least %.2f m needed to fix the "
+               "camera's orientation",
+               (highest - lowest).norm(), options.min_position_spread));
   }
   const cv::Matx33d k(intrinsics.fx, 0, intrinsics.cx, 0, intrinsics.fy, intrinsics.cy, 0, 0, 1);
   const cv::Mat distortion = cv::Mat::zeros(1, 5, CV_64F);
@@ -410,9 +413,10 @@ CameraCalibration solveCamera(const std::vector<MarkerView>& views, const camera
   }
   result.residuals = residualsOf(views, intrinsics, marker_in_flange, result.camera_in_world, options.marker_size);
   if (result.residuals.reprojection_rms_px > options.max_reprojection_rms_px) {
-    throw CalibrationError(format("Calibrate: the marker's corners are off by %.2f px (RMS) with the new camera pose, "
-                                  "more than %.2f allowed (has the marker moved on the gripper? recalibrate the marker)",
-                                  result.residuals.reprojection_rms_px, options.max_reprojection_rms_px));
+    throw CalibrationError(
+        format("Calibrate: the marker's corners are off by %.2f px (RMS) with the new camera pose, "
+               "more than %.2f allowed (has the marker moved on the gripper? recalibrate the marker)",
+               result.residuals.reprojection_rms_px, options.max_reprojection_rms_px));
   }
   return result;
 }

@@ -36,12 +36,15 @@ std::vector<world::Pose> candidateMarkerPoses(const world::Pose& camera_in_world
   const bool tilted = options.tilt_deg > 0 || options.roll_deg > 0;
   if (!tilted) {
     // Spread: the region's far corners at alternating heights, its centre, then the rest.
-    const std::array<Eigen::Vector3d, 9> pattern = {
-        Eigen::Vector3d(lo.x(), lo.y(), lo.z()), Eigen::Vector3d(hi.x(), hi.y(), lo.z()),
-        Eigen::Vector3d(lo.x(), hi.y(), hi.z()), Eigen::Vector3d(hi.x(), lo.y(), hi.z()),
-        mid,
-        Eigen::Vector3d(lo.x(), hi.y(), lo.z()), Eigen::Vector3d(hi.x(), lo.y(), lo.z()),
-        Eigen::Vector3d(lo.x(), lo.y(), hi.z()), Eigen::Vector3d(hi.x(), hi.y(), hi.z())};
+    const std::array<Eigen::Vector3d, 9> pattern = {Eigen::Vector3d(lo.x(), lo.y(), lo.z()),
+                                                    Eigen::Vector3d(hi.x(), hi.y(), lo.z()),
+                                                    Eigen::Vector3d(lo.x(), hi.y(), hi.z()),
+                                                    Eigen::Vector3d(hi.x(), lo.y(), hi.z()),
+                                                    mid,
+                                                    Eigen::Vector3d(lo.x(), hi.y(), lo.z()),
+                                                    Eigen::Vector3d(hi.x(), lo.y(), lo.z()),
+                                                    Eigen::Vector3d(lo.x(), lo.y(), hi.z()),
+                                                    Eigen::Vector3d(hi.x(), hi.y(), hi.z())};
     for (const auto& p : pattern) {
       out.push_back(facingCamera(p, camera_in_world));
     }

@@ -106,11 +106,10 @@ int calibrate(const CalibrateOptions& options, bool marker) {
     std::printf("FAILURE: %s\n%s\n", result.reason.c_str(), out.is_null() ? "" : out.dump(2).c_str());
   }
   if (!options.json.empty()) {
-    std::ofstream(options.json) << nlohmann::json{{"state", component::toString(result.state)},
-                                                  {"reason", result.reason},
-                                                  {"data", out}}
-                                       .dump(2)
-                                << "\n";
+    std::ofstream(options.json)
+        << nlohmann::json{{"state", component::toString(result.state)}, {"reason", result.reason}, {"data", out}}.dump(
+               2)
+        << "\n";
   }
   return result.state == component::OperationState::kSuccess ? 0 : 1;
 }
@@ -146,11 +145,11 @@ int evaluate(EvalOptions options) {
   const trials::CalibrationEvalSummary summary =
       trials::evaluateCalibration(options.eval, [](const trials::CalibrationSample& s) {
         if (s.camera_ok) {
-          std::printf("set-up %d %-10s camera %.2f mm %.3f deg (drawn pose was %.1f mm %.2f deg off), marker %.2f mm "
-                      "%.3f deg, simulated %.1f + %.1f s\n",
-                      s.setup, s.method.empty() ? "cell" : s.method.c_str(), s.camera_mm, s.camera_deg,
-                      s.camera_before_mm, s.camera_before_deg, s.marker_mm, s.marker_deg, s.marker_simulated_s,
-                      s.camera_simulated_s);
+          std::printf(
+              "set-up %d %-10s camera %.2f mm %.3f deg (drawn pose was %.1f mm %.2f deg off), marker %.2f mm "
+              "%.3f deg, simulated %.1f + %.1f s\n",
+              s.setup, s.method.empty() ? "cell" : s.method.c_str(), s.camera_mm, s.camera_deg, s.camera_before_mm,
+              s.camera_before_deg, s.marker_mm, s.marker_deg, s.marker_simulated_s, s.camera_simulated_s);
         } else {
           std::printf("set-up %d %-10s FAILED: %s\n", s.setup, s.method.empty() ? "cell" : s.method.c_str(),
                       s.reason.c_str());
@@ -165,7 +164,8 @@ int evaluate(EvalOptions options) {
 }
 
 void addCellOptions(CLI::App* command, CalibrateOptions& options) {
-  command->add_option("--scene", options.scene, "scene file (default sim/scenes/assembly.json)")->check(CLI::ExistingFile);
+  command->add_option("--scene", options.scene, "scene file (default sim/scenes/assembly.json)")
+      ->check(CLI::ExistingFile);
   command->add_option("--seed", options.seed, "seed of the cell (placement, noise, the camera's move)")
       ->each([&options](const std::string&) { options.seed_given = true; });
   command->add_option("--camera-move", options.camera_move,
@@ -196,10 +196,12 @@ void addCalibrateCommand(CLI::App& app, int& exit_code) {
   CLI::App* marker = command->add_subcommand(
       "marker", "Once, after fixing the marker to the gripper: find where it is on the flange (hand-eye calibration)");
   addCellOptions(marker, *marker_options);
-  marker->add_option("--method", marker_options->method,
-                     "hand-eye method: daniilidis (the paper's), tsai, park, horaud, andreff, shah, li")
+  marker
+      ->add_option("--method", marker_options->method,
+                   "hand-eye method: daniilidis (the paper's), tsai, park, horaud, andreff, shah, li")
       ->capture_default_str();
-  marker->add_flag("--no-refine", marker_options->no_refine, "keep the method's own solution (no reprojection refinement)");
+  marker->add_flag("--no-refine", marker_options->no_refine,
+                   "keep the method's own solution (no reprojection refinement)");
   marker->callback([marker_options, &exit_code] { exit_code = calibrate(*marker_options, true); });
 
   auto eval_options = std::make_shared<EvalOptions>();

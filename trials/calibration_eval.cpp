@@ -154,13 +154,16 @@ std::string CalibrationEvalSummary::text() const {
       ms.push_back(s->marker_simulated_s);
       cs.push_back(s->camera_simulated_s);
     }
-    const auto largest = [](const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); };
+    const auto largest = [](const std::vector<double>& v) {
+      return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
+    };
     char line[400];
-    std::snprintf(line, sizeof line,
-                  "%-12s %2d/%-2zu  %7.2f / %6.3f          %7.2f / %6.3f                %6.2f / %6.3f (%6.2f / %6.3f)        "
-                  "%5.1f / %5.1f\n",
-                  method.c_str(), ok, list.size(), median(xm), median(xd), median(am), median(ad), median(cm),
-                  median(cd), largest(cm), largest(cd), median(ms), median(cs));
+    std::snprintf(
+        line, sizeof line,
+        "%-12s %2d/%-2zu  %7.2f / %6.3f          %7.2f / %6.3f                %6.2f / %6.3f (%6.2f / %6.3f)        "
+        "%5.1f / %5.1f\n",
+        method.c_str(), ok, list.size(), median(xm), median(xd), median(am), median(ad), median(cm), median(cd),
+        largest(cm), largest(cd), median(ms), median(cs));
     out += line;
   }
   return out;

@@ -60,11 +60,11 @@ Synthetic makeViews(int count, double tilt_deg, double pixel_sigma, std::uint64_
       marker_in_world.linear() =
           marker_in_world.linear() * Eigen::AngleAxisd(tilt_deg * kDeg * unit(random), Eigen::Vector3d::UnitZ());
     } else {
-      marker_in_world.linear() = marker_in_world.linear() *
-                                 (Eigen::AngleAxisd(tilt_deg * kDeg * unit(random), Eigen::Vector3d::UnitX()) *
-                                  Eigen::AngleAxisd(tilt_deg * kDeg * unit(random), Eigen::Vector3d::UnitY()) *
-                                  Eigen::AngleAxisd(tilt_deg * kDeg * unit(random), Eigen::Vector3d::UnitZ()))
-                                     .toRotationMatrix();
+      marker_in_world.linear() =
+          marker_in_world.linear() * (Eigen::AngleAxisd(tilt_deg * kDeg * unit(random), Eigen::Vector3d::UnitX()) *
+                                      Eigen::AngleAxisd(tilt_deg * kDeg * unit(random), Eigen::Vector3d::UnitY()) *
+                                      Eigen::AngleAxisd(tilt_deg * kDeg * unit(random), Eigen::Vector3d::UnitZ()))
+                                         .toRotationMatrix();
     }
     MarkerView view;
     view.flange_in_world = marker_in_world * s.marker.inverse();
@@ -105,8 +105,8 @@ TEST(HandEye, EveryMethodIsExactWithoutNoise) {
 
 TEST(HandEye, RefinementOnCornersBeatsNoisyArucoPoses) {
   const Synthetic s = makeViews(15, 30, 0.2, 2);
-  const MarkerCalibration raw = solveMarker(s.views, intrinsics(), HandEyeMethod::kDaniilidis, false,
-                                            {.max_reprojection_rms_px = 100});
+  const MarkerCalibration raw =
+      solveMarker(s.views, intrinsics(), HandEyeMethod::kDaniilidis, false, {.max_reprojection_rms_px = 100});
   const MarkerCalibration refined = solveMarker(s.views, intrinsics(), HandEyeMethod::kDaniilidis, true);
   EXPECT_TRUE(refined.refined);
   EXPECT_LT(millimetres(refined.marker_in_flange, s.marker), 1.0);

@@ -19,8 +19,8 @@ TEST(SimMarker, CornersAreSeenWhereTheSimulatorPutsThem) {
   const world::Pose base_in_world(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
   const world::Pose marker_in_flange = world::poseFromXyzRpy(0.0353, 0, 0.075, -M_PI / 2, 0, -M_PI / 2);
   const arm::Ur5Kinematics kinematics;
-  for (const Eigen::Vector3d& place : {Eigen::Vector3d(0.45, -0.15, 0.25), Eigen::Vector3d(0.55, 0.15, 0.3),
-                                       Eigen::Vector3d(0.5, 0.0, 0.2)}) {
+  for (const Eigen::Vector3d& place :
+       {Eigen::Vector3d(0.45, -0.15, 0.25), Eigen::Vector3d(0.55, 0.15, 0.3), Eigen::Vector3d(0.5, 0.0, 0.2)}) {
     // The marker facing the drawn camera there; the arm's configuration from the UR5's IK.
     sim::SimulationOptions options;
     {
@@ -54,8 +54,8 @@ TEST(SimMarker, CornersAreSeenWhereTheSimulatorPutsThem) {
     const auto simulation = sim::Simulation::create(sim::loadScene("sim/scenes/one_node.json"), options);
     const camera::RgbdFrame frame = simulation->captureRgbd(1);
     const world::Pose marker_in_camera = simulation->rgbdPose().inverse() * simulation->gripperMarkerPose();
-    for (const auto& detection : perception::detectArucoMarkers(frame.rgb, frame.intrinsics,
-                                                                sim::Simulation::kGripperMarkerSize)) {
+    for (const auto& detection :
+         perception::detectArucoMarkers(frame.rgb, frame.intrinsics, sim::Simulation::kGripperMarkerSize)) {
       if (detection.id != sim::Simulation::kGripperMarkerId) {
         continue;
       }
@@ -66,8 +66,8 @@ TEST(SimMarker, CornersAreSeenWhereTheSimulatorPutsThem) {
         const Eigen::Vector2d expected(frame.intrinsics.fx * c.x() / c.z() + frame.intrinsics.cx,
                                        frame.intrinsics.fy * c.y() / c.z() + frame.intrinsics.cy);
         const double error = (expected - detection.corners[k]).norm();
-        std::printf("place %.2f %.2f corner %zu: expected %.2f %.2f seen %.2f %.2f (%.2f px)\n", place.x(), place.y(), k, expected.x(),
-                    expected.y(), detection.corners[k].x(), detection.corners[k].y(), error);
+        std::printf("place %.2f %.2f corner %zu: expected %.2f %.2f seen %.2f %.2f (%.2f px)\n", place.x(), place.y(),
+                    k, expected.x(), expected.y(), detection.corners[k].x(), detection.corners[k].y(), error);
         worst = std::max(worst, error);
       }
     }
