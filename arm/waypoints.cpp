@@ -1,7 +1,11 @@
 #include "arm/waypoints.h"
 
+#include <cerrno>
+#include <cmath>
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <stdexcept>
 
 #include "core/files.h"
@@ -36,42 +40,149 @@ nlohmann::json toJson(const Waypoint& waypoint) {
   return json;
 }
 
-Waypoint fromJson(const nlohmann::json& json) {
+using nlohmann::json;
+
+/// A problem with one field of the file: "waypoints[2].orientation: ...".
+[[noreturn]] void fail(const std::string& field, const std::string& problem) {
+  throw std::runtime_error(field + ": " + problem);
+}
+
+std::string shown(const json& value) {
+  std::string text = value.dump();
+  return text.size() <= 60 ? text : text.substr(0, 57) + "...";
+}
+
+std::vector<double> numbers(const json& value, const std::string& field, std::size_t size, const std::string& what) {
+  if (!value.is_array() || value.size() != size) {
+    fail(field, "must be " + what + ", not " + shown(value));
+  }
+  std::vector<double> out;
+  for (std::size_t i = 0; i < size; ++i) {
+    if (!value[i].is_number() || !std::isfinite(value[i].get<double>())) {
+      fail(field + "[" + std::to_string(i) + "]", "must be a finite number, not " + shown(value[i]));
+    }
+    out.push_back(value[i].get<double>());
+  }
+  return out;
+}
+
+std::string stringField(const json& value, const std::string& field) {
+  if (!value.is_string()) {
+    fail(field, "must be a string, not " + shown(value));
+  }
+  return value.get<std::string>();
+}
+
+Waypoint fromJson(const json& item, const std::string& field) {
+  if (!item.is_object()) {
+    fail(field, "must be an object {\"name\": ..., ...}, not " + shown(item));
+  }
+  for (const auto& [key, value] : item.items()) {
+    if (key != "name" && key != "joints" && key != "frame" && key != "position" && key != "orientation") {
+      fail(field + "." + key, "unknown field (known: name, joints, frame, position, orientation)");
+    }
+  }
   Waypoint waypoint;
-  waypoint.name = json.at("name").get<std::string>();
+  if (!item.contains("name")) {
+    fail(field + ".name", "missing");
+  }
+  waypoint.name = stringField(item.at("name"), field + ".name");
   if (const std::string problem = checkWaypointName(waypoint.name); !problem.empty()) {
-    throw std::runtime_error(problem);
+    fail(field + ".name", problem);
   }
-  if (json.contains("joints")) {
+  if (item.contains("joints")) {
+    for (const char* key : {"frame", "position", "orientation"}) {
+      if (item.contains(key)) {
+        fail(field,
+             "has both \"joints\" (a joint configuration) and \"" + std::string(key) + "\" (of a pose); give one");
+      }
+    }
     waypoint.kind = Waypoint::Kind::kJoints;
-    waypoint.joints = json.at("joints").get<JointVector>();
-  } else {
-    waypoint.kind = Waypoint::Kind::kPose;
-    waypoint.frame = json.value("frame", "world");
-    const auto p = json.at("position").get<std::array<double, 3>>();
-    const auto q = json.at("orientation").get<std::array<double, 4>>();
-    waypoint.pose = world::Pose::Identity();
-    waypoint.pose.translation() = Eigen::Vector3d(p[0], p[1], p[2]);
-    waypoint.pose.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
+    const auto joints =
+        numbers(item.at("joints"), field + ".joints", kJointCount, std::to_string(kJointCount) + " angles (radians)");
+    std::copy(joints.begin(), joints.end(), waypoint.joints.begin());
+    return waypoint;
   }
+  waypoint.kind = Waypoint::Kind::kPose;
+  for (const char* key : {"position", "orientation"}) {
+    if (!item.contains(key)) {
+      fail(field + "." + key,
+           "missing (a waypoint has \"joints\", or \"position\" [x, y, z] and \"orientation\" [w, x, y, z])");
+    }
+  }
+  if (item.contains("frame")) {
+    waypoint.frame = stringField(item.at("frame"), field + ".frame");
+    if (waypoint.frame.empty()) {
+      fail(field + ".frame", "must name a frame (\"world\", or a frame symbol such as \"table_center\")");
+    }
+  }
+  const auto p = numbers(item.at("position"), field + ".position", 3, "[x, y, z] (m)");
+  const auto q = numbers(item.at("orientation"), field + ".orientation", 4, "a unit quaternion [w, x, y, z]");
+  const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
+  // A zero quaternion is no rotation at all (normalizing it gives nan); one far from unit
+  // length is a typing error more likely than a rotation.
+  if (std::abs(rotation.norm() - 1.0) > 0.01) {
+    std::ostringstream norm;
+    norm << rotation.norm();
+    fail(field + ".orientation", "must be a unit quaternion [w, x, y, z], not " + shown(item.at("orientation")) +
+                                     " (length " + norm.str() + ")");
+  }
+  waypoint.pose = world::Pose::Identity();
+  waypoint.pose.translation() = Eigen::Vector3d(p[0], p[1], p[2]);
+  waypoint.pose.linear() = rotation.normalized().toRotationMatrix();
   return waypoint;
 }
 
 }  // namespace
 
 WaypointStore::WaypointStore(std::filesystem::path file, bool persist) : file_(std::move(file)), persist_(persist) {
-  if (file_.empty() || !std::filesystem::exists(file_)) {
+  if (file_.empty()) {
     return;
   }
+  const std::string label = "waypoint file '" + file_.string() + "'";
+  std::error_code error;
+  const bool exists = std::filesystem::exists(file_, error);
+  if (error) {  // e.g. a loop of symbolic links, or a folder on the way that is a file
+    throw std::runtime_error("cannot read " + label + ": " + error.message());
+  }
+  if (!exists) {
+    return;
+  }
+  if (std::filesystem::is_directory(file_, error)) {
+    throw std::runtime_error("cannot read " + label + ": it is a folder");
+  }
   std::ifstream stream(file_);
+  if (!stream) {
+    throw std::runtime_error("cannot read " + label + ": " + std::strerror(errno));
+  }
+  std::stringstream text;
+  text << stream.rdbuf();
+  if (stream.bad()) {
+    throw std::runtime_error("cannot read " + label + ": " + std::strerror(errno));
+  }
   try {
-    const nlohmann::json json = nlohmann::json::parse(stream);
-    for (const auto& item : json.at("waypoints")) {
-      Waypoint waypoint = fromJson(item);
+    const json document = json::parse(text.str());
+    if (!document.is_object() || !document.contains("waypoints") || !document.at("waypoints").is_array()) {
+      fail("waypoints", "missing: the file is {\"waypoints\": [...]}");
+    }
+    for (const auto& [key, value] : document.items()) {
+      if (key != "waypoints") {
+        fail(key, "unknown field (known: waypoints)");
+      }
+    }
+    const json& list = document.at("waypoints");
+    std::map<std::string, std::size_t> index_of;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string field = "waypoints[" + std::to_string(i) + "]";
+      Waypoint waypoint = fromJson(list[i], field);
+      if (const auto [previous, added] = index_of.emplace(waypoint.name, i); !added) {
+        fail(field + ".name", "'" + waypoint.name + "' is taken already (by waypoints[" +
+                                  std::to_string(previous->second) + "]); names must differ");
+      }
       waypoints_[waypoint.name] = std::move(waypoint);
     }
   } catch (const std::exception& e) {
-    throw std::runtime_error("waypoint file '" + file_.string() + "': " + e.what());
+    throw std::runtime_error(label + ": " + e.what());
   }
 }
 

@@ -4,6 +4,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cmath>
+
 #include "arm/trajectory.h"
 #include "core/paths.h"
 #include "sim/simulation.h"
@@ -51,6 +53,9 @@ void BM_PhysicsArmMoving(benchmark::State& state) {
 }
 BENCHMARK(BM_PhysicsArmMoving)->Unit(benchmark::kMillisecond);
 
+/// One frame as a plan's DetectObjects takes its last one: colour and depth, noise on 2 threads.
+/// "CPU" is the main thread's; the /process_time variant counts every thread (Mesa's
+/// llvmpipe rasterizes on its own threads).
 void BM_CaptureRgbdFrame(benchmark::State& state) {
   const auto simulation = assembly();
   simulation->captureRgbd(0);  // the first frame compiles shaders
@@ -59,7 +64,50 @@ void BM_CaptureRgbdFrame(benchmark::State& state) {
     benchmark::DoNotOptimize(simulation->captureRgbd(seed++).points.data());
   }
 }
-BENCHMARK(BM_CaptureRgbdFrame)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_CaptureRgbdFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_CaptureRgbdFrame)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+
+/// A frame without colour, as DetectObjects takes all but its last one (the same points).
+void BM_CaptureDepthFrame(benchmark::State& state) {
+  const auto simulation = assembly();
+  simulation->captureRgbd(0, false);
+  std::uint64_t seed = 1;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(simulation->captureRgbd(seed++, false).points.data());
+  }
+}
+BENCHMARK(BM_CaptureDepthFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_CaptureDepthFrame)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+
+/// The render alone: colour only, no depth read-back, no noise.
+void BM_RenderColourOnly(benchmark::State& state) {
+  const auto simulation = assembly();
+  simulation->renderImage("rgbd", 640, 480);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(simulation->renderImage("rgbd", 640, 480).pixels.data());
+  }
+}
+BENCHMARK(BM_RenderColourOnly)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+
+/// The Kinect-v1 noise model alone on the workcell's clean depth image, on 1 and 2 threads.
+void BM_DepthNoise(benchmark::State& state) {
+  sim::SimulationOptions options;
+  options.depth_noise.enabled = false;
+  const auto simulation = sim::Simulation::create(sim::loadScene(dataRoot() / "sim/scenes/assembly.json"), options);
+  const camera::RgbdFrame clean = simulation->captureRgbd(0, false);
+  std::vector<float> depth(clean.points.size());
+  for (std::size_t i = 0; i < depth.size(); ++i) {
+    depth[i] = std::isfinite(clean.points[i].z()) ? clean.points[i].z() : 0.0f;
+  }
+  std::vector<Eigen::Vector3f> points;
+  std::uint64_t seed = 1;
+  for (auto _ : state) {
+    sim::noisyPointCloud(depth, clean.intrinsics, sim::DepthNoiseOptions{}, seed++, points,
+                         static_cast<int>(state.range(0)));
+    benchmark::DoNotOptimize(points.data());
+  }
+}
+BENCHMARK(BM_DepthNoise)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
 
 void BM_LoadWorkcell(benchmark::State& state) {
   for (auto _ : state) {

@@ -1,6 +1,6 @@
 #pragma once
 // A task plan as data: the content of BehaviorTree.CPP v4 XML files, before it is validated
-// against a NodeRegistry and instantiated as a Tree. No tinyxml2 here (see plan_xml.h).
+// against a NodeRegistry and instantiated as a Tree. No XML parser here (see plan_xml.h).
 
 #include <optional>
 #include <stdexcept>

@@ -1,10 +1,9 @@
 #include "bt/plan_xml.h"
 
-#include <tinyxml2.h>
-
 #include <algorithm>
 #include <fstream>
 #include <memory>
+#include <pugixml.hpp>
 #include <set>
 #include <sstream>
 
@@ -21,6 +20,17 @@ constexpr std::string_view kExplicitKinds[] = {"Action", "Condition", "Control",
 
 bool isExplicitKind(std::string_view element) {
   return std::find(std::begin(kExplicitKinds), std::end(kExplicitKinds), element) != std::end(kExplicitKinds);
+}
+
+/// Nesting deeper than this is refused with a message (BehaviorTree.CPP's XML parser, tinyxml2
+/// 10, refuses more than 500 levels); it keeps the recursive walks over a plan within the stack.
+constexpr int kMaxElementDepth = 500;
+
+/// The text an element starts with (its first child, when that is text), as tinyxml2's
+/// GetText(); nullptr when it starts with an element or is empty.
+const char* leadingText(const pugi::xml_node& element) {
+  const pugi::xml_node first = element.first_child();
+  return first.type() == pugi::node_pcdata || first.type() == pugi::node_cdata ? first.value() : nullptr;
 }
 
 bool isBlank(const char* text) {
@@ -41,22 +51,35 @@ class FileParser {
   explicit FileParser(std::string label) { file_.path = std::move(label); }
 
   PlanFile parse(std::string_view xml) {
-    tinyxml2::XMLDocument document(/*processEntities=*/true, tinyxml2::COLLAPSE_WHITESPACE);
-    if (document.Parse(xml.data(), xml.size()) != tinyxml2::XML_SUCCESS) {
-      error(document.ErrorLineNum(), std::string("malformed XML: ") + document.ErrorStr());
+    xml_ = xml;
+    pugi::xml_document document;
+    // Entities and CDATA as XML has them; attribute values kept as written (no whitespace
+    // conversion), as BehaviorTree.CPP reads them.
+    const pugi::xml_parse_result result = document.load_buffer(
+        xml.data(), xml.size(), pugi::parse_cdata | pugi::parse_escapes | pugi::parse_eol, pugi::encoding_utf8);
+    if (result.status == pugi::status_no_document_element) {
+      error(0, "no XML element found");
       throw PlanError(std::move(diagnostics_));
     }
-    const tinyxml2::XMLElement* root = document.RootElement();
-    if (root == nullptr) {
-      error(0, "no XML element found");
-    } else if (std::string_view(root->Name()) != "root") {
-      error(root->GetLineNum(),
-            "the top element must be <root BTCPP_format=\"4\">, found <" + std::string(root->Name()) + ">");
+    if (result.status == pugi::status_end_element_mismatch) {
+      // Name the element left open, at its line (the parser stops at the wrong end tag).
+      const auto [name, open_line] = openElementAt(static_cast<std::size_t>(result.offset));
+      error(open_line, "malformed XML: <" + name + "> is not closed (mismatched end tag on line " +
+                           std::to_string(lineAt(result.offset)) + ")");
+      throw PlanError(std::move(diagnostics_));
+    }
+    if (!result) {
+      error(lineAt(result.offset), std::string("malformed XML: ") + result.description());
+      throw PlanError(std::move(diagnostics_));
+    }
+    const pugi::xml_node root = document.document_element();
+    if (std::string_view(root.name()) != "root") {
+      error(line(root), "the top element must be <root BTCPP_format=\"4\">, found <" + std::string(root.name()) + ">");
     } else {
-      if (root->NextSiblingElement() != nullptr) {
-        error(root->NextSiblingElement()->GetLineNum(), "only one top-level <root> element is allowed");
+      if (const pugi::xml_node next = nextElement(root)) {
+        error(line(next), "only one top-level <root> element is allowed");
       }
-      parseRoot(*root);
+      parseRoot(root);
     }
     if (!diagnostics_.empty()) {
       throw PlanError(std::move(diagnostics_));
@@ -67,128 +90,209 @@ class FileParser {
  private:
   void error(int line, std::string message) { diagnostics_.push_back({{file_.path, line}, std::move(message)}); }
 
-  void parseRoot(const tinyxml2::XMLElement& root) {
-    for (const auto* attribute = root.FirstAttribute(); attribute != nullptr; attribute = attribute->Next()) {
-      const std::string_view key = attribute->Name();
+  /// 1-based line of a byte offset in the file.
+  int lineAt(std::ptrdiff_t offset) {
+    if (line_starts_.empty()) {
+      line_starts_.push_back(0);
+      for (std::size_t i = 0; i < xml_.size(); ++i) {
+        if (xml_[i] == '\n') {
+          line_starts_.push_back(i + 1);
+        }
+      }
+    }
+    const auto at = static_cast<std::size_t>(std::max<std::ptrdiff_t>(offset, 0));
+    return static_cast<int>(std::upper_bound(line_starts_.begin(), line_starts_.end(), at) - line_starts_.begin());
+  }
+  int line(const pugi::xml_node& node) { return lineAt(node.offset_debug()); }
+
+  /// The innermost element open at `offset` of well-formed text before it, and its line.
+  std::pair<std::string, int> openElementAt(std::size_t offset) {
+    offset = std::min(xml_.rfind("</", offset), offset);  // the mismatched end tag closes nothing
+    std::vector<std::pair<std::string, std::size_t>> open;
+    const auto skipPast = [this](std::size_t from, std::string_view end) {
+      const std::size_t at = xml_.find(end, from);
+      return at == std::string_view::npos ? xml_.size() : at + end.size();
+    };
+    std::size_t i = 0;
+    while ((i = xml_.find('<', i)) != std::string_view::npos && i < offset) {
+      const std::string_view rest = xml_.substr(i);
+      if (rest.starts_with("<!--")) {
+        i = skipPast(i, "-->");
+      } else if (rest.starts_with("<![CDATA[")) {
+        i = skipPast(i, "]]>");
+      } else if (rest.starts_with("<?")) {
+        i = skipPast(i, "?>");
+      } else if (rest.starts_with("<!")) {
+        i = skipPast(i, ">");
+      } else if (rest.starts_with("</")) {
+        if (!open.empty()) {
+          open.pop_back();
+        }
+        i = skipPast(i, ">");
+      } else {
+        const std::size_t name_end = xml_.find_first_of(" \t\r\n/>", i + 1);
+        const std::size_t start = i;
+        char quote = 0;
+        for (++i; i < xml_.size() && (quote != 0 || xml_[i] != '>'); ++i) {
+          if (quote == 0 && (xml_[i] == '"' || xml_[i] == '\'')) {
+            quote = xml_[i];
+          } else if (xml_[i] == quote) {
+            quote = 0;
+          }
+        }
+        if (i < xml_.size() && xml_[i - 1] != '/') {
+          open.emplace_back(std::string(xml_.substr(start + 1, name_end - start - 1)), start);
+        }
+      }
+    }
+    if (open.empty()) {
+      return {"?", lineAt(static_cast<std::ptrdiff_t>(offset))};
+    }
+    return {open.back().first, lineAt(static_cast<std::ptrdiff_t>(open.back().second))};
+  }
+
+  void parseRoot(const pugi::xml_node& root) {
+    for (const pugi::xml_attribute attribute : root.attributes()) {
+      const std::string_view key = attribute.name();
       if (key == "BTCPP_format") {
-        if (std::string_view(attribute->Value()) != "4") {
-          error(root.GetLineNum(), "BTCPP_format=\"" + std::string(attribute->Value()) +
-                                       "\" is not supported: plans use BehaviorTree.CPP's format 4");
+        if (std::string_view(attribute.value()) != "4") {
+          error(line(root), "BTCPP_format=\"" + std::string(attribute.value()) +
+                                "\" is not supported: plans use BehaviorTree.CPP's format 4");
         }
       } else if (key == "main_tree_to_execute") {
-        file_.main_tree = attribute->Value();
+        file_.main_tree = attribute.value();
       }
       // Other attributes (Groot2's project_name, ...) are ignored, as BehaviorTree.CPP does.
     }
     std::set<std::string> tree_ids;
-    for (const auto* tree = root.FirstChildElement("BehaviorTree"); tree != nullptr;
-         tree = tree->NextSiblingElement("BehaviorTree")) {
+    for (const pugi::xml_node tree : root.children("BehaviorTree")) {
+      static_cast<void>(tree);
       ++tree_count_;
     }
-    for (const auto* element = root.FirstChildElement(); element != nullptr; element = element->NextSiblingElement()) {
-      const std::string_view name = element->Name();
+    for (const pugi::xml_node element : root.children()) {
+      if (element.type() != pugi::node_element) {
+        continue;
+      }
+      const std::string_view name = element.name();
       if (name == "BehaviorTree") {
-        parseBehaviorTree(*element, tree_ids);
+        parseBehaviorTree(element, tree_ids);
       } else if (name == "include") {
-        parseInclude(*element);
+        parseInclude(element);
       } else if (name == "TreeNodesModel") {
         continue;  // derived data: regenerated from the registry when saving
       } else {
-        error(element->GetLineNum(), "unexpected element <" + std::string(name) +
-                                         "> in <root>: expected <BehaviorTree>, <include> or "
-                                         "<TreeNodesModel>");
+        error(line(element), "unexpected element <" + std::string(name) +
+                                 "> in <root>: expected <BehaviorTree>, <include> or "
+                                 "<TreeNodesModel>");
       }
     }
   }
 
-  void parseInclude(const tinyxml2::XMLElement& element) {
-    const char* path = element.Attribute("path");
-    if (element.Attribute("ros_pkg") != nullptr) {
-      error(element.GetLineNum(), "<include ros_pkg=...> is not supported (there is no ROS here)");
-    } else if (path == nullptr || *path == '\0') {
-      error(element.GetLineNum(), "<include> needs a path attribute");
+  void parseInclude(const pugi::xml_node& element) {
+    const pugi::xml_attribute path = element.attribute("path");
+    if (element.attribute("ros_pkg")) {
+      error(line(element), "<include ros_pkg=...> is not supported (there is no ROS here)");
+    } else if (!path || *path.value() == '\0') {
+      error(line(element), "<include> needs a path attribute");
     } else {
-      file_.includes.push_back({path, {file_.path, element.GetLineNum()}});
+      file_.includes.push_back({path.value(), {file_.path, line(element)}});
     }
   }
 
-  void parseBehaviorTree(const tinyxml2::XMLElement& element, std::set<std::string>& tree_ids) {
+  void parseBehaviorTree(const pugi::xml_node& element, std::set<std::string>& tree_ids) {
     PlanTree tree;
-    tree.location = {file_.path, element.GetLineNum()};
-    const char* id = element.Attribute("ID");
-    if (id == nullptr && tree_count_ > 1) {
-      error(element.GetLineNum(), "<BehaviorTree> needs an ID attribute: the file has " + std::to_string(tree_count_) +
-                                      " trees (only a file's single tree may leave it out)");
+    tree.location = {file_.path, line(element)};
+    const pugi::xml_attribute id = element.attribute("ID");
+    if (!id && tree_count_ > 1) {
+      error(line(element), "<BehaviorTree> needs an ID attribute: the file has " + std::to_string(tree_count_) +
+                               " trees (only a file's single tree may leave it out)");
       return;
-    } else if (id == nullptr) {
+    } else if (!id) {
       // A file's single tree may leave the ID out; BehaviorTree.CPP then names it "BehaviorTree_<k>".
       tree.id = "BehaviorTree_" + std::to_string(unnamed_trees_++);
-    } else if (*id == '\0') {
-      error(element.GetLineNum(), "<BehaviorTree ID=\"\"> has an empty ID: name the tree, or leave ID out");
+    } else if (*id.value() == '\0') {
+      error(line(element), "<BehaviorTree ID=\"\"> has an empty ID: name the tree, or leave ID out");
       return;
     } else {
-      tree.id = id;
+      tree.id = id.value();
     }
-    for (const auto* attribute = element.FirstAttribute(); attribute != nullptr; attribute = attribute->Next()) {
-      const std::string_view key = attribute->Name();
+    for (const pugi::xml_attribute attribute : element.attributes()) {
+      const std::string_view key = attribute.name();
       if (key != "ID" && !key.starts_with("_")) {
-        error(element.GetLineNum(),
-              "unknown attribute '" + std::string(key) + "' on <BehaviorTree ID=\"" + tree.id + "\">");
+        error(line(element), "unknown attribute '" + std::string(key) + "' on <BehaviorTree ID=\"" + tree.id + "\">");
       }
     }
     if (!tree_ids.insert(tree.id).second) {
-      error(element.GetLineNum(), "BehaviorTree '" + tree.id + "' is defined twice");
+      error(line(element), "BehaviorTree '" + tree.id + "' is defined twice");
     }
-    if (!isBlank(element.GetText())) {
-      error(element.GetLineNum(), "unexpected text inside <BehaviorTree ID=\"" + tree.id + "\">");
+    if (!isBlank(leadingText(element))) {
+      error(line(element), "unexpected text inside <BehaviorTree ID=\"" + tree.id + "\">");
     }
-    const auto* first = element.FirstChildElement();
-    if (first == nullptr) {
-      error(element.GetLineNum(), "BehaviorTree '" + tree.id + "' has no root node");
+    const pugi::xml_node first =
+        element.first_child().type() == pugi::node_element ? element.first_child() : nextElement(element.first_child());
+    if (!first) {
+      error(line(element), "BehaviorTree '" + tree.id + "' has no root node");
       return;
     }
-    if (first->NextSiblingElement() != nullptr) {
-      error(first->NextSiblingElement()->GetLineNum(),
-            "BehaviorTree '" + tree.id + "' has more than one root node: wrap them in a Sequence");
+    if (const pugi::xml_node second = nextElement(first)) {
+      error(line(second), "BehaviorTree '" + tree.id + "' has more than one root node: wrap them in a Sequence");
     }
-    tree.root = parseNode(*first);
+    tree.root = parseNode(first, 1);
     file_.trees.push_back(std::move(tree));
   }
 
-  PlanNode parseNode(const tinyxml2::XMLElement& element) {
+  static pugi::xml_node nextElement(const pugi::xml_node& node) {
+    pugi::xml_node next = node.next_sibling();
+    while (next && next.type() != pugi::node_element) {
+      next = next.next_sibling();
+    }
+    return next;
+  }
+
+  PlanNode parseNode(const pugi::xml_node& element, int depth) {
     PlanNode node;
-    node.location = {file_.path, element.GetLineNum()};
-    const std::string_view element_name = element.Name();
+    node.location = {file_.path, line(element)};
+    const std::string_view element_name = element.name();
     const bool explicit_form = isExplicitKind(element_name);
     if (!explicit_form) {
       node.id = element_name;
     }
     std::set<std::string_view> seen;
-    for (const auto* attribute = element.FirstAttribute(); attribute != nullptr; attribute = attribute->Next()) {
-      const std::string_view key = attribute->Name();
+    for (const pugi::xml_attribute attribute : element.attributes()) {
+      const std::string_view key = attribute.name();
       if (!seen.insert(key).second) {
-        error(element.GetLineNum(), "attribute '" + std::string(key) + "' is written twice");
+        error(line(element), "attribute '" + std::string(key) + "' is written twice");
         continue;
       }
       if (explicit_form && key == "ID") {
-        node.id = attribute->Value();
+        node.id = attribute.value();
         continue;
       }
-      node.attributes.emplace_back(std::string(key), attribute->Value());
+      node.attributes.emplace_back(std::string(key), attribute.value());
     }
     if (explicit_form && node.id.empty()) {
-      error(element.GetLineNum(), "<" + std::string(element_name) + "> needs an ID attribute");
+      error(line(element), "<" + std::string(element_name) + "> needs an ID attribute");
       node.id = element_name;
     }
-    if (!isBlank(element.GetText())) {
-      error(element.GetLineNum(), "unexpected text inside <" + std::string(element_name) + ">");
+    if (!isBlank(leadingText(element))) {
+      error(line(element), "unexpected text inside <" + std::string(element_name) + ">");
     }
-    for (const auto* child = element.FirstChildElement(); child != nullptr; child = child->NextSiblingElement()) {
-      node.children.push_back(parseNode(*child));
+    for (pugi::xml_node child = element.first_child(); child; child = child.next_sibling()) {
+      if (child.type() != pugi::node_element) {
+        continue;
+      }
+      if (depth + 3 > kMaxElementDepth) {  // <root>, <BehaviorTree> and this node's level
+        error(line(child),
+              "nesting is too deep: more than " + std::to_string(kMaxElementDepth) + " levels of elements");
+        break;
+      }
+      node.children.push_back(parseNode(child, depth + 1));
     }
     return node;
   }
 
+  std::string_view xml_;
+  std::vector<std::size_t> line_starts_;
   PlanFile file_;
   std::vector<Diagnostic> diagnostics_;
   int unnamed_trees_ = 0;

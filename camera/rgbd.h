@@ -52,6 +52,9 @@ class RgbdCamera {
   virtual Duration framePeriod() const = 0;
   /// The current frame. In simulation it is rendered from the world's present state.
   virtual RgbdFrame capture() = 0;
+  /// The current frame for a user that needs its points only: the colour image may be left
+  /// empty (a simulated camera then skips rendering colour). The points are as capture()'s.
+  virtual RgbdFrame captureDepth() { return capture(); }
 };
 
 }  // namespace costar::camera

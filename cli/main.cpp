@@ -1,8 +1,11 @@
-// costar: teach a collaborative robot a task as a behavior tree, and run it.
+// costar-robot: every costar command, with the robot libraries (simulator, perception,
+// planning). The light `costar` (light_main.cpp) runs the commands that need none of them and
+// hands the others to this executable (robot_binary.h).
 
 #include <CLI/CLI.hpp>
 
 #include "cli/calibrate_command.h"
+#include "cli/describe_command.h"
 #include "cli/perception_commands.h"
 #include "cli/plan_commands.h"
 #include "cli/serve_command.h"
@@ -18,6 +21,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   int exit_code = 0;
   costar::cli::addPlanCommands(app, exit_code);
+  costar::cli::addDescribeWorkcellCommand(app, exit_code);  // hidden: for the build
   costar::cli::addSimCommands(app, exit_code);
   costar::cli::addPerceptionCommands(app, exit_code);
   costar::cli::addTeachCommand(app, exit_code);

@@ -65,7 +65,8 @@ std::vector<camera::RgbdFrame> captureFrames(sim::Simulation& simulation, int co
   std::vector<camera::RgbdFrame> frames;
   for (int i = 0; i < count; ++i) {
     simulation.stepTo(simulation.time() + std::chrono::nanoseconds(33'333'333));
-    frames.push_back(simulation.captureRgbd(seed + static_cast<std::uint64_t>(i)));
+    // Colour only for the last frame: the median filter takes its colour from that one.
+    frames.push_back(simulation.captureRgbd(seed + static_cast<std::uint64_t>(i), i + 1 == count));
   }
   return frames;
 }
@@ -294,8 +295,6 @@ int collect(const CollectOptions& options) {
     sim::Scene empty;
     empty.label = "clear table";
     empty.regions = sim::defaultRegions();
-    // One simulation at a time: destroying a Simulation ends the EGL display that every live
-    // renderer shares (sim/gl_context.cpp).
     camera::RgbdFrame clear;
     {
       auto simulation = sim::Simulation::create(empty);
@@ -478,6 +477,7 @@ class SwitchableCamera final : public camera::RgbdCamera {
   const camera::Intrinsics& intrinsics() const override { return camera_->intrinsics(); }
   Duration framePeriod() const override { return camera_->framePeriod(); }
   camera::RgbdFrame capture() override { return camera_->capture(); }
+  camera::RgbdFrame captureDepth() override { return camera_->captureDepth(); }
 
  private:
   std::unique_ptr<sim::SimRgbdCamera> camera_;

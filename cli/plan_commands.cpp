@@ -15,6 +15,7 @@
 #include "bt/nodes_model.h"
 #include "bt/plan_xml.h"
 #include "bt/trace.h"
+#include "cli/workcell_access.h"
 #include "workcell/workcell.h"
 
 namespace costar::cli {
@@ -98,9 +99,9 @@ void addWorkcellOptions(CLI::App* command, workcell::WorkcellOptions& options) {
                       "waypoint file (default " + workcell::defaultWaypointFile("<workcell>").string() + ")");
 }
 
-std::unique_ptr<workcell::Workcell> openWorkcell(const workcell::WorkcellOptions& options) {
+std::unique_ptr<workcell::Workcell> openWorkcell(const workcell::WorkcellOptions& options, WorkcellUse use) {
   try {
-    return workcell::makeWorkcell(options);
+    return openWorkcellFor(options, use);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return nullptr;
@@ -118,7 +119,7 @@ struct RunOptions {
 };
 
 int runPlan(const RunOptions& options) {
-  const std::unique_ptr<workcell::Workcell> cell = openWorkcell(options.workcell);
+  const std::unique_ptr<workcell::Workcell> cell = openWorkcell(options.workcell, WorkcellUse::kRun);
   if (!cell) {
     return kExitInvalid;
   }
@@ -186,7 +187,7 @@ int runPlan(const RunOptions& options) {
 
 int validatePlan(const std::string& path, const workcell::WorkcellOptions& workcell_options) {
   try {
-    const auto cell = workcell::makeWorkcell(workcell_options);
+    const auto cell = openWorkcellFor(workcell_options, WorkcellUse::kDescribe);
     const bt::Plan plan = bt::loadPlan(path);
     const auto diagnostics = bt::validatePlan(plan, cell->nodes());
     if (!diagnostics.empty()) {
@@ -233,7 +234,7 @@ nlohmann::json nodesJson(const bt::NodeRegistry& registry) {
 
 int writeNodes(const workcell::WorkcellOptions& workcell_options, const std::string& format, bool all,
                const std::string& out) {
-  const std::unique_ptr<workcell::Workcell> cell = openWorkcell(workcell_options);
+  const std::unique_ptr<workcell::Workcell> cell = openWorkcell(workcell_options, WorkcellUse::kDescribe);
   if (!cell) {
     return kExitInvalid;
   }

@@ -2,8 +2,12 @@
 
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "bt/plan.h"
 #include "trials/judge.h"
@@ -18,25 +22,130 @@ struct Options {
   std::string json;
   std::string plot;
   double require = 0.0;
+  std::string shard;                      // "I/N"
+  std::vector<std::string> merge_inputs;  // `costar trials merge`
 };
 
+/// "I/N" with 0 <= I < N into the options. @throws std::invalid_argument.
+void parseShard(const std::string& text, trials::TrialOptions& options) {
+  const auto slash = text.find('/');
+  try {
+    std::size_t used_index = 0;
+    std::size_t used_count = 0;
+    if (slash == std::string::npos) {
+      throw std::invalid_argument("no '/'");
+    }
+    options.shard_index = std::stoi(text.substr(0, slash), &used_index);
+    options.shard_count = std::stoi(text.substr(slash + 1), &used_count);
+    if (used_index != slash || used_count != text.size() - slash - 1) {
+      throw std::invalid_argument("trailing characters");
+    }
+  } catch (const std::exception&) {
+    throw std::invalid_argument("--shard: '" + text + "' is not I/N (e.g. 0/4: the first of 4 slices)");
+  }
+  if (options.shard_count < 1 || options.shard_index < 0 || options.shard_index >= options.shard_count) {
+    throw std::invalid_argument("--shard: '" + text + "': needs 0 <= I < N (slices are numbered from 0)");
+  }
+}
+
+/// Prints the summary, writes the JSON and the plot where asked; the exit code.
+int report(const trials::Summary& summary, const Options& options) {
+  std::printf("\n%s", summary.text().c_str());
+  const double rate = summary.trials.empty() ? 0.0 : static_cast<double>(summary.successes()) / summary.trials.size();
+  int code = rate + 1e-12 >= options.require ? 0 : 1;
+  // Each output on its own: the JSON is written even when the plot cannot be.
+  const auto write = [&code](const std::string& file, const std::function<void()>& writer) {
+    try {
+      writer();
+      std::printf("wrote %s\n", file.c_str());
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      code = 2;
+    }
+  };
+  if (!options.json.empty()) {
+    write(options.json, [&] { trials::writeJson(summary, options.json); });
+  }
+  if (!options.plot.empty()) {
+    write(options.plot, [&] { trials::writePlot(summary, options.plot); });
+  }
+  return code;
+}
+
+/// Checks that the outputs can be written at the end, before anything runs.
+void checkOutputs(const Options& options) {
+  if (!options.json.empty()) {
+    trials::checkOutputFile(options.json, "--json");
+  }
+  if (!options.plot.empty()) {
+    trials::checkOutputFile(options.plot, "--plot");
+  }
+}
+
+int merge(const Options& options) {
+  std::vector<trials::Summary> shards;
+  try {
+    checkOutputs(options);
+    for (const std::string& file : options.merge_inputs) {
+      std::ifstream stream(file);
+      if (!stream) {
+        throw std::runtime_error(file + ": cannot be read");
+      }
+      try {
+        shards.push_back(trials::Summary::fromJson(nlohmann::json::parse(stream)));
+      } catch (const std::exception& e) {
+        throw std::runtime_error(file + ": " + e.what());
+      }
+    }
+    const trials::Summary merged = trials::mergeShards(shards);
+    std::printf("costar trials merge: %zu result file(s), %zu trials of %s on scene %s, judge '%s'\n", shards.size(),
+                merged.trials.size(), merged.options.plan.c_str(), merged.options.scene.c_str(),
+                merged.options.judge.c_str());
+    return report(merged, options);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
+}
+
 int run(Options options) {
+  if (options.trials.plan.empty() || options.trials.judge.empty()) {
+    std::cerr << "error: costar trials needs a plan and --judge (or: costar trials merge RESULTS.json...)\n";
+    return 2;
+  }
   if (options.trials.scene.empty()) {
     options.trials.scene = "sim/scenes/assembly.json";
+  }
+  // Everything that can be checked is checked before the first trial: no result is lost to a
+  // bad option or an output that cannot be written at the end.
+  try {
+    if (!options.shard.empty()) {
+      parseShard(options.shard, options.trials);
+    }
+    trials::checkOptions(options.trials);
+    checkOutputs(options);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
   }
   std::printf("costar trials: %d trial(s) of %s on scene %s, judge '%s', seeds %llu.., %d at a time\n",
               options.trials.count, options.trials.plan.c_str(), options.trials.scene.c_str(),
               options.trials.judge.c_str(), static_cast<unsigned long long>(options.trials.seed), options.trials.jobs);
+  if (options.trials.shard_count > 1) {
+    std::printf("shard %d/%d: trials %d, %d, ... of them\n", options.trials.shard_index, options.trials.shard_count,
+                options.trials.shard_index, options.trials.shard_index + options.trials.shard_count);
+  }
   std::fflush(stdout);
   trials::Summary summary;
   try {
-    summary = trials::runTrials(options.trials, [&options](const trials::TrialResult& result, int done) {
+    const int total = (options.trials.count - options.trials.shard_index + options.trials.shard_count - 1) /
+                      options.trials.shard_count;  // this shard's trials
+    summary = trials::runTrials(options.trials, [total](const trials::TrialResult& result, int done) {
       if (result.success) {
-        std::printf("[%4d/%d] trial %d (seed %llu): SUCCESS in %.1f s simulated (%.1f s wall)\n", done,
-                    options.trials.count, result.index, static_cast<unsigned long long>(result.seed),
-                    result.cycle_time_s, result.wall_s);
+        std::printf("[%4d/%d] trial %d (seed %llu): SUCCESS in %.1f s simulated (%.1f s wall)\n", done, total,
+                    result.index, static_cast<unsigned long long>(result.seed), result.cycle_time_s, result.wall_s);
       } else {
-        std::printf("[%4d/%d] trial %d (seed %llu): FAILURE at %s: %s\n", done, options.trials.count, result.index,
+        std::printf("[%4d/%d] trial %d (seed %llu): FAILURE at %s: %s\n", done, total, result.index,
                     static_cast<unsigned long long>(result.seed), result.failure_path.c_str(), result.reason.c_str());
       }
       std::fflush(stdout);
@@ -50,17 +159,23 @@ int run(Options options) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
   }
-  std::printf("\n%s", summary.text().c_str());
-  if (!options.json.empty()) {
-    std::ofstream(options.json) << summary.toJson().dump(2) << "\n";
-    std::printf("wrote %s\n", options.json.c_str());
-  }
-  if (!options.plot.empty()) {
-    trials::writePlot(summary, options.plot);
-    std::printf("wrote %s\n", options.plot.c_str());
-  }
-  const double rate = summary.trials.empty() ? 0.0 : static_cast<double>(summary.successes()) / summary.trials.size();
-  return rate + 1e-12 >= options.require ? 0 : 1;
+  return report(summary, options);
+}
+
+/// A number from `low` (excluded when `low_open`) to `high`; unlike CLI::Range, nan is refused.
+CLI::Validator numberIn(double low, double high, bool low_open, const std::string& unit) {
+  char range[96];
+  std::snprintf(range, sizeof range, "%s %g%s and at most %g", low_open ? "above" : "from", low, unit.c_str(), high);
+  const std::string description = range;
+  return CLI::Validator(
+      [low, high, low_open, description](std::string& text) -> std::string {
+        double value = 0.0;
+        if (!CLI::detail::lexical_cast(text, value) || !(low_open ? value > low : value >= low) || !(value <= high)) {
+          return "must be a number " + description + ", not " + text;
+        }
+        return {};
+      },
+      "NUMBER " + description);
 }
 
 }  // namespace
@@ -74,8 +189,8 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
   }
   CLI::App* command = app.add_subcommand(
       "trials", "Rerun a plan as N randomized trials in the simulated cell, judged from its true state");
-  command->add_option("plan", options->trials.plan, "plan file")->required()->check(CLI::ExistingFile);
-  command->add_option("--judge", options->trials.judge, "how success is judged (see below)")->required();
+  command->add_option("plan", options->trials.plan, "plan file (required unless merging)")->check(CLI::ExistingFile);
+  command->add_option("--judge", options->trials.judge, "how success is judged (see below; required)");
   command->add_option("--scene", options->trials.scene, "scene file (default sim/scenes/assembly.json)")
       ->check(CLI::ExistingFile);
   command->add_option("-n,--n", options->trials.count, "number of trials")
@@ -89,6 +204,7 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
   command->add_option("--waypoints", options->trials.waypoints, "waypoint file the plan uses (read only)")
       ->check(CLI::ExistingFile);
   command->add_option("--time-limit", options->trials.time_limit_s, "simulated seconds allowed per trial")
+      ->check(numberIn(0.0, trials::kMaxTimeLimitSeconds, true, " s"))
       ->capture_default_str();
   command->add_option_function<std::string>(
       "--camera-move",
@@ -111,10 +227,32 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
   command->add_option("--json", options->json, "write the summary and every trial as JSON");
   command->add_option("--plot", options->plot, "write a PNG: success rate, failures, cycle times");
   command->add_option("--require", options->require, "exit 1 when the success rate is below this (0..1)")
-      ->check(CLI::Range(0.0, 1.0));
-  command->footer("Judges:" + judges +
-                  "\nExit code: 0, or 1 when the success rate is below --require; 2 for an invalid plan or option.");
-  command->callback([options, &exit_code] { exit_code = run(*options); });
+      ->check(numberIn(0.0, 1.0, false, ""));
+  command->add_option("--shard", options->shard,
+                      "run only slice I of N (0 <= I < N): trials I, I+N, I+2N, ..., each with its own seed as in "
+                      "one run; combine the --json files with `costar trials merge`");
+
+  CLI::App* merge_command = command->add_subcommand(
+      "merge", "Combine the --json results of shards (costar trials --shard I/N) into one summary and plot");
+  merge_command->add_option("results", options->merge_inputs, "JSON files written by `costar trials --json`")
+      ->required()
+      ->check(CLI::ExistingFile);
+  merge_command->add_option("--json", options->json, "write the merged summary as JSON");
+  merge_command->add_option("--plot", options->plot, "write a PNG: success rate, failures, cycle times");
+  merge_command->add_option("--require", options->require, "exit 1 when the success rate is below this (0..1)")
+      ->check(numberIn(0.0, 1.0, false, ""));
+  merge_command->callback([options, &exit_code] { exit_code = merge(*options); });
+  command->footer(
+      "Judges:" + judges +
+      "\nMany machines: run `costar trials PLAN --judge J -n 10000 --shard $I/100 --json r$I.json` as jobs I = 0..99 "
+      "(a Slurm array, GNU parallel, Kubernetes indexed jobs), then `costar trials merge r*.json --plot trials.png`."
+      "\nExit code: 0, or 1 when the success rate is below --require; 2 for an invalid plan or option (checked "
+      "before the first trial) or an output that could not be written.");
+  command->callback([options, merge_command, &exit_code] {
+    if (!merge_command->parsed()) {
+      exit_code = run(*options);
+    }
+  });
 }
 
 }  // namespace costar::cli

@@ -19,7 +19,16 @@ function(costar_library name)
   costar_warnings(costar_${name})
 endfunction()
 
-# costar_test(NAME SOURCES ... DEPS ...): a GoogleTest executable registered with CTest.
+# In a COSTAR_SANITIZE build: the sanitizers' default runtime options, linked into an executable.
+function(costar_sanitizer_options target)
+  if(TARGET costar_sanitizer_options)
+    target_link_libraries(${target} PRIVATE costar_sanitizer_options)
+  endif()
+endfunction()
+
+# costar_test(NAME SOURCES ... DEPS ... [LABELS ...]): a GoogleTest executable registered with
+# CTest. The label "sanitize" puts it in the subset run under the sanitizers in scripts/test.sh
+# (target sanitize_tests, ctest -L sanitize).
 function(costar_test name)
   if(NOT COSTAR_BUILD_TESTS)
     return()
@@ -28,6 +37,10 @@ function(costar_test name)
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main GTest::gmock)
   costar_warnings(${name})
+  costar_sanitizer_options(${name})
+  if("sanitize" IN_LIST ARG_LABELS)
+    set_property(GLOBAL APPEND PROPERTY COSTAR_SANITIZE_TESTS ${name})
+  endif()
   include(GoogleTest)
   gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
     PROPERTIES LABELS "${ARG_LABELS}" DISCOVERY_TIMEOUT 60)

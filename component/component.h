@@ -7,6 +7,7 @@
 // runs in the executor's process or behind a process boundary.
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -30,6 +31,10 @@ struct OperationSpec {
   std::string description;
   std::vector<ParamSpec> params;
   OperationKind kind = OperationKind::kRobotAction;
+  /// Checks across parameters that would make the operation fail at once (a grasp not taught
+  /// for the chosen class, a place with neither target): empty when valid, else the problem.
+  /// Plan validation (the editor's Check, costar run) calls it with every port's value.
+  std::function<std::string(const ParamMap& params)> check;
 
   const ParamSpec* param(std::string_view name) const;
 };

@@ -126,6 +126,15 @@ void ComponentRegistry::registerNodes(bt::NodeRegistry& nodes) {
       for (const ParamSpec& param : operation.params) {
         spec.ports.push_back(portOf(param));
       }
+      if (operation.check) {
+        spec.check_instance = [operation](const bt::NodeArgs& args, std::size_t) -> std::string {
+          try {
+            return operation.check(parseParams(operation, args));
+          } catch (const std::invalid_argument&) {
+            return {};  // an ill-typed parameter: the port check names it
+          }
+        };
+      }
       spec.build = [this, target, operation](const bt::NodeArgs& args) {
         return std::make_unique<OperationNode>(operation.name, args.name(), *target, parseParams(operation, args),
                                                [this] { refreshWorld(); });

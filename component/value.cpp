@@ -336,7 +336,8 @@ ParamMap paramsFromJson(const std::vector<ParamSpec>& specs, const nlohmann::jso
       throw std::invalid_argument("missing parameter '" + spec.name + "'");
     }
   }
-  for (const auto& [name, item] : json.items()) {
+  for (const auto& item : json.items()) {
+    const std::string& name = item.key();  // not a structured binding: clang 14 cannot capture one
     const bool known = std::any_of(specs.begin(), specs.end(), [&](const ParamSpec& s) { return s.name == name; });
     if (!known) {
       throw std::invalid_argument("unknown parameter '" + name + "'");
@@ -361,6 +362,12 @@ nlohmann::json toJson(const ParamSpec& spec) {
   }
   if (!spec.choices_from.empty()) {
     json["choices_from"] = spec.choices_from;
+  }
+  if (!spec.extra_choices.empty()) {
+    json["extra_choices"] = spec.extra_choices;
+  }
+  if (!spec.excludes.empty()) {
+    json["excludes"] = spec.excludes;
   }
   return json;
 }

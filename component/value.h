@@ -76,6 +76,12 @@ struct ParamSpec {
   /// For strings whose allowed values come from what the system knows at run time
   /// ("waypoint", "object_class", "predicate", "frame"): the editor offers that list.
   std::string choices_from;
+  /// Values offered besides the `choices_from` list (e.g. "table" for a place, which is not a
+  /// frame): the editor adds them to its list.
+  std::vector<std::string> extra_choices;
+  /// Parameters that cannot be given together with this one: the editor clears them when
+  /// this one is set (SmartRelease's target and target_class).
+  std::vector<std::string> excludes;
   /// Further checks of a written value (e.g. its syntax): empty when valid, else the problem.
   std::function<std::string(std::string_view)> validate;
 

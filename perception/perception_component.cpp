@@ -70,7 +70,9 @@ class DetectObjectsOperation final : public component::RunningOperation {
 
  private:
   void capture() {
-    frames_.push_back(component_.camera_.capture());
+    // The pipeline takes colour from the last frame only (the median filter's output).
+    const bool last = static_cast<int>(frames_.size()) + 1 >= wanted_;
+    frames_.push_back(last ? component_.camera_.capture() : component_.camera_.captureDepth());
     if (component_.config_.camera_pose) {
       frames_.back().camera_pose = component_.config_.camera_pose();
     }

@@ -1,12 +1,13 @@
 #include "perception/persistence.h"
 
 #include <boost/geometry.hpp>
+#include <boost/geometry/geometries/box.hpp>
 #include <boost/geometry/geometries/point.hpp>
 #include <boost/geometry/index/rtree.hpp>
 
 #include <algorithm>
 #include <map>
-#include <queue>
+#include <optional>
 #include <tuple>
 
 #include "perception/canonical_orientation.h"
@@ -20,6 +21,7 @@ namespace {
 
 using Point = bg::model::point<double, 3, bg::cs::cartesian>;
 using Entry = std::pair<Point, std::size_t>;  // position, index into the previous objects
+using Box = bg::model::box<Point>;
 using Tree = bgi::rtree<Entry, bgi::rstar<16>>;
 
 Point toPoint(const Eigen::Vector3d& p) { return Point(p.x(), p.y(), p.z()); }
@@ -29,6 +31,7 @@ Point toPoint(const Eigen::Vector3d& p) { return Point(p.x(), p.y(), p.z()); }
 /// One R*-tree per class (the "same type" test of Algorithm 1 is the choice of tree).
 struct PersistenceFilter::Index {
   std::map<std::string, Tree, std::less<>> trees;
+  std::vector<Entry> hits;  // a query's results, reused
 };
 
 PersistenceFilter::PersistenceFilter(std::vector<world::ObjectClass> classes, PersistenceOptions options)
@@ -46,50 +49,56 @@ void PersistenceFilter::clear() {
 const std::vector<TrackedObject>& PersistenceFilter::update(const std::vector<Detection>& detections) {
   const std::vector<TrackedObject> previous = std::move(objects_);
   objects_.clear();
-  const double max_squared = options_.max_distance * options_.max_distance;
+  objects_.reserve(detections.size() + previous.size());
+  const double max_distance = options_.max_distance;
+  const double max_squared = max_distance * max_distance;
 
-  // Nearest previous object of the detection's class still in its tree, within d_max.
-  const auto nearest = [&](std::size_t d) -> std::optional<std::pair<double, Entry>> {
-    const auto tree = index_->trees.find(detections[d].object_class);
-    if (tree == index_->trees.end() || tree->second.empty()) {
-      return std::nullopt;
+  // Every (detection, previous object of its class) pair within d_max, from one box query per
+  // detection in its class's tree.
+  struct Pair {
+    double squared;
+    std::uint32_t detection;
+    std::uint32_t previous;
+    bool operator<(const Pair& other) const {
+      return std::tie(squared, detection, previous) < std::tie(other.squared, other.detection, other.previous);
+    }
+  };
+  std::vector<Pair> pairs;
+  pairs.reserve(detections.size());
+  std::vector<Entry>& hits = index_->hits;
+  const Tree* tree = nullptr;
+  const std::string* tree_class = nullptr;
+  for (std::size_t d = 0; d < detections.size(); ++d) {
+    const std::string& object_class = detections[d].object_class;
+    if (tree_class == nullptr || *tree_class != object_class) {
+      const auto found = index_->trees.find(object_class);
+      tree = found == index_->trees.end() ? nullptr : &found->second;
+      tree_class = &object_class;
+    }
+    if (tree == nullptr || tree->empty()) {
+      continue;
     }
     const Point p = toPoint(detections[d].pose.translation());
-    for (auto it = tree->second.qbegin(bgi::nearest(p, 1)); it != tree->second.qend(); ++it) {
-      const double squared = bg::comparable_distance(p, it->first);
+    const Box around(Point(p.get<0>() - max_distance, p.get<1>() - max_distance, p.get<2>() - max_distance),
+                     Point(p.get<0>() + max_distance, p.get<1>() + max_distance, p.get<2>() + max_distance));
+    hits.clear();
+    tree->query(bgi::intersects(around), std::back_inserter(hits));
+    for (const Entry& hit : hits) {
+      const double squared = bg::comparable_distance(p, hit.first);
       if (squared <= max_squared) {
-        return std::make_pair(squared, *it);
+        pairs.push_back({squared, static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(hit.second)});
       }
-    }
-    return std::nullopt;
-  };
-
-  // Closest pairs first: a queue of (distance, detection, previous object).
-  using Candidate = std::tuple<double, std::size_t, std::size_t>;
-  std::priority_queue<Candidate, std::vector<Candidate>, std::greater<>> queue;
-  for (std::size_t d = 0; d < detections.size(); ++d) {
-    if (const auto found = nearest(d)) {
-      queue.emplace(found->first, d, found->second.second);
     }
   }
+  // Closest pairs first: a pair counts when neither side is matched yet.
+  std::sort(pairs.begin(), pairs.end());
   std::vector<std::optional<std::size_t>> match(detections.size());
   std::vector<bool> taken(previous.size(), false);
-  while (!queue.empty()) {
-    const auto [squared, d, p] = queue.top();
-    queue.pop();
-    if (match[d]) {
-      continue;
+  for (const Pair& pair : pairs) {
+    if (!match[pair.detection] && !taken[pair.previous]) {
+      match[pair.detection] = pair.previous;
+      taken[pair.previous] = true;
     }
-    if (taken[p]) {
-      // Its nearest went to a closer detection: look again among the rest.
-      if (const auto found = nearest(d)) {
-        queue.emplace(found->first, d, found->second.second);
-      }
-      continue;
-    }
-    match[d] = p;
-    taken[p] = true;
-    index_->trees[detections[d].object_class].remove(Entry(toPoint(previous[p].pose.translation()), p));
   }
 
   const auto find_class = [this](const std::string& name) -> const world::ObjectClass* {
@@ -139,8 +148,15 @@ const std::vector<TrackedObject>& PersistenceFilter::update(const std::vector<De
   }
   // The next update's trees, bulk-loaded (packing) per class.
   std::map<std::string, std::vector<Entry>, std::less<>> entries;
+  std::vector<Entry>* current = nullptr;
+  const std::string* current_class = nullptr;
   for (std::size_t i = 0; i < objects_.size(); ++i) {
-    entries[objects_[i].object_class].emplace_back(toPoint(objects_[i].pose.translation()), i);
+    const std::string& object_class = objects_[i].object_class;
+    if (current_class == nullptr || *current_class != object_class) {
+      current = &entries[object_class];
+      current_class = &object_class;
+    }
+    current->emplace_back(toPoint(objects_[i].pose.translation()), i);
   }
   index_->trees.clear();
   for (auto& [name, values] : entries) {

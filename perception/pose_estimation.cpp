@@ -683,22 +683,6 @@ std::vector<Detection> ClassPoseEstimator::estimateCluster(const Cloud& cloud, c
     local.recognition += seconds(start);
     ++local.runs;
     local.candidates += static_cast<int>(candidates.size());
-    if (std::getenv("PDEBUG_DUMP") && attempt == 1) {
-      static int dump_count = 0;
-      std::FILE* f = std::fopen(
-          ("/tmp/dump_" + model_.name() + std::to_string(task) + "_" + std::to_string(dump_count++) + ".txt").c_str(),
-          "w");
-      for (const int i : remaining) {
-        const Eigen::Vector3d p = frame.camera_pose * cloud.points[static_cast<std::size_t>(i)].cast<double>();
-        const Eigen::Vector3d n =
-            frame.camera_pose.linear() * cloud.normals[static_cast<std::size_t>(i)].cast<double>();
-        std::fprintf(f, "%f %f %f %f %f %f\n", p.x(), p.y(), p.z(), n.x(), n.y(), n.z());
-      }
-      std::fclose(f);
-    }
-    if (std::getenv("PDEBUG"))
-      std::fprintf(stderr, "%s task %u attempt %d: %zu points, %zu candidates, accepted so far %zu\n",
-                   model_.name().c_str(), task, attempt, remaining.size(), candidates.size(), accepted.size());
 
     // Verification. Candidates are ordered by a quick render-and-compare of their raw pose;
     // each is refined by a coarse ICP and checked again, and one that passes is refined and
@@ -739,22 +723,12 @@ std::vector<Detection> ClassPoseEstimator::estimateCluster(const Cloud& cloud, c
         coarse = refinePose(model_, coarse_points, candidate.pose, 8, 0.01, options_.icp_final_distance + 0.001);
         quick = compareWithDepth(model_, coarse.pose, frame, options_.depth_tolerance, 5);
         ok = passes(quick);
-        if (std::getenv("PDEBUG")) {
-          Eigen::Vector3d e = (frame.camera_pose * coarse.pose).translation();
-          std::fprintf(stderr, "   raw %.2f narrow -> (%.3f %.3f %.3f) agree %.2f vis %.2f\n", raw_score, e.x(), e.y(),
-                       e.z(), quick.agreement(), quick.visibleFraction());
-        }
       }
       if (!ok) {
         coarse = refinePose(model_, coarse_points, candidate.pose, 10, options_.icp_initial_distance,
                             options_.icp_coarse_final_distance, 0.2);
         quick = compareWithDepth(model_, coarse.pose, frame, options_.depth_tolerance, 5);
         ok = passes(quick);
-        if (std::getenv("PDEBUG")) {
-          Eigen::Vector3d e = (frame.camera_pose * coarse.pose).translation();
-          std::fprintf(stderr, "   raw %.2f narrow -> (%.3f %.3f %.3f) agree %.2f vis %.2f\n", raw_score, e.x(), e.y(),
-                       e.z(), quick.agreement(), quick.visibleFraction());
-        }
       }
       if (!ok || !aboveSupport(coarse.pose)) {
         continue;
@@ -782,11 +756,6 @@ std::vector<Detection> ClassPoseEstimator::estimateCluster(const Cloud& cloud, c
       detection.recognition_score = candidate.match;
       detection.fit_rms = refined.rms;
       detection.support = refined.inliers;
-      if (std::getenv("PDEBUG")) {
-        Eigen::Vector3d e = (frame.camera_pose * refined.pose).translation();
-        std::fprintf(stderr, "   fine -> (%.3f %.3f %.3f) conf %.3f vis %.2f support %d\n", e.x(), e.y(), e.z(),
-                     detection.confidence, detection.visible_fraction, detection.support);
-      }
       if (detection.confidence < options_.min_confidence ||
           detection.visible_fraction < options_.min_visible_fraction || !aboveSupport(refined.pose)) {
         continue;

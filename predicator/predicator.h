@@ -21,6 +21,7 @@
 
 #include "component/component.h"
 #include "predicator/geometry.h"
+#include "predicator/pattern.h"
 #include "world/object_class.h"
 #include "world/world_state.h"
 
@@ -33,12 +34,6 @@ struct PredicatorConfig {
   std::vector<std::string> references = {"table_center"};
   /// The frame whose axes say what left, front and up are.
   std::string viewpoint = "table_center";
-};
-
-/// One term of a query: predicate(args) with "?" for the symbol sought.
-struct Pattern {
-  std::string predicate;
-  std::vector<std::string> args;
 };
 
 enum class MatchMode { kAll, kAny };

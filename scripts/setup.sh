@@ -15,7 +15,7 @@ PACKAGES=(
   # test and benchmark frameworks
   libgtest-dev libgmock-dev libbenchmark-dev
   # libraries of the engine, the component model and the CLI
-  libtinyxml2-dev nlohmann-json3-dev libspdlog-dev libcli11-dev libeigen3-dev libboost-dev libpng-dev
+  libpugixml-dev nlohmann-json3-dev libspdlog-dev libcli11-dev libeigen3-dev libboost-dev libpng-dev
   # the simulated workcell: MuJoCo physics, headless rendering with Mesa's EGL
   libmujoco-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
   # arm kinematics from URDF (Orocos KDL), collision checking (FCL), motion planning (OMPL)

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Quick start 2: set up, build, and run every test: unit and end-to-end tests (CTest), the
-# plan-parser, API and end-to-end server fuzz targets in smoke mode (libFuzzer, clang, address + UB sanitizers),
-# and the editor's page (Vitest, then end to end in headless Chromium).
+# Quick start 2: set up, build, and run every test: unit and end-to-end tests (CTest), a subset
+# of them again under the address + UB sanitizers (SANITIZE=all: every test; SANITIZE=0: none),
+# the plan-parser, API and end-to-end server fuzz targets in smoke mode (libFuzzer, clang,
+# address + UB sanitizers), and the editor's page (Vitest, then end to end in headless Chromium).
 #   FUZZ_RUNS=20000 (default) sets the smoke run's length; FUZZ_RUNS=0 skips it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,6 +13,30 @@ BUILD_DIR="${COSTAR_BUILD_DIR:-build}"
 echo
 echo "test: CTest"
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$(nproc)" --timeout 600
+
+# AddressSanitizer + UndefinedBehaviorSanitizer (clang, -DCOSTAR_SANITIZE=ON, its own build
+# folder): the tests labelled "sanitize" (core, world, bt, component, gripper, planning, arm and
+# sim: the plan, scene and waypoint parsers, the simulation, rendering on two threads).
+# SANITIZE=all builds and runs every test so instead (docs/TESTING.md); SANITIZE=0 skips it.
+SANITIZE="${SANITIZE:-subset}"
+if [[ "$SANITIZE" != "0" ]]; then
+  echo
+  echo "test: under AddressSanitizer + UndefinedBehaviorSanitizer ($SANITIZE)"
+  sanitize_start=$(date +%s)
+  CC=clang CXX=clang++ cmake -S . -B "$BUILD_DIR-sanitize" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
+    -DCOSTAR_SANITIZE=ON -DCOSTAR_BUILD_BENCH=OFF \
+    -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache \
+    -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
+  if [[ "$SANITIZE" == "all" ]]; then
+    cmake --build "$BUILD_DIR-sanitize" -j "$(nproc)"
+    ctest --test-dir "$BUILD_DIR-sanitize" --output-on-failure -j "$(nproc)" --timeout 3600
+  else
+    cmake --build "$BUILD_DIR-sanitize" --target sanitize_tests -j "$(nproc)"
+    ctest --test-dir "$BUILD_DIR-sanitize" -L sanitize --output-on-failure -j "$(nproc)" --timeout 1800
+  fi
+  echo "test: sanitizers done in $(( $(date +%s) - sanitize_start )) s"
+fi
 
 FUZZ_RUNS="${FUZZ_RUNS:-20000}"
 if [[ "$FUZZ_RUNS" -gt 0 ]]; then
@@ -48,8 +73,9 @@ if [[ "$FUZZ_RUNS" -gt 0 ]]; then
 fi
 
 # The task editor's page (web/): Vitest unit tests, the production build, then the end-to-end
-# test in Debian's Chromium (headless, driven by playwright-core): the "pick up node" plan
-# built by clicks, saved, run in the simulated cell, judged from the simulator's true state.
+# test in Debian's Chromium (headless, driven by playwright-core): the paper's structure
+# assembly built by clicks and keys (at most 30 UI actions), saved, run in the simulated cell,
+# judged from the simulator's true state; screenshots at 1600x1000 and 1280x800.
 # EDITOR_E2E=0 skips the browser test.
 echo
 echo "test: the editor's page (npm ci, Vitest, vite build)"
@@ -66,7 +92,7 @@ if [[ "${EDITOR_E2E:-1}" != "0" ]]; then
   fi
   echo
   echo "test: the editor end to end in Chromium (artifacts in $BUILD_DIR/test-artifacts)"
-  node web/e2e/pick_up_node.mjs --costar "$BUILD_DIR/cli/costar" --artifacts "$BUILD_DIR/test-artifacts"
+  node web/e2e/assemble_by_clicks.mjs --costar "$BUILD_DIR/cli/costar" --artifacts "$BUILD_DIR/test-artifacts"
 fi
 echo
 echo "test: all passed in $(( $(date +%s) - start )) s"

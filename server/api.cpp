@@ -464,10 +464,10 @@ HttpResponse Api::route(const HttpRequest& request) {
       return status ? jsonResponse(*status) : errorResponse(404, "nothing has run yet");
     }
     const auto id = parseLong(s[2]);
-    if (!id || *id < 1) {
-      throw RequestError(400, "a run id is a positive integer");
+    if (!id || *id == 0) {
+      throw RequestError(400, "a run id is a nonzero integer (plan runs count up from 1, operations down from -1)");
     }
-    if (const auto log = store_.run(*id)) {
+    if (const auto log = *id > 0 ? store_.run(*id) : std::nullopt) {
       json out = runLogJson(*log);
       if (const auto status = backend_.runStatus(*id)) {
         out["live"] = *status;

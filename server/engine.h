@@ -120,6 +120,8 @@ class Engine final : public Backend {
   template <typename F>
   auto call(F task) -> decltype(task());
 
+  /// The palette (GET /api/nodes) and the workcell's info, built once (engine_lists.cpp).
+  void describeNodes();
   void loop();
   void runTasks();
   void hook(bool running);
@@ -174,6 +176,7 @@ class Engine final : public Backend {
   std::uint64_t drained_state_version_ = 0;
   EngineStats stats_;
   std::int64_t next_run_id_ = 1;
+  std::int64_t next_operation_id_ = -1;
   std::string last_error_;  // the last exception of the idle loop, shown by info()
 
   // The run log writer.

@@ -94,14 +94,16 @@ int runServe(const ServeOptions& options, std::ostream& out, std::ostream& err) 
   if (options.test_endpoints) {
     err << "warning: TEST ONLY endpoints are on (--test-endpoints): never use this on a robot\n";
   }
-  if (options.token_file.empty()) {
-    out << "  open the editor at " << server->url() << "#token=" << server->token() << "\n";
-  } else {
-    out << "  open the editor at " << server->url() << " (token in " << options.token_file.string() << ")\n";
+  // As notebook servers do: the address to open carries the token (in the fragment, which a
+  // browser never sends to the server), whether the token was made now or read from a file.
+  out << "  open the editor at " << server->url() << "#token=" << server->token() << "\n";
+  if (!options.token_file.empty()) {
+    out << "  token from " << options.token_file.string() << "\n";
   }
-  out << "listening on " << server->url() << "\n" << std::flush;
-  // From here on, a crash stops the arm before the process dies.
+  // From here on, a crash stops the arm before the process dies. Installed before the address
+  // is announced, so that whoever reads it (a person, a test) finds the handlers in place.
   const FatalStop fatal_stop(server->engine());
+  out << "listening on " << server->url() << "\n" << std::flush;
   int signal = 0;
   sigwait(&signals, &signal);
   out << "costar serve: stopping (signal " << signal << ")\n" << std::flush;

@@ -1,9 +1,11 @@
 #include "sim/depth_noise.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <thread>
 
 namespace costar::sim {
 
@@ -75,100 +77,190 @@ const NormalTable& normals() {
   return table;
 }
 
+struct Scratch {
+  std::vector<float> ray_x;
+  std::vector<float> ray_y;
+  std::vector<std::uint8_t> surface;
+  std::vector<float> incidence;
+  std::vector<std::uint32_t> reading_rows;
+  std::vector<std::uint64_t> draws;
+};
+
 int roundToInt(double x) { return static_cast<int>(std::floor(x + 0.5)); }
+
+/// Runs `rows(v_begin, v_end)` over [0, height) on `threads` threads (the calling one included).
+template <typename Rows>
+void parallelRows(int height, int threads, const Rows& rows) {
+  if (threads <= 1 || height < 2) {
+    rows(0, height);
+    return;
+  }
+  std::vector<std::thread> helpers;
+  for (int t = 1; t < threads; ++t) {
+    helpers.emplace_back(rows, height * t / threads, height * (t + 1) / threads);
+  }
+  rows(0, height / threads);
+  for (auto& helper : helpers) {
+    helper.join();
+  }
+}
 
 }  // namespace
 
+// Three passes, so that the expensive ones run on several threads while the noise stays a
+// function of the seed alone: (1) per pixel, whether it gets a reading and its incidence angle
+// (parallel); (2) the random bits, drawn in pixel order for the pixels that read (serial, cheap);
+// (3) the jittered, noisy, quantized reading (parallel). The result is the same for any number
+// of threads, and the same as drawing while scanning the image once.
 void noisyPointCloud(const std::vector<float>& depth, const camera::Intrinsics& in, const DepthNoiseOptions& o,
-                     std::uint64_t seed, std::vector<Eigen::Vector3f>& points) {
+                     std::uint64_t seed, std::vector<Eigen::Vector3f>& points, int threads) {
   const int w = in.width;
   const int h = in.height;
+  const std::size_t pixels = static_cast<std::size_t>(w) * h;
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  points.assign(static_cast<std::size_t>(w) * h, Eigen::Vector3f(nan, nan, nan));
+  points.resize(pixels);  // every pixel is written below
+  threads = std::clamp(threads, 1, 8);
 
+  // Scratch kept per calling thread: a camera's frames come one after another, and fresh
+  // megabytes for each would be cleared and page-faulted in again every frame.
+  thread_local Scratch scratch;
   // Rays through each pixel (z = 1): a point is depth * ray.
-  std::vector<float> ray_x(static_cast<std::size_t>(w));
-  std::vector<float> ray_y(static_cast<std::size_t>(h));
+  std::vector<float>& ray_x = scratch.ray_x;
+  std::vector<float>& ray_y = scratch.ray_y;
+  ray_x.resize(static_cast<std::size_t>(w));
+  ray_y.resize(static_cast<std::size_t>(h));
   for (int u = 0; u < w; ++u) {
     ray_x[u] = static_cast<float>((u - in.cx) / in.fx);
   }
   for (int v = 0; v < h; ++v) {
     ray_y[v] = static_cast<float>((v - in.cy) / in.fy);
   }
-  const auto at = [&](int u, int v) { return depth[static_cast<std::size_t>(v) * w + u]; };
+  const float* const z_at = depth.data();
+  // 1 where the clean image has a surface.
+  std::vector<std::uint8_t>& surface = scratch.surface;
+  surface.resize(pixels);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    const float z = z_at[i];
+    surface[i] = z > 0.0f && std::isfinite(z) ? 1 : 0;
+  }
+  const std::uint8_t* const ok = surface.data();
   const auto valid = [&](int u, int v) {
-    if (u < 0 || v < 0 || u >= w || v >= h) {
-      return false;
-    }
-    const float z = at(u, v);
-    return z > 0.0f && std::isfinite(z);
+    return static_cast<unsigned>(u) < static_cast<unsigned>(w) && static_cast<unsigned>(v) < static_cast<unsigned>(h) &&
+           ok[static_cast<std::size_t>(v) * w + u] != 0;
   };
   const auto point = [&](int u, int v) {
-    const float z = at(u, v);
+    const float z = z_at[static_cast<std::size_t>(v) * w + u];
     return Eigen::Vector3f(ray_x[u] * z, ray_y[v] * z, z);
   };
 
-  FastRandom random(seed);
-  const NormalTable& normal = normals();
-  const float cos_max = static_cast<float>(std::cos(o.max_incidence_deg * M_PI / 180.0));
-  const double focal_baseline = in.fx * o.baseline;
+  if (!o.enabled) {
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        points[static_cast<std::size_t>(v) * w + u] = valid(u, v) ? point(u, v) : Eigen::Vector3f(nan, nan, nan);
+      }
+    }
+    return;
+  }
 
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      if (!valid(u, v)) {
-        continue;
-      }
-      const float z_clean = at(u, v);
-      Eigen::Vector3f& out = points[static_cast<std::size_t>(v) * w + u];
-      if (!o.enabled) {
-        out = point(u, v);
-        continue;
-      }
-      if (z_clean < o.min_range || z_clean > o.max_range) {
-        continue;
-      }
-      // Surface normal from the neighbours (central differences where possible); the
-      // incidence angle between it and the viewing ray.
-      const int u0 = valid(u - 1, v) ? u - 1 : u;
-      const int u1 = valid(u + 1, v) ? u + 1 : u;
-      const int v0 = valid(u, v - 1) ? v - 1 : v;
-      const int v1 = valid(u, v + 1) ? v + 1 : v;
-      double theta = 0.0;
-      if (u0 != u1 && v0 != v1) {
-        const Eigen::Vector3f normal = (point(u1, v) - point(u0, v)).cross(point(u, v1) - point(u, v0));
-        const Eigen::Vector3f ray(ray_x[u], ray_y[v], 1.0f);
-        const float scale = normal.norm() * ray.norm();
-        if (scale > 0.0f) {
-          const float cosine = std::min(1.0f, std::abs(normal.dot(ray)) / scale);
-          if (cosine < cos_max) {
-            continue;  // grazing: the projected pattern is not seen
-          }
-          theta = std::acos(cosine);
-        }
-      }
-      // Lateral noise: the reading comes from a jittered pixel.
-      const std::uint64_t bits = random.next();  // 16 bits for each of the three normals
-      const double sigma_l = lateralSigma(o, theta);
-      const int su = roundToInt(u + sigma_l * normal[bits]);
-      const int sv = roundToInt(v + sigma_l * normal[bits >> 16]);
-      if (!valid(su, sv)) {
-        continue;  // the jitter fell off the surface: no reading
-      }
-      double z = at(su, sv);
-      z += axialSigma(o, z, theta) * normal[bits >> 32];
-      if (o.quantize_disparity && z > 0) {
-        const double disparity = std::round(focal_baseline / z / o.disparity_step) * o.disparity_step;
-        if (disparity <= 0) {
+  // Pass 1: the incidence angle of each pixel that reads (NaN: no reading), and how many read
+  // in each row.
+  const float cos_max = static_cast<float>(std::cos(o.max_incidence_deg * M_PI / 180.0));
+  std::vector<float>& incidence = scratch.incidence;
+  incidence.resize(pixels);
+  std::vector<std::uint32_t>& reading_rows = scratch.reading_rows;
+  reading_rows.assign(static_cast<std::size_t>(h) + 1, 0);
+  parallelRows(h, threads, [&](int v_begin, int v_end) {
+    for (int v = v_begin; v < v_end; ++v) {
+      std::uint32_t reading = 0;
+      for (int u = 0; u < w; ++u) {
+        const std::size_t i = static_cast<std::size_t>(v) * w + u;
+        float& theta_out = incidence[i];
+        theta_out = nan;
+        if (ok[i] == 0) {
           continue;
         }
-        z = focal_baseline / disparity;
+        const float z_clean = z_at[i];
+        if (z_clean < o.min_range || z_clean > o.max_range) {
+          continue;
+        }
+        // Surface normal from the neighbours (central differences where possible); the
+        // incidence angle between it and the viewing ray.
+        const int u0 = valid(u - 1, v) ? u - 1 : u;
+        const int u1 = valid(u + 1, v) ? u + 1 : u;
+        const int v0 = valid(u, v - 1) ? v - 1 : v;
+        const int v1 = valid(u, v + 1) ? v + 1 : v;
+        float theta = 0.0f;
+        if (u0 != u1 && v0 != v1) {
+          const Eigen::Vector3f normal = (point(u1, v) - point(u0, v)).cross(point(u, v1) - point(u, v0));
+          const Eigen::Vector3f ray(ray_x[u], ray_y[v], 1.0f);
+          const float scale = normal.norm() * ray.norm();
+          if (scale > 0.0f) {
+            const float cosine = std::min(1.0f, std::abs(normal.dot(ray)) / scale);
+            if (cosine < cos_max) {
+              continue;  // grazing: the projected pattern is not seen
+            }
+            theta = std::acos(cosine);
+          }
+        }
+        theta_out = theta;
+        ++reading;
       }
-      if (z < o.min_range || z > o.max_range) {
-        continue;
-      }
-      out = Eigen::Vector3f(static_cast<float>(ray_x[u] * z), static_cast<float>(ray_y[v] * z), static_cast<float>(z));
+      reading_rows[static_cast<std::size_t>(v) + 1] = reading;
     }
+  });
+
+  // Pass 2: one 64-bit draw per reading pixel, in pixel order (16 bits for each of three
+  // normals).
+  for (int v = 0; v < h; ++v) {
+    reading_rows[static_cast<std::size_t>(v) + 1] += reading_rows[static_cast<std::size_t>(v)];
   }
+  std::vector<std::uint64_t>& draws = scratch.draws;
+  draws.resize(reading_rows.back());
+  FastRandom random(seed);
+  for (auto& bits : draws) {
+    bits = random.next();
+  }
+
+  // Pass 3: lateral jitter, axial noise, disparity quantization.
+  const NormalTable& normal = normals();
+  const double focal_baseline = in.fx * o.baseline;
+  parallelRows(h, threads, [&](int v_begin, int v_end) {
+    for (int v = v_begin; v < v_end; ++v) {
+      std::size_t next_draw = reading_rows[static_cast<std::size_t>(v)];
+      for (int u = 0; u < w; ++u) {
+        const std::size_t i = static_cast<std::size_t>(v) * w + u;
+        Eigen::Vector3f& out = points[i];
+        out = Eigen::Vector3f(nan, nan, nan);
+        const float theta_f = incidence[i];
+        if (std::isnan(theta_f)) {
+          continue;
+        }
+        const double theta = theta_f;
+        // Lateral noise: the reading comes from a jittered pixel.
+        const std::uint64_t bits = draws[next_draw++];
+        const double sigma_l = lateralSigma(o, theta);
+        const int su = roundToInt(u + sigma_l * normal[bits]);
+        const int sv = roundToInt(v + sigma_l * normal[bits >> 16]);
+        if (!valid(su, sv)) {
+          continue;  // the jitter fell off the surface: no reading
+        }
+        double z = z_at[static_cast<std::size_t>(sv) * w + su];
+        z += axialSigma(o, z, theta) * normal[bits >> 32];
+        if (o.quantize_disparity && z > 0) {
+          const double disparity = std::round(focal_baseline / z / o.disparity_step) * o.disparity_step;
+          if (disparity <= 0) {
+            continue;
+          }
+          z = focal_baseline / disparity;
+        }
+        if (z < o.min_range || z > o.max_range) {
+          continue;
+        }
+        out =
+            Eigen::Vector3f(static_cast<float>(ray_x[u] * z), static_cast<float>(ray_y[v] * z), static_cast<float>(z));
+      }
+    }
+  });
 }
 
 }  // namespace costar::sim

@@ -36,9 +36,11 @@ struct DepthNoiseOptions {
 
 /// Converts a clean metric depth image (row-major; 0 or NaN where there is no surface) into
 /// the organized point cloud the sensor would report, in the optical frame, with the noise
-/// above drawn from a generator seeded with `seed` (same seed, same output).
+/// above drawn from a generator seeded with `seed` (same seed, same output). Runs on up to
+/// `threads` threads; the output does not depend on how many.
 void noisyPointCloud(const std::vector<float>& clean_depth, const camera::Intrinsics& intrinsics,
-                     const DepthNoiseOptions& options, std::uint64_t seed, std::vector<Eigen::Vector3f>& points);
+                     const DepthNoiseOptions& options, std::uint64_t seed, std::vector<Eigen::Vector3f>& points,
+                     int threads = 1);
 
 /// sigma_z of the model at depth z (m) and incidence angle theta (rad).
 double axialSigma(const DepthNoiseOptions& options, double z, double theta);

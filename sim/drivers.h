@@ -18,6 +18,7 @@ class SimRgbdCamera final : public camera::RgbdCamera {
   const camera::Intrinsics& intrinsics() const override { return simulation_.rgbdIntrinsics(); }
   Duration framePeriod() const override { return std::chrono::nanoseconds(33'333'333); }
   camera::RgbdFrame capture() override { return simulation_.captureRgbd(next_seed_++); }
+  camera::RgbdFrame captureDepth() override { return simulation_.captureRgbd(next_seed_++, false); }
 
  private:
   Simulation& simulation_;
@@ -32,7 +33,9 @@ class SimGripperDriver final : public gripper::GripperDriver {
     const FingerState state = simulation_.fingers();
     return {state.opening, state.opening_speed, state.force, state.pads_in_contact};
   }
-  void command(double opening, double speed, double force) override { simulation_.commandFingers(opening, speed, force); }
+  void command(double opening, double speed, double force) override {
+    simulation_.commandFingers(opening, speed, force);
+  }
   double maxOpening() const override { return Simulation::kMaxOpening; }
 
  private:

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -19,54 +20,121 @@ std::string eglError(const char* what) {
   }() + "); is Mesa's EGL (libegl-mesa0, libgl1-mesa-dri) installed?";
 }
 
+/// The process's one EGL display (EGL gives every caller the same one for a platform) and the
+/// number of renderers using it. Made on first use and never destroyed, so that a renderer
+/// destroyed during static destruction at exit still finds the lock.
+struct SharedDisplay {
+  /// Held while a renderer is created or destroyed: the display's initialization and
+  /// termination, and MuJoCo's loading of GL functions into its globals (mjr_makeContext).
+  std::mutex mutex;
+  int users = 0;
+  EGLDisplay display = EGL_NO_DISPLAY;
+  EGLConfig config = nullptr;
+};
+
+SharedDisplay& sharedDisplay() {
+  static auto* shared = new SharedDisplay;  // never destroyed, see above
+  return *shared;
+}
+
+/// One more user of the display: initializes it for the first. The caller holds the mutex.
+void acquireDisplay(SharedDisplay& shared) {
+  if (shared.users == 0) {
+    // Mesa's surfaceless platform: no display server, no GPU needed.
+    const auto get_platform_display =
+        reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    if (get_platform_display == nullptr) {
+      throw std::runtime_error("headless rendering: eglGetPlatformDisplayEXT is not available");
+    }
+    const EGLDisplay display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    EGLint major = 0;
+    EGLint minor = 0;
+    if (display == EGL_NO_DISPLAY || eglInitialize(display, &major, &minor) != EGL_TRUE) {
+      throw std::runtime_error(eglError("eglInitialize"));
+    }
+    const EGLint config_attributes[] = {EGL_RED_SIZE,
+                                        8,
+                                        EGL_GREEN_SIZE,
+                                        8,
+                                        EGL_BLUE_SIZE,
+                                        8,
+                                        EGL_ALPHA_SIZE,
+                                        8,
+                                        EGL_DEPTH_SIZE,
+                                        24,
+                                        EGL_STENCIL_SIZE,
+                                        8,
+                                        EGL_COLOR_BUFFER_TYPE,
+                                        EGL_RGB_BUFFER,
+                                        EGL_SURFACE_TYPE,
+                                        EGL_PBUFFER_BIT,
+                                        EGL_RENDERABLE_TYPE,
+                                        EGL_OPENGL_BIT,
+                                        EGL_NONE};
+    EGLConfig config = nullptr;
+    EGLint count = 0;
+    if (eglChooseConfig(display, config_attributes, &config, 1, &count) != EGL_TRUE || count < 1) {
+      const std::string error = eglError("eglChooseConfig");
+      eglTerminate(display);
+      throw std::runtime_error(error);
+    }
+    shared.display = display;
+    shared.config = config;
+  }
+  ++shared.users;
+}
+
+/// One user fewer: the last terminates the display (no context is left on it then). The
+/// caller holds the mutex.
+void releaseDisplay(SharedDisplay& shared) {
+  if (--shared.users == 0) {
+    eglTerminate(shared.display);
+    shared.display = EGL_NO_DISPLAY;
+    shared.config = nullptr;
+  }
+}
+
 }  // namespace
 
-GlRenderer::GlRenderer(const mjModel* model) {
-  // Mesa's surfaceless platform: no display server, no GPU needed.
-  const auto get_platform_display =
-      reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-  if (get_platform_display == nullptr) {
-    throw std::runtime_error("headless rendering: eglGetPlatformDisplayEXT is not available");
+/// Makes a renderer's context current on this thread for a scope, then gives the thread back
+/// what it had (normally no context), so that the context is current nowhere between scopes.
+class GlRenderer::Current {
+ public:
+  Current(EGLDisplay display, EGLContext context)
+      : display_(display),
+        api_(eglQueryAPI()),
+        previous_display_(eglGetCurrentDisplay()),
+        previous_context_(eglGetCurrentContext()),
+        previous_draw_(eglGetCurrentSurface(EGL_DRAW)),
+        previous_read_(eglGetCurrentSurface(EGL_READ)) {
+    eglBindAPI(EGL_OPENGL_API);  // the bound API is per thread
+    if (eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context) != EGL_TRUE) {
+      const std::string error = eglError("eglMakeCurrent");
+      eglBindAPI(api_);
+      throw std::runtime_error(error);
+    }
   }
-  display_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-  EGLint major = 0;
-  EGLint minor = 0;
-  if (display_ == EGL_NO_DISPLAY || eglInitialize(display_, &major, &minor) != EGL_TRUE) {
-    throw std::runtime_error(eglError("eglInitialize"));
+  ~Current() {
+    if (previous_context_ != EGL_NO_CONTEXT) {
+      eglMakeCurrent(previous_display_, previous_draw_, previous_read_, previous_context_);
+    } else {
+      eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    }
+    eglBindAPI(api_);
   }
-  const EGLint config_attributes[] = {EGL_RED_SIZE,
-                                      8,
-                                      EGL_GREEN_SIZE,
-                                      8,
-                                      EGL_BLUE_SIZE,
-                                      8,
-                                      EGL_ALPHA_SIZE,
-                                      8,
-                                      EGL_DEPTH_SIZE,
-                                      24,
-                                      EGL_STENCIL_SIZE,
-                                      8,
-                                      EGL_COLOR_BUFFER_TYPE,
-                                      EGL_RGB_BUFFER,
-                                      EGL_SURFACE_TYPE,
-                                      EGL_PBUFFER_BIT,
-                                      EGL_RENDERABLE_TYPE,
-                                      EGL_OPENGL_BIT,
-                                      EGL_NONE};
-  EGLConfig config;
-  EGLint count = 0;
-  if (eglChooseConfig(display_, config_attributes, &config, 1, &count) != EGL_TRUE || count < 1) {
-    eglTerminate(display_);
-    throw std::runtime_error(eglError("eglChooseConfig"));
-  }
-  eglBindAPI(EGL_OPENGL_API);
-  context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, nullptr);
-  if (context_ == EGL_NO_CONTEXT) {
-    eglTerminate(display_);
-    throw std::runtime_error(eglError("eglCreateContext"));
-  }
-  makeCurrent();
+  Current(const Current&) = delete;
+  Current& operator=(const Current&) = delete;
 
+ private:
+  EGLDisplay display_;
+  EGLenum api_;
+  EGLDisplay previous_display_;
+  EGLContext previous_context_;
+  EGLSurface previous_draw_;
+  EGLSurface previous_read_;
+};
+
+GlRenderer::GlRenderer(const mjModel* model) {
   mjv_defaultScene(&scene_);
   mjv_defaultOption(&option_);
   mjv_defaultPerturb(&perturb_);
@@ -74,54 +142,103 @@ GlRenderer::GlRenderer(const mjModel* model) {
   for (int group = 0; group < mjNGROUP; ++group) {
     option_.sitegroup[group] = 0;  // sites are markers for people, not surfaces a camera sees
   }
-  mjv_makeScene(model, &scene_, 4000);
-  mjr_makeContext(model, &render_context_, mjFONTSCALE_100);
-  mjr_setBuffer(mjFB_OFFSCREEN, &render_context_);
-  if (render_context_.currentBuffer != mjFB_OFFSCREEN) {
-    throw std::runtime_error("headless rendering: MuJoCo's offscreen buffer is not supported");
+  SharedDisplay& shared = sharedDisplay();
+  const std::lock_guard lock(shared.mutex);
+  acquireDisplay(shared);
+  display_ = shared.display;
+  try {
+    eglBindAPI(EGL_OPENGL_API);
+    context_ = eglCreateContext(display_, shared.config, EGL_NO_CONTEXT, nullptr);
+    if (context_ == EGL_NO_CONTEXT) {
+      throw std::runtime_error(eglError("eglCreateContext"));
+    }
+    const Current current(display_, context_);
+    mjv_makeScene(model, &scene_, 4000);
+    mjr_makeContext(model, &render_context_, mjFONTSCALE_100);
+    mujoco_context_ = true;
+    mjr_setBuffer(mjFB_OFFSCREEN, &render_context_);
+    if (render_context_.currentBuffer != mjFB_OFFSCREEN) {
+      throw std::runtime_error("headless rendering: MuJoCo's offscreen buffer is not supported");
+    }
+  } catch (...) {
+    if (context_ != EGL_NO_CONTEXT) {
+      if (mujoco_context_) {
+        try {
+          const Current current(display_, context_);
+          mjr_freeContext(&render_context_);
+        } catch (const std::exception&) {
+          // Not current: its GL objects go with the context.
+        }
+      }
+      eglDestroyContext(display_, context_);
+    }
+    mjv_freeScene(&scene_);
+    releaseDisplay(shared);
+    throw;
   }
 }
 
 GlRenderer::~GlRenderer() {
-  makeCurrent();
-  mjr_freeContext(&render_context_);
-  mjv_freeScene(&scene_);
-  eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-  eglDestroyContext(display_, context_);
-  eglTerminate(display_);
-}
-
-void GlRenderer::makeCurrent() {
-  if (eglGetCurrentContext() != context_ &&
-      eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_) != EGL_TRUE) {
-    throw std::runtime_error(eglError("eglMakeCurrent"));
+  SharedDisplay& shared = sharedDisplay();
+  const std::lock_guard lock(shared.mutex);
+  try {
+    const Current current(display_, context_);
+    mjr_freeContext(&render_context_);
+  } catch (const std::exception& e) {
+    // Only when the context is current on another thread, which this class never leaves it:
+    // its GL objects go with the context.
+    std::fprintf(stderr, "warning: %s (while freeing a renderer)\n", e.what());
   }
+  mjv_freeScene(&scene_);
+  eglDestroyContext(display_, context_);
+  releaseDisplay(shared);
 }
 
-void GlRenderer::render(const mjModel* model, mjData* data, int camera_id, int width, int height, RgbImage& rgb,
+int GlRenderer::liveCount() {
+  SharedDisplay& shared = sharedDisplay();
+  const std::lock_guard lock(shared.mutex);
+  return shared.users;
+}
+
+void GlRenderer::render(const mjModel* model, mjData* data, int camera_id, int width, int height, RgbImage* rgb,
                         std::vector<float>* depth) {
   if (width > render_context_.offWidth || height > render_context_.offHeight || width <= 0 || height <= 0) {
     throw std::runtime_error("cannot render " + std::to_string(width) + "x" + std::to_string(height) +
                              ": the largest image is " + std::to_string(render_context_.offWidth) + "x" +
                              std::to_string(render_context_.offHeight));
   }
-  makeCurrent();
+  const Current current(display_, context_);
   mjvCamera camera;
   mjv_defaultCamera(&camera);
   camera.type = mjCAMERA_FIXED;
   camera.fixedcamid = camera_id;
   mjv_updateScene(model, data, &option_, &perturb_, &camera, mjCAT_ALL, &scene_);
+  // Depth alone: the same surfaces drawn flat, without what only colour needs (shadow maps are
+  // a second render of the scene from the light, reflections a third; the skybox, lighting
+  // and textures). Depth is the same either way.
+  const bool colour = rgb != nullptr;
+  scene_.flags[mjRND_SHADOW] = colour ? 1 : 0;
+  scene_.flags[mjRND_REFLECTION] = colour ? 1 : 0;
+  scene_.flags[mjRND_SKYBOX] = colour ? 1 : 0;
+  scene_.flags[mjRND_SEGMENT] = colour ? 0 : 1;
   const mjrRect viewport{0, 0, width, height};
   mjr_render(viewport, &scene_, &render_context_);
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
-  rgb_buffer_.resize(pixels * 3);
-  depth_buffer_.resize(pixels);
-  mjr_readPixels(rgb_buffer_.data(), depth != nullptr ? depth_buffer_.data() : nullptr, viewport, &render_context_);
+  if (colour) {
+    rgb_buffer_.resize(pixels * 3);
+  }
+  if (depth != nullptr) {
+    depth_buffer_.resize(pixels);
+  }
+  mjr_readPixels(colour ? rgb_buffer_.data() : nullptr, depth != nullptr ? depth_buffer_.data() : nullptr, viewport,
+                 &render_context_);
 
   // OpenGL's rows go bottom-up; images go top-down.
-  rgb = RgbImage(width, height);
-  for (int y = 0; y < height; ++y) {
-    std::copy_n(&rgb_buffer_[static_cast<std::size_t>(height - 1 - y) * width * 3], width * 3, rgb.at(0, y));
+  if (colour) {
+    *rgb = RgbImage(width, height);
+    for (int y = 0; y < height; ++y) {
+      std::copy_n(&rgb_buffer_[static_cast<std::size_t>(height - 1 - y) * width * 3], width * 3, rgb->at(0, y));
+    }
   }
   if (depth != nullptr) {
     // Depth buffer value d -> distance along the optical axis.
@@ -131,10 +248,10 @@ void GlRenderer::render(const mjModel* model, mjData* data, int camera_id, int w
     depth->resize(pixels);
     for (int y = 0; y < height; ++y) {
       const float* row = &depth_buffer_[static_cast<std::size_t>(height - 1 - y) * width];
+      float* out = depth->data() + static_cast<std::size_t>(y) * width;
       for (int x = 0; x < width; ++x) {
         const double d = row[x];
-        (*depth)[static_cast<std::size_t>(y) * width + x] =
-            d >= 1.0 ? 0.0f : static_cast<float>(near / (1.0 - d * (1.0 - near / far)));
+        out[x] = d >= 1.0 ? 0.0f : static_cast<float>(near / (1.0 - d * (1.0 - near / far)));
       }
     }
   }

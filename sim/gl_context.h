@@ -1,6 +1,18 @@
 #pragma once
 // Headless OpenGL rendering of a MuJoCo model (internal to sim/): an EGL context on Mesa's
 // surfaceless platform and MuJoCo's offscreen buffer.
+//
+// Ownership and threads (issue 10: a crash in libEGL_mesa with `trials -j 2`, and "terminate
+// ... eglMakeCurrent failed" when `costar serve` stopped):
+// - The EGL display is one per process (EGL hands every caller the same one). Every renderer
+//   holds a reference to it; it is initialized with the first and terminated with the last,
+//   under one lock, so no renderer ever sees it terminated.
+// - A renderer's context is current on the calling thread only inside render() (and while it
+//   is created and destroyed): at any other time it is current on no thread. A renderer may
+//   therefore be created, used and destroyed on different threads, one thread at a time; two
+//   renderers render on two threads at once.
+// - Teardown order: MuJoCo's GL objects, then the context, then (with the last renderer) the
+//   display. The destructor never throws.
 
 #include <EGL/egl.h>
 #include <mujoco/mujoco.h>
@@ -21,16 +33,22 @@ class GlRenderer {
   GlRenderer& operator=(const GlRenderer&) = delete;
 
   /// Renders camera `camera_id` at width x height (at most the model's offscreen size).
-  /// `depth`, if given, receives metric depth along the optical axis, row-major, top row
-  /// first. The image rows are top first too.
-  void render(const mjModel* model, mjData* data, int camera_id, int width, int height, RgbImage& rgb,
+  /// `rgb`, if given, receives the colour image; `depth`, if given, metric depth along the
+  /// optical axis, row-major, top row first. The image rows are top first too. Without `rgb`
+  /// only depth is rendered (flat, no shadows: faster, the same depth). Not for two threads at
+  /// once on one renderer.
+  void render(const mjModel* model, mjData* data, int camera_id, int width, int height, RgbImage* rgb,
               std::vector<float>* depth);
 
+  /// Renderers alive in this process (tests: the display is terminated when it is 0).
+  static int liveCount();
+
  private:
-  void makeCurrent();
+  class Current;  // makes the context current on this thread for a scope
 
   EGLDisplay display_ = EGL_NO_DISPLAY;
   EGLContext context_ = EGL_NO_CONTEXT;
+  bool mujoco_context_ = false;
   mjvScene scene_;
   mjvOption option_;
   mjvPerturb perturb_;

@@ -7,6 +7,11 @@
 //              {"class": "node", "count": 2, "region": "right"},
 //              {"class": "link", "region": "right"}]}
 // "at" is x, y (m, world frame: the robot's base, table top z = 0) and yaw (degrees).
+// Optional: "min_gap" (m, 0 to 0.5, default 0.02) between randomly placed parts. Custom
+// regions add to (or replace) the default ones. A field the format does not know, a value of
+// the wrong type or out of range (a count of 4294967297, a negative min_gap, a region or an
+// "at" off the table) is an error naming the file and the field, e.g.
+//   scene 'my.json': parts[1].count: must be a whole number from 1 to 100, not 0
 
 #include <cstdint>
 #include <filesystem>
@@ -70,11 +75,15 @@ struct Scene {
   std::optional<CameraOffset> camera_offset;
 };
 
+/// The table top (x, y in m), as sim/models/ur5_workcell.xml has it; regions and fixed
+/// placements must lie on it.
+Region tableTop();
+
 /// The regions every scene knows: "table" (the reachable part of the table), "right" and
 /// "left" halves (y < 0 and y > 0, the robot's right and left).
 std::map<std::string, Region> defaultRegions();
 
-/// Reads a scene file. @throws std::runtime_error naming the file and the problem.
+/// Reads a scene file. @throws std::runtime_error naming the file, the field and the problem.
 Scene loadScene(const std::filesystem::path& file);
 Scene parseScene(const std::string& json_text, const std::string& label);
 
@@ -87,7 +96,8 @@ struct PartPlacement {
 };
 
 /// Places every requested part resting on the table: fixed ones where asked, random ones
-/// uniformly in their region with a uniform yaw, keeping `min_gap` between footprints.
+/// uniformly in their region with a uniform yaw, keeping `min_gap` between footprints (each
+/// part's bounding rectangle turned by its yaw, so long parts can lie side by side).
 /// Deterministic for a given `seed` (the scene's seed unless overridden).
 /// @throws std::runtime_error for an unknown class, colour or region, or when the parts do
 /// not fit.

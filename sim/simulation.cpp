@@ -26,6 +26,9 @@ constexpr double kArmOmega = 50.0;
 constexpr double kArmKp = kArmOmega * kArmOmega;
 constexpr double kArmKd = 2.0 * kArmOmega;
 
+// Threads that turn a depth image into a noisy cloud (the noise does not depend on it).
+constexpr int kNoiseThreads = 2;
+
 std::string readText(const std::filesystem::path& file) {
   std::ifstream stream(file);
   if (!stream) {
@@ -119,6 +122,7 @@ struct Simulation::Impl {
   camera::Intrinsics intrinsics = camera::Intrinsics::fromHorizontalFov(640, 480, 58.0 * M_PI / 180.0);
   DepthNoiseOptions noise;
   std::unique_ptr<GlRenderer> renderer;
+  std::vector<float> clean_depth;  // the camera's last depth image, before noise
 
   SimClock* clock = nullptr;
   int listener = 0;
@@ -238,6 +242,11 @@ struct Simulation::Impl {
     mj_step1(model, data);
     control();
     mj_step2(model, data);
+    if (data->warning[mjWARN_CONTACTFULL].number > 0 || data->warning[mjWARN_CNSTRFULL].number > 0) {
+      // MuJoCo would carry on without the contacts that did not fit: wrong physics.
+      throw std::runtime_error("physics: more contacts or constraint rows than the workcell model's <size nconmax=" +
+                               std::to_string(model->nconmax) + " njmax=" + std::to_string(model->njmax) + "> allows");
+    }
     countTableContacts();
     ++steps;
   }
@@ -471,7 +480,7 @@ world::Pose Simulation::gripperMarkerInFlange() const {
   return impl_->bodyPose(impl_->tool_body).inverse() * gripperMarkerPose();
 }
 
-camera::RgbdFrame Simulation::captureRgbd(std::uint64_t noise_seed) {
+camera::RgbdFrame Simulation::captureRgbd(std::uint64_t noise_seed, bool colour) {
   if (!impl_->renderer) {
     impl_->renderer = std::make_unique<GlRenderer>(impl_->model);
   }
@@ -480,9 +489,9 @@ camera::RgbdFrame Simulation::captureRgbd(std::uint64_t noise_seed) {
   frame.intrinsics = in;
   frame.stamp = time();
   frame.camera_pose = rgbdPose();
-  std::vector<float> depth;
-  impl_->renderer->render(impl_->model, impl_->data, impl_->rgbd_camera, in.width, in.height, frame.rgb, &depth);
-  noisyPointCloud(depth, in, impl_->noise, noise_seed, frame.points);
+  impl_->renderer->render(impl_->model, impl_->data, impl_->rgbd_camera, in.width, in.height,
+                          colour ? &frame.rgb : nullptr, &impl_->clean_depth);
+  noisyPointCloud(impl_->clean_depth, in, impl_->noise, noise_seed, frame.points, kNoiseThreads);
   return frame;
 }
 
@@ -492,7 +501,7 @@ RgbImage Simulation::renderImage(const std::string& camera, int width, int heigh
   }
   const int id = impl_->id(mjOBJ_CAMERA, camera.c_str());
   RgbImage image;
-  impl_->renderer->render(impl_->model, impl_->data, id, width, height, image, nullptr);
+  impl_->renderer->render(impl_->model, impl_->data, id, width, height, &image, nullptr);
   return image;
 }
 

@@ -7,6 +7,11 @@
 // with computed-torque control within the UR5's torque limits; the gripper's fingers close by
 // a force-limited servo, so parts are held only by contact and friction.
 //
+// Threads: a Simulation is used by one thread at a time, but belongs to none: it may be made,
+// stepped, rendered and destroyed on different threads, since its GL context is current only
+// inside captureRgbd() and renderImage() (sim/gl_context.h). Several simulations render at once
+// on several threads, and any of them may be destroyed while the others render.
+//
 // Ground truth (parts(), contacts) is for tests and the trial judge only: components that a
 // plan uses must get their knowledge from the arm's joint states, the gripper's finger state
 // and camera frames.
@@ -119,7 +124,9 @@ class Simulation {
   /// offset): what the system believes before it calibrates the camera.
   world::Pose rgbdNominalPose() const;
   /// Renders the RGB-D camera now and applies the depth noise model with `noise_seed`.
-  camera::RgbdFrame captureRgbd(std::uint64_t noise_seed);
+  /// Without `colour` the frame's colour image is left empty and only depth is rendered
+  /// (faster; the points are the same).
+  camera::RgbdFrame captureRgbd(std::uint64_t noise_seed, bool colour = true);
   /// Renders a named camera ("rgbd", "overview") at any size up to 1280 x 960.
   RgbImage renderImage(const std::string& camera, int width, int height);
 

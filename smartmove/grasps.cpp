@@ -52,6 +52,17 @@ std::optional<Grasp> GraspLibrary::find(const std::string& object_class, const s
   return std::nullopt;
 }
 
+std::optional<Grasp> GraspLibrary::defaultFor(const std::string& object_class) const {
+  for (const auto* source : {&defaults_, &taught_}) {
+    for (const auto& [key, grasp] : *source) {
+      if (key.first == object_class) {
+        return find(object_class, key.second);
+      }
+    }
+  }
+  return std::nullopt;
+}
+
 std::vector<Grasp> GraspLibrary::forClass(const std::string& object_class) const {
   std::map<std::string, Grasp> found;
   for (const auto* source : {&defaults_, &taught_}) {

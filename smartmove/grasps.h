@@ -29,6 +29,9 @@ class GraspLibrary {
 
   std::optional<Grasp> find(const std::string& object_class, const std::string& name) const;
   std::vector<Grasp> forClass(const std::string& object_class) const;
+  /// The grasp used when a plan names none: the class's first in the defaults file (as taught,
+  /// when a taught grasp has its name), else its first taught one.
+  std::optional<Grasp> defaultFor(const std::string& object_class) const;
   std::vector<std::string> names() const;
   /// Adds or replaces a taught grasp and saves the taught file atomically.
   void teach(const Grasp& grasp);

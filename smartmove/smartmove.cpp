@@ -15,21 +15,6 @@ using component::ValueType;
 
 namespace {
 
-std::string trim(std::string text) {
-  const auto first = text.find_first_not_of(" \t\n");
-  if (first == std::string::npos) {
-    return {};
-  }
-  const auto last = text.find_last_not_of(" \t\n");
-  return text.substr(first, last - first + 1);
-}
-
-bool isName(const std::string& text) {
-  return !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '?';
-  });
-}
-
 /// An operation of another component, started now, as a step.
 class ComponentStep final : public RunningOperation {
  public:
@@ -118,53 +103,6 @@ world::Pose up(double metres) { return world::Pose(Eigen::Translation3d(0, 0, me
 
 }  // namespace
 
-std::vector<predicator::Pattern> parsePredicateList(const std::string& text) {
-  std::vector<predicator::Pattern> patterns;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t end = std::min(text.find(';', start), text.size());
-    const std::string item = trim(text.substr(start, end - start));
-    start = end + 1;
-    if (item.empty()) {
-      continue;
-    }
-    predicator::Pattern pattern;
-    const auto open = item.find('(');
-    if (open == std::string::npos) {
-      pattern.predicate = item;
-    } else {
-      if (item.back() != ')') {
-        throw std::invalid_argument("'" + item + "' must look like name(arg, ...)");
-      }
-      pattern.predicate = trim(item.substr(0, open));
-      const std::string inside = item.substr(open + 1, item.size() - open - 2);
-      std::size_t a = 0;
-      while (a <= inside.size()) {
-        const std::size_t b = std::min(inside.find(',', a), inside.size());
-        const std::string arg = trim(inside.substr(a, b - a));
-        if (!arg.empty() || b < inside.size()) {
-          if (!isName(arg)) {
-            throw std::invalid_argument("'" + arg + "' in '" + item + "' is not a symbol name");
-          }
-          pattern.args.push_back(arg);
-        }
-        a = b + 1;
-      }
-    }
-    if (!isName(pattern.predicate) || pattern.predicate.find('?') != std::string::npos) {
-      throw std::invalid_argument("'" + pattern.predicate + "' is not a predicate name");
-    }
-    const auto wildcards = std::count(pattern.args.begin(), pattern.args.end(), "?");
-    if (wildcards == 0) {
-      pattern.args.insert(pattern.args.begin(), "?");  // the object is the first argument
-    } else if (wildcards > 1) {
-      throw std::invalid_argument("'" + item + "' has more than one '?'");
-    }
-    patterns.push_back(std::move(pattern));
-  }
-  return patterns;
-}
-
 std::string partObstacle(const std::string& object) { return "part:" + object; }
 
 SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Component& gripper, world::WorldState& world,
@@ -188,21 +126,12 @@ SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Compon
   ParamSpec predicates{"predicates", ValueType::kString,
                        "conditions on the part, e.g. right_of(table_center); near(node_1)", std::string()};
   predicates.choices_from = "predicate";
-  predicates.validate = [check = pattern_check_](std::string_view text) -> std::string {
-    try {
-      for (const auto& pattern : parsePredicateList(std::string(text))) {
-        if (*check) {
-          if (std::string problem = (*check)(pattern); !problem.empty()) {
-            return problem;
-          }
-        }
-      }
-      return {};
-    } catch (const std::invalid_argument& e) {
-      return e.what();
-    }
+  predicates.validate = [check = pattern_check_](std::string_view text) {
+    return predicator::checkPatternList(text, *check);
   };
-  ParamSpec grasp{"grasp", ValueType::kString, "a grasp taught for the class", std::string("top")};
+  ParamSpec grasp{"grasp", ValueType::kString,
+                  "a grasp taught for the class (default: the first taught for it, e.g. 'top' for a node)",
+                  std::string()};
   grasp.choices_from = "grasp";
   ParamSpec approach{"approach", ValueType::kDouble, "distance of the straight approach and retreat (m)",
                      config_.approach};
@@ -220,15 +149,53 @@ SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Compon
                    "satisfies the predicates",
                    std::string()};
   target.choices_from = "frame";
+  target.extra_choices = {"table"};
+  target.excludes = {"target_class"};
+  target_class.excludes = {"target"};
+  // What would fail at once, caught when the plan is checked (the editor's Check, costar run).
+  const auto check_grasp = [this](const component::ParamMap& params) -> std::string {
+    const std::string& object_class = params.at("object_class").asString();
+    const std::string& name = params.at("grasp").asString();
+    if (name.empty() || grasps_.find(object_class, name)) {
+      return {};
+    }
+    std::string taught;
+    for (const auto& known : grasps_.forClass(object_class)) {
+      taught += (taught.empty() ? "" : ", ") + known.name;
+    }
+    return "no grasp '" + name + "' is taught for class '" + object_class + "'" +
+           (taught.empty() ? std::string(" (none is)") : " (taught: " + taught + ")");
+  };
+  const auto check_release = [](const component::ParamMap& params) -> std::string {
+    const std::string& target_class = params.at("target_class").asString();
+    const std::string& target = params.at("target").asString();
+    if (target_class.empty() && target.empty()) {
+      return "give target_class (put the part on such a part) or target (a frame, or 'table')";
+    }
+    if (!target_class.empty() && !target.empty()) {
+      return "give target_class or target, not both (target '" + target + "' would be ignored)";
+    }
+    if (!target.empty() && target != "table" && !params.at("predicates").asString().empty()) {
+      return "the conditions cannot apply: the part goes to frame '" + target +
+             "' itself (conditions choose among parts with target_class, or spots with target 'table')";
+    }
+    return {};
+  };
   description_.operations = {{"SmartMove",
                               "Moves the tool to the best reachable part that satisfies the conditions.",
-                              {object_class, predicates, grasp, speed}},
+                              {object_class, predicates, grasp, speed},
+                              component::OperationKind::kRobotAction,
+                              check_grasp},
                              {"SmartGrasp",
                               "Picks up the best reachable part that satisfies the conditions.",
-                              {object_class, predicates, grasp, approach, speed}},
+                              {object_class, predicates, grasp, approach, speed},
+                              component::OperationKind::kRobotAction,
+                              check_grasp},
                              {"SmartRelease",
                               "Puts the part held on a part that satisfies the conditions, or at a frame.",
-                              {target_class, predicates, target, approach, speed}},
+                              {target_class, predicates, target, approach, speed},
+                              component::OperationKind::kRobotAction,
+                              check_release},
                              {"TeachGrasp",
                               "Saves how the gripper holds the nearest part of a class as a named grasp.",
                               {object_class, {"grasp", ValueType::kString, "name of the new grasp", {}}},
@@ -450,7 +417,11 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
   if (operation == "SmartMove" || operation == "SmartGrasp") {
     const bool grasping = operation == "SmartGrasp";
     const std::string object_class = text("object_class");
-    const auto grasp = grasps_.find(object_class, text("grasp"));
+    const auto grasp =
+        text("grasp").empty() ? grasps_.defaultFor(object_class) : grasps_.find(object_class, text("grasp"));
+    if (!grasp && text("grasp").empty()) {
+      return failed("no grasp is taught for class '" + object_class + "'");
+    }
     if (!grasp) {
       return failed("no grasp '" + text("grasp") + "' is taught for class '" + object_class + "'");
     }

@@ -59,16 +59,16 @@ struct SmartMoveConfig {
   CostWeights weights;
 };
 
-/// Parses "right_of(table_center); near(node_1)" into patterns with "?" for the object.
-/// @throws std::invalid_argument naming the problem.
-std::vector<predicator::Pattern> parsePredicateList(const std::string& text);
+/// Parses "right_of(table_center); near(node_1)" into patterns with "?" for the object
+/// (predicator/pattern.h). @throws std::invalid_argument naming the problem.
+using predicator::parsePredicateList;
 
 /// Obstacle name of a known part in the collision world.
 std::string partObstacle(const std::string& object);
 
 /// Checks one predicate pattern of a plan before it runs (known predicate, right number of
 /// arguments, known reference frames): empty when fine, else the problem.
-using PatternCheck = std::function<std::string(const predicator::Pattern&)>;
+using PatternCheck = predicator::PatternCheck;
 
 class SmartMoveComponent final : public component::LocalComponent {
  public:

@@ -1,9 +1,14 @@
 #include "trials/trials.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <mutex>
 #include <regex>
 #include <stdexcept>
@@ -12,6 +17,7 @@
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
+#include "core/files.h"
 #include "sim/simulation.h"
 #include "trials/judge.h"
 #include "workcell/workcell.h"
@@ -83,9 +89,77 @@ double percentile(std::vector<double> values, double p) {
   return values[low] + (values[high] - values[low]) * (position - low);
 }
 
+std::string shown(double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+
 }  // namespace
 
+void checkOptions(const TrialOptions& options) {
+  if (options.count < 1) {
+    throw std::invalid_argument("the number of trials must be at least 1, not " + std::to_string(options.count));
+  }
+  if (options.jobs < 1) {
+    throw std::invalid_argument("the number of trials run at once must be at least 1, not " +
+                                std::to_string(options.jobs));
+  }
+  if (options.shard_count < 1 || options.shard_index < 0 || options.shard_index >= options.shard_count) {
+    throw std::invalid_argument("shard " + std::to_string(options.shard_index) + "/" +
+                                std::to_string(options.shard_count) + ": needs 0 <= I < N");
+  }
+  // nan compares false with everything: the conditions are written so that it fails them.
+  if (!(options.time_limit_s > 0.0 && options.time_limit_s <= kMaxTimeLimitSeconds)) {
+    throw std::invalid_argument("the time limit must be a number of simulated seconds above 0 and at most " +
+                                shown(kMaxTimeLimitSeconds) + ", not " + shown(options.time_limit_s));
+  }
+  if (!(options.settle_s >= 0.0 && options.settle_s <= kMaxTimeLimitSeconds)) {
+    throw std::invalid_argument("the settle time must be a number of simulated seconds from 0 to " +
+                                shown(kMaxTimeLimitSeconds) + ", not " + shown(options.settle_s));
+  }
+}
+
+void checkOutputFile(const std::filesystem::path& file, const std::string& what) {
+  const std::string label = what + " '" + file.string() + "'";
+  if (file.empty()) {
+    throw std::invalid_argument(what + ": the file name is empty");
+  }
+  std::error_code error;
+  const auto status = std::filesystem::status(file, error);
+  if (std::filesystem::is_directory(status)) {
+    throw std::invalid_argument("cannot write " + label + ": it is a folder");
+  }
+  const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : ".";
+  if (!std::filesystem::is_directory(folder, error)) {
+    throw std::invalid_argument("cannot write " + label + ": there is no folder '" + folder.string() + "'");
+  }
+  // A regular file is replaced by a new one written in its folder; a device is written to.
+  const bool exists = std::filesystem::exists(status);
+  const std::filesystem::path written = exists && !std::filesystem::is_regular_file(status) ? file : folder;
+  if (::access(written.c_str(), W_OK) != 0) {
+    throw std::invalid_argument("cannot write " + label + ": " + std::strerror(errno));
+  }
+}
+
+void writeJson(const Summary& summary, const std::filesystem::path& file) {
+  const std::string text = summary.toJson().dump(2) + "\n";
+  std::error_code error;
+  const auto status = std::filesystem::status(file, error);
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status) &&
+      !std::filesystem::is_directory(status)) {
+    std::ofstream stream(file);
+    stream << text << std::flush;
+    if (!stream) {
+      throw std::runtime_error("cannot write '" + file.string() + "': " + std::strerror(errno));
+    }
+    return;
+  }
+  writeFileAtomically(file, text);
+}
+
 Summary runTrials(const TrialOptions& options, const std::function<void(const TrialResult&, int)>& progress) {
+  checkOptions(options);
   const Judge judge = trials::judge(options.judge);
   const bt::Plan plan = bt::loadPlan(options.plan);
   {
@@ -99,17 +173,22 @@ Summary runTrials(const TrialOptions& options, const std::function<void(const Tr
       throw bt::PlanError(std::move(diagnostics));
     }
   }
+  // This shard's trials: every shard_count-th index, so that slices take about as long.
+  std::vector<int> indices;
+  for (int index = options.shard_index; index < options.count; index += options.shard_count) {
+    indices.push_back(index);
+  }
   Summary summary;
   summary.options = options;
-  summary.trials.resize(static_cast<std::size_t>(options.count));
-  std::atomic<int> next{0};
+  summary.trials.resize(indices.size());
+  std::atomic<std::size_t> next{0};
   int done = 0;
   std::mutex mutex;
   const auto worker = [&] {
-    for (int index = next++; index < options.count; index = next++) {
-      TrialResult result = runOne(options, plan, judge, index);
+    for (std::size_t slot = next++; slot < indices.size(); slot = next++) {
+      TrialResult result = runOne(options, plan, judge, indices[slot]);
       std::lock_guard lock(mutex);
-      summary.trials[static_cast<std::size_t>(index)] = result;
+      summary.trials[slot] = result;
       ++done;
       if (progress) {
         progress(result, done);
@@ -170,6 +249,9 @@ nlohmann::json Summary::toJson() const {
   json["judge"] = options.judge;
   json["trials"] = trials.size();
   json["seed"] = options.seed;
+  json["count"] = options.count;
+  json["shard"] = {{"index", options.shard_index}, {"count", options.shard_count}};
+  json["time_limit_s"] = options.time_limit_s;
   json["successes"] = successes();
   json["success_rate"] = trials.empty() ? 0.0 : static_cast<double>(successes()) / trials.size();
   json["cycle_time_s"] = cycleTimes();
@@ -195,9 +277,125 @@ nlohmann::json Summary::toJson() const {
   return json;
 }
 
+namespace {
+
+/// `json[key]` as T, or an error naming the field.
+template <typename T>
+T field(const nlohmann::json& json, const std::string& key, const std::string& where) {
+  const auto found = json.find(key);
+  if (found == json.end()) {
+    throw std::runtime_error(where + ": missing field '" + key + "'");
+  }
+  try {
+    return found->get<T>();
+  } catch (const nlohmann::json::exception&) {
+    throw std::runtime_error(where + ": field '" + key + "' has the wrong type (" + found->type_name() + ")");
+  }
+}
+
+}  // namespace
+
+Summary Summary::fromJson(const nlohmann::json& json) {
+  if (!json.is_object()) {
+    throw std::runtime_error("trial results: expected a JSON object, not " + std::string(json.type_name()));
+  }
+  Summary summary;
+  const std::string where = "trial results";
+  summary.options.plan = field<std::string>(json, "plan", where);
+  summary.options.scene = field<std::string>(json, "scene", where);
+  summary.options.judge = field<std::string>(json, "judge", where);
+  summary.options.seed = field<std::uint64_t>(json, "seed", where);
+  summary.options.count = json.contains("count") ? field<int>(json, "count", where) : field<int>(json, "trials", where);
+  summary.options.time_limit_s = json.value("time_limit_s", summary.options.time_limit_s);
+  if (json.contains("shard")) {
+    summary.options.shard_index = field<int>(json.at("shard"), "index", where + ", shard");
+    summary.options.shard_count = field<int>(json.at("shard"), "count", where + ", shard");
+  }
+  const auto& results = json.find("results");
+  if (results == json.end() || !results->is_array()) {
+    throw std::runtime_error(where + ": missing array 'results'");
+  }
+  for (std::size_t i = 0; i < results->size(); ++i) {
+    const nlohmann::json& item = (*results)[i];
+    const std::string at = where + ", results[" + std::to_string(i) + "]";
+    if (!item.is_object()) {
+      throw std::runtime_error(at + ": expected an object");
+    }
+    TrialResult trial;
+    trial.index = field<int>(item, "index", at);
+    trial.seed = field<std::uint64_t>(item, "seed", at);
+    trial.success = field<bool>(item, "success", at);
+    trial.cycle_time_s = field<double>(item, "cycle_time_s", at);
+    trial.wall_s = item.value("wall_s", 0.0);
+    if (!trial.success) {
+      trial.failure_path = field<std::string>(item, "failure_path", at);
+      trial.reason = field<std::string>(item, "reason", at);
+    }
+    summary.trials.push_back(std::move(trial));
+  }
+  return summary;
+}
+
+Summary mergeShards(const std::vector<Summary>& shards) {
+  if (shards.empty()) {
+    throw std::runtime_error("no trial results to merge");
+  }
+  const TrialOptions& first = shards.front().options;
+  Summary merged;
+  merged.options = first;
+  merged.options.shard_index = 0;
+  merged.options.shard_count = 1;
+  merged.trials.resize(static_cast<std::size_t>(first.count));
+  std::vector<bool> seen(static_cast<std::size_t>(first.count), false);
+  for (std::size_t s = 0; s < shards.size(); ++s) {
+    const TrialOptions& options = shards[s].options;
+    const auto differs = [&](const std::string& what, const std::string& a, const std::string& b) {
+      if (a != b) {
+        throw std::runtime_error("results " + std::to_string(s + 1) + " are of another batch: " + what + " '" + b +
+                                 "', not '" + a + "'");
+      }
+    };
+    differs("plan", first.plan.string(), options.plan.string());
+    differs("scene", first.scene.string(), options.scene.string());
+    differs("judge", first.judge, options.judge);
+    differs("first seed", std::to_string(first.seed), std::to_string(options.seed));
+    differs("trial count", std::to_string(first.count), std::to_string(options.count));
+    for (const TrialResult& trial : shards[s].trials) {
+      if (trial.index < 0 || trial.index >= first.count) {
+        throw std::runtime_error("results " + std::to_string(s + 1) + ": trial " + std::to_string(trial.index) +
+                                 " is outside 0.." + std::to_string(first.count - 1));
+      }
+      if (seen[static_cast<std::size_t>(trial.index)]) {
+        throw std::runtime_error("trial " + std::to_string(trial.index) + " appears twice (results " +
+                                 std::to_string(s + 1) + ")");
+      }
+      seen[static_cast<std::size_t>(trial.index)] = true;
+      merged.trials[static_cast<std::size_t>(trial.index)] = trial;
+    }
+  }
+  std::string missing;
+  int missing_count = 0;
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    if (!seen[i] && ++missing_count <= 10) {
+      missing += (missing.empty() ? "" : ", ") + std::to_string(i);
+    }
+  }
+  if (missing_count > 0) {
+    throw std::runtime_error(std::to_string(missing_count) + " of " + std::to_string(first.count) +
+                             " trials are missing (a shard not merged?): " + missing +
+                             (missing_count > 10 ? ", ..." : ""));
+  }
+  return merged;
+}
+
 std::string Summary::text() const {
   char line[256];
   std::string out;
+  if (options.shard_count > 1) {
+    std::snprintf(line, sizeof line, "shard %d/%d (trials %d, %d, ... of %d): ", options.shard_index,
+                  options.shard_count, options.shard_index, options.shard_index + options.shard_count, options.count);
+    out += line;
+  }
   std::snprintf(line, sizeof line, "%d of %zu trials succeeded (%.1f %%)\n", successes(), trials.size(),
                 trials.empty() ? 0.0 : 100.0 * successes() / trials.size());
   out += line;

@@ -33,6 +33,10 @@ struct TrialOptions {
   /// after setting the cell up (not counted in the cycle time; a failed calibration fails the
   /// trial).
   bool calibrate = false;
+  /// This run's slice of the trials, for spreading them over machines: trials i with
+  /// i % shard_count == shard_index (trial i keeps seed + i whichever shard runs it).
+  int shard_index = 0;
+  int shard_count = 1;
 };
 
 struct TrialResult {
@@ -48,6 +52,7 @@ struct TrialResult {
 
 struct Summary {
   TrialOptions options;
+  /// The trials this summary holds, by index (a shard holds every shard_count-th).
   std::vector<TrialResult> trials;
   int successes() const;
   /// Failures grouped by node path and reason, numbers masked ("# candidates"), most first.
@@ -56,14 +61,38 @@ struct Summary {
   std::map<std::string, double> cycleTimes() const;
   nlohmann::json toJson() const;
   std::string text() const;
+  /// Reads what toJson wrote. @throws std::runtime_error naming the field and the problem.
+  static Summary fromJson(const nlohmann::json& json);
 };
 
+/// Checks the numbers: count and jobs at least 1, time limit a finite number of seconds above 0
+/// (at most kMaxTimeLimitSeconds), settle time finite and not negative.
+/// @throws std::invalid_argument naming the option and the problem.
+void checkOptions(const TrialOptions& options);
+inline constexpr double kMaxTimeLimitSeconds = 1e6;
+
+/// Checks, before any trial runs, that `file` can be written at the end: its folder exists, it
+/// is not a folder itself, and it may be written. `what` names it in the error ("--json").
+/// @throws std::invalid_argument naming the file and the problem.
+void checkOutputFile(const std::filesystem::path& file, const std::string& what);
+
+/// Combines shard summaries of one batch (same plan, scene, judge, first seed and count) into
+/// the summary a single run would give. @throws std::runtime_error when they do not belong
+/// together, a trial appears twice, or trials are missing (listing the first missing ones).
+Summary mergeShards(const std::vector<Summary>& shards);
+
 /// Runs the trials; `progress` is called as each one ends (from the trial's thread, one at a
-/// time). @throws std::runtime_error before the first trial when the plan is invalid or a file
-/// is missing.
+/// time). @throws std::invalid_argument or std::runtime_error before the first trial when an
+/// option is out of range (checkOptions), the plan is invalid or a file is missing.
 Summary runTrials(const TrialOptions& options, const std::function<void(const TrialResult&, int done)>& progress = {});
 
+/// Writes Summary::toJson() to `file`: atomically for a regular file (a crash leaves the old
+/// file or the new one), straight through for a device such as /dev/stdout.
+/// @throws std::runtime_error naming the file and the system error.
+void writeJson(const Summary& summary, const std::filesystem::path& file);
+
 /// A PNG a person can read: success rate, failures by reason, cycle-time histogram.
+/// @throws std::runtime_error naming the file when it cannot be written.
 void writePlot(const Summary& summary, const std::filesystem::path& png);
 
 }  // namespace costar::trials

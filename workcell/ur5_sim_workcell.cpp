@@ -7,6 +7,7 @@
 #include "perception/perception_component.h"
 #include "perception/pipeline.h"
 #include "planning/collision_world.h"
+#include "predicator/pattern.h"
 #include "predicator/predicator.h"
 #include "sim/arm_driver.h"
 #include "sim/drivers.h"
@@ -158,28 +159,13 @@ class Ur5SimWorkcell final : public Workcell {
   /// and its other arguments are frames that exist now (fixed frames, waypoints) or object
   /// classes; names of detected parts are not known before the plan runs and are refused.
   std::string checkPattern(const predicator::Pattern& pattern) {
-    const auto& declared = components().predicates();
-    const auto it = declared.find(pattern.predicate);
-    if (it == declared.end()) {
-      std::string known;
-      for (const auto& [name, decl] : declared) {
-        known += (known.empty() ? "" : ", ") + name;
-      }
-      return "unknown predicate '" + pattern.predicate + "' (known: " + known + ")";
-    }
-    if (pattern.args.size() != it->second.arity) {
-      return "predicate '" + pattern.predicate + "' takes " + std::to_string(it->second.arity) + " argument(s), " +
-             std::to_string(pattern.args.size()) + " given (the part counts as one)";
-    }
     components().refreshWorld();
-    for (const auto& arg : pattern.args) {
-      const bool is_class = std::any_of(simulation_->objectClasses().begin(), simulation_->objectClasses().end(),
-                                        [&arg](const world::ObjectClass& c) { return c.name == arg; });
-      if (arg != "?" && !is_class && components().world().symbol(arg) == nullptr) {
-        return "unknown reference frame '" + arg + "' in " + pattern.predicate + "(...)";
-      }
-    }
-    return {};
+    return predicator::checkPatternAgainst(pattern, components().predicates(), [this](const std::string& arg) {
+      const auto& classes = simulation_->objectClasses();
+      return std::any_of(classes.begin(), classes.end(),
+                         [&arg](const world::ObjectClass& c) { return c.name == arg; }) ||
+             components().world().symbol(arg) != nullptr;
+    });
   }
 
   std::string name() const override { return "ur5-sim"; }

@@ -5,7 +5,6 @@
 #include <cstdlib>
 
 #include "testing/test_components.h"
-#include "workcell/ur5_sim_workcell.h"
 
 namespace costar::workcell {
 
@@ -80,12 +79,18 @@ std::filesystem::path defaultWaypointFile(const std::string& workcell) {
 
 namespace {
 
+constexpr const char* kUr5SimSummary =
+    "simulated UR5 with a 2-finger gripper and an RGB-D camera (MuJoCo); the default";
+constexpr const char* kTestSummary =
+    "TEST ONLY: test components (logger, scripted actions, counter, an arm without a robot)";
+constexpr const char* kNoneSummary = "no components: built-in nodes only";
+
 /// Built-in nodes only: no components, simulated clock.
 class BareWorkcell final : public Workcell {
  public:
   BareWorkcell() : Workcell(std::make_unique<SimClock>()) { registerNodes(); }
   std::string name() const override { return "none"; }
-  std::string description() const override { return "no components: built-in nodes only"; }
+  std::string description() const override { return kNoneSummary; }
 };
 
 /// TEST ONLY: the components of testing/ (a logger, scripted actions, a counter, an arm
@@ -100,24 +105,17 @@ class TestWorkcell final : public Workcell {
     registerNodes();
   }
   std::string name() const override { return "test"; }
-  std::string description() const override {
-    return "TEST ONLY: test components (logger, scripted actions, counter, an arm without a robot)";
-  }
+  std::string description() const override { return kTestSummary; }
 };
 
 }  // namespace
 
 std::vector<WorkcellInfo> knownWorkcells() {
-  return {{"ur5-sim", "simulated UR5 with a 2-finger gripper and an RGB-D camera (MuJoCo); the default"},
-          {"test", TestWorkcell().description()},
-          {"none", BareWorkcell().description()}};
+  return {{"ur5-sim", kUr5SimSummary}, {"test", kTestSummary}, {"none", kNoneSummary}};
 }
 
-std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& options) {
+std::unique_ptr<Workcell> makeLightWorkcell(const WorkcellOptions& options) {
   const std::string& name = options.name;
-  if (name == "ur5-sim") {
-    return makeUr5SimWorkcell(options);
-  }
   if (name == "test") {
     return std::make_unique<TestWorkcell>();
   }
@@ -126,6 +124,9 @@ std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& options) {
   }
   std::string known;
   for (const auto& info : knownWorkcells()) {
+    if (info.name == name) {
+      return nullptr;  // a robot cell: makeWorkcell() builds it
+    }
     known += (known.empty() ? "" : ", ") + info.name;
   }
   throw std::invalid_argument("unknown workcell '" + name + "' (known: " + known + ")");

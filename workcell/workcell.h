@@ -91,8 +91,15 @@ struct WorkcellInfo {
 std::vector<WorkcellInfo> knownWorkcells();
 
 /// Creates a workcell. @throws std::invalid_argument naming the known ones for an unknown
-/// name; std::runtime_error when its files cannot be read.
+/// name; std::runtime_error when its files cannot be read. In costar_workcell, which links
+/// the robot libraries (simulator, perception, planning).
 std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& options);
+
+/// Creates a workcell that needs none of the robot libraries ("test", "none"), or returns
+/// nullptr for a known robot cell ("ur5-sim"), which only makeWorkcell() builds. In
+/// costar_workcell_base, with the light `costar` executable.
+/// @throws std::invalid_argument naming the known ones for an unknown name.
+std::unique_ptr<Workcell> makeLightWorkcell(const WorkcellOptions& options);
 
 /// Where waypoints of `workcell` are kept by default.
 std::filesystem::path defaultWaypointFile(const std::string& workcell);

@@ -126,9 +126,35 @@ TEST(Validation, MalformedXmlNamesTheLine) {
       problems("<root BTCPP_format=\"4\">\n<BehaviorTree ID=\"m\">\n<Sequence>\n</BehaviorTree></root>");
   ASSERT_EQ(unclosed.size(), 1u);
   EXPECT_EQ(unclosed[0].where.line, 3);
-  EXPECT_NE(unclosed[0].message.find("MISMATCHED_ELEMENT"), std::string::npos);
-  EXPECT_NE(unclosed[0].message.find("Sequence"), std::string::npos);
+  EXPECT_NE(unclosed[0].message.find("<Sequence> is not closed (mismatched end tag on line 4)"), std::string::npos)
+      << unclosed[0].message;
   EXPECT_NE(problem("<root><BehaviorTree ID=\"m\"><Sequence></root>").find("malformed XML"), std::string::npos);
+  // Comments, self-closed elements and '>' inside attribute values are no open elements.
+  const auto inner = problems(
+      "<root BTCPP_format=\"4\">\n<BehaviorTree ID=\"m\">\n<Sequence><!-- <Fallback> -->\n"
+      "<Script code=\"a > b\"/>\n<Inverter>\n<AlwaysSuccess/>\n</Sequence></BehaviorTree></root>");
+  ASSERT_EQ(inner.size(), 1u);
+  EXPECT_EQ(inner[0].where.line, 5);
+  EXPECT_NE(inner[0].message.find("<Inverter> is not closed"), std::string::npos) << inner[0].message;
+}
+
+TEST(Validation, NestingUpToBehaviorTreeCppsLimitIsRead) {
+  // 300 levels (BehaviorTree.CPP reads up to 500); deeper is refused with a message, not a crash.
+  const auto nested = [](int levels) {
+    std::string xml = "<root BTCPP_format=\"4\"><BehaviorTree ID=\"m\">";
+    for (int i = 0; i < levels; ++i) {
+      xml += "<Inverter>";
+    }
+    xml += "<AlwaysSuccess/>";
+    for (int i = 0; i < levels; ++i) {
+      xml += "</Inverter>";
+    }
+    return xml + "</BehaviorTree></root>";
+  };
+  EXPECT_TRUE(problems(nested(300)).empty());
+  const auto deep = problems(nested(100000));
+  ASSERT_EQ(deep.size(), 1u);
+  EXPECT_NE(deep[0].message.find("nesting is too deep: more than 500 levels"), std::string::npos) << deep[0].message;
 }
 
 TEST(Validation, UnknownNodeWithASuggestion) {

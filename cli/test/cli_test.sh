@@ -36,6 +36,18 @@ check "nodes json"          0 '"category": "knowledge"' -- "$costar" nodes -w te
 check "help"                0 'Exit code: 0 SUCCESS' -- "$costar" run --help
 check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit 0.1
 
+# Trials spread over machines: shards' JSON results merge into one summary (no simulation here:
+# two hand-written shard files of a 3-trial batch).
+shard_json() {  # shard_json INDEX RESULTS
+  printf '{"plan": "p.xml", "scene": "s.json", "judge": "lift", "seed": 5, "count": 3, "trials": 3, "shard": {"index": %s, "count": 2}, "results": [%s]}' "$1" "$2"
+}
+shard_json 0 '{"index": 0, "seed": 5, "success": true, "cycle_time_s": 6.0}, {"index": 2, "seed": 7, "success": false, "cycle_time_s": 9.0, "failure_path": "main/SmartGrasp", "reason": "no feasible node"}' >"$tmp/s0.json"
+shard_json 1 '{"index": 1, "seed": 6, "success": true, "cycle_time_s": 7.0}' >"$tmp/s1.json"
+check "trials merge"        0 '^2 of 3 trials succeeded' -- "$costar" trials merge "$tmp/s0.json" "$tmp/s1.json" --json "$tmp/merged.json"
+check "trials merge: missing" 2 '1 of 3 trials are missing \(a shard not merged\?\): 1' -- "$costar" trials merge "$tmp/s0.json"
+check "trials merge: twice" 2 'trial 1 appears twice' -- "$costar" trials merge "$tmp/s0.json" "$tmp/s1.json" "$tmp/s1.json"
+check "trials: bad shard"   2 "needs 0 <= I < N" -- "$costar" trials examples/ur5/pick_up_node.xml --judge lift --shard 4/4
+
 # Teaching: jog, teach, move back, rename; waypoints persist in the file.
 printf 'jog z 0.05\nteach up\nhome\nmove up\nrename up lifted\nmove nowhere\nquit\n' |
   "$costar" teach --scene sim/scenes/one_node.json --waypoints "$tmp/waypoints.json" >"$tmp/teach.out" 2>&1
@@ -62,6 +74,38 @@ assert fails[-1]["origin"].endswith('TestAction "grasp link"'), fails[-1]
 PY
 then echo "ok   trace"; else echo "FAIL trace"; failures=$((failures + 1)); fi
 
+# Trials: options, scene and waypoint files and output paths are checked before the first trial
+# (issue 10); the errors name the option or the file and the field. No trial runs in these.
+trials=(trials examples/ur5/blind_pick_place.xml --judge blind_place --scene sim/scenes/one_node.json
+        --waypoints examples/ur5/blind_waypoints.json -n 1)
+no_trial() {  # no_trial NAME: the last check's output shows no trial ran
+  if grep -qE '^\[ *1/1\]' "$tmp/out"; then echo "FAIL $1: a trial ran"; failures=$((failures + 1)); fi
+}
+for bad in nan 0 -5 inf; do
+  check "trials --time-limit $bad" 2 "--time-limit: must be a number above 0 s and at most 1e\+06, not $bad" \
+    -- "$costar" "${trials[@]}" --time-limit "$bad"
+  no_trial "trials --time-limit $bad"
+done
+check "trials --require nan" 2 '--require: must be a number from 0 and at most 1, not nan' \
+  -- "$costar" "${trials[@]}" --require nan
+check "trials --plot in a missing folder" 2 "error: cannot write --plot '/nonexistent/p.png': there is no folder '/nonexistent'" \
+  -- "$costar" "${trials[@]}" --plot /nonexistent/p.png
+no_trial "trials --plot in a missing folder"
+check "trials --json to a folder" 2 "error: cannot write --json '$tmp': it is a folder" \
+  -- "$costar" "${trials[@]}" --json "$tmp"
+no_trial "trials --json to a folder"
+check "trials --json in a missing folder" 2 "error: cannot write --json '$tmp/no/r.json': there is no folder '$tmp/no'" \
+  -- "$costar" "${trials[@]}" --json "$tmp/no/r.json"
+printf '{"parts": [{"class": "node", "count": 4294967297}]}\n' >"$tmp/count.json"
+check "trials: scene count out of range" 2 \
+  "error: scene '$tmp/count.json': parts\[0\]\.count: must be a whole number from 1 to 100, not 4294967297" \
+  -- "$costar" trials examples/ur5/blind_pick_place.xml --judge blind_place --scene "$tmp/count.json" -n 1
+no_trial "trials: scene count out of range"
+printf '{"waypoints": [{"name": "pick", "position": [0.45, -0.25, 0.03], "orientation": [0, 0, 0, 0]}]}\n' >"$tmp/zero.json"
+check "run: zero quaternion in a waypoint" 2 \
+  "waypoint file '$tmp/zero.json': waypoints\[0\]\.orientation: must be a unit quaternion \[w, x, y, z\], not \[0,0,0,0\]" \
+  -- "$costar" run examples/ur5/blind_pick_place.xml -q --scene sim/scenes/one_node.json --waypoints "$tmp/zero.json"
+
 # Ctrl-C stops the run, cancels the operation and exits 130.
 cat > "$tmp/long.xml" <<'XML'
 <root BTCPP_format="4"><BehaviorTree ID="m"><Repeat num_cycles="-1"><Sleep msec="10"/></Repeat></BehaviorTree></root>
@@ -78,5 +122,51 @@ kill -INT $pid
 wait $pid
 code=$?
 if [[ $code -eq 130 ]] && grep -q STOPPED "$tmp/out"; then echo "ok   ctrl-c"; else echo "FAIL ctrl-c: exit $code"; cat "$tmp/out"; failures=$((failures + 1)); fi
+
+# The light costar links no robot library; costar-robot (beside it) runs the commands that do.
+robot="$(dirname "$costar")/costar-robot"
+if ldd "$costar" | grep -qE 'libpcl|libvtk|libQt|libopencv|libmujoco|libompl|libfcl|liborocos|libEGL'; then
+  echo "FAIL light executable links robot libraries:"; ldd "$costar" | grep -E 'libpcl|libvtk|libQt|libopencv|libmujoco|libompl|libfcl|liborocos|libEGL' | head; failures=$((failures + 1))
+else
+  echo "ok   light executable ($(ldd "$costar" | wc -l) shared libraries)"
+fi
+# Both list the same commands, options and exit codes.
+"$costar" --help | sed "s|$costar|COSTAR|" >"$tmp/help.light"
+"$robot" --help | sed "s|$robot|COSTAR|" >"$tmp/help.robot"
+if diff -u "$tmp/help.robot" "$tmp/help.light" >"$tmp/help.diff"; then echo "ok   same help"; else echo "FAIL help differs"; cat "$tmp/help.diff"; failures=$((failures + 1)); fi
+check "misspelt command"    2 'subcommand is required' -- "$costar" rnu examples/test_workcell/demo.xml
+check "version"             0 '^costar 0\.1\.0' -- "$costar" --version
+# Validating against the UR5 cell's stored description gives what the cell itself gives, word
+# for word (exit code, every problem, the summary line), with and without taught waypoints.
+same() {  # same NAME ARGS...: costar and costar-robot print the same and exit the same
+  local name="$1"
+  shift
+  "$costar" "$@" >"$tmp/light.out" 2>&1
+  local light=$?
+  "$robot" "$@" >"$tmp/robot.out" 2>&1
+  local heavy=$?
+  if [[ $light -eq $heavy ]] && diff -u "$tmp/robot.out" "$tmp/light.out" >"$tmp/same.diff"; then
+    echo "ok   $name (exit $light)"
+  else
+    echo "FAIL $name: exit $light, costar-robot $heavy"; cat "$tmp/same.diff"; failures=$((failures + 1))
+  fi
+}
+for plan in examples/ur5/*.xml cli/test/fixtures/ur5_predicates.xml; do
+  same "validate $plan as costar-robot does" validate "$plan" --waypoints "$tmp/none.json"
+done
+same "validate with waypoints as costar-robot does" validate cli/test/fixtures/ur5_predicates.xml \
+  --waypoints examples/ur5/blind_waypoints.json
+same "nodes model as costar-robot writes it" nodes --waypoints "$tmp/none.json"
+same "nodes json as costar-robot writes it" nodes --format json --waypoints "$tmp/none.json"
+check "predicate problems named" 2 'ur5_predicates.xml:11: .*unknown reference frame .node_1.' \
+  -- "$costar" validate cli/test/fixtures/ur5_predicates.xml --waypoints examples/ur5/blind_waypoints.json
+# Without costar-robot beside it: a clear error for what needs it, the rest still works.
+mkdir -p "$tmp/alone"
+cp "$costar" "$tmp/alone/costar"
+check "no costar-robot: robot command" 2 "'costar sim' needs the robot libraries .*costar-robot.*cannot be started" \
+  -- "$tmp/alone/costar" sim snapshot sim/scenes/one_node.json --out "$tmp/x.png"
+check "no costar-robot: run on ur5-sim" 2 "needs the robot libraries" \
+  -- "$tmp/alone/costar" run examples/ur5/pick_up_node.xml
+check "no costar-robot: run -w none" 0 '^SUCCESS' -- "$tmp/alone/costar" run bench/plans/reference_1000_leaves.xml -w none -q
 
 exit $((failures > 0))

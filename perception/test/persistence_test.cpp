@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
+#include <tuple>
 
 #include "core/paths.h"
 #include "perception/canonical_orientation.h"
@@ -230,6 +232,72 @@ TEST(Persistence, ManyObjectsMatchLikeBruteForce) {
     agree += name == object.name;
   }
   EXPECT_GE(agree, 1990);  // points a few mm apart may pair the other way round
+}
+
+TEST(Persistence, CrowdedObjectsMatchClosestPairFirstLikeAGreedyReference) {
+  // Clusters of objects closer than d_max to each other, moved by up to 2 cm: each detection has
+  // several candidates, so the order in which pairs are taken matters. Reference: Algorithm 1's
+  // rule spelled out by brute force, all same-class pairs within d_max sorted by distance, a
+  // pair taken when neither side is matched yet.
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> centre(0.0, 3.0);
+  std::uniform_real_distribution<double> spread(-0.02, 0.02);
+  std::vector<Detection> first;
+  for (int cluster = 0; cluster < 150; ++cluster) {
+    const double cx = centre(random);
+    const double cy = centre(random);
+    for (int i = 0; i < 4; ++i) {
+      first.push_back(detection(i % 2 == 0 ? "node" : "link", cx + spread(random), cy + spread(random)));
+    }
+  }
+  PersistenceFilter filter(classes());
+  const std::vector<TrackedObject> before = filter.update(first);
+  std::vector<Detection> moved = first;
+  for (auto& d : moved) {
+    d.pose.translation() += Eigen::Vector3d(spread(random) / 2, spread(random) / 2, 0);
+  }
+  std::shuffle(moved.begin(), moved.end(), random);
+  const auto& after = filter.update(moved);
+  ASSERT_EQ(after.size(), moved.size());
+
+  const double d_max = filter.options().max_distance;
+  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  for (std::size_t d = 0; d < moved.size(); ++d) {
+    for (std::size_t p = 0; p < before.size(); ++p) {
+      const double distance = (moved[d].pose.translation() - before[p].pose.translation()).norm();
+      if (before[p].object_class == moved[d].object_class && distance <= d_max) {
+        pairs.emplace_back(distance, d, p);
+      }
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<std::string> expected(moved.size());
+  std::vector<bool> taken(before.size(), false);
+  for (const auto& [distance, d, p] : pairs) {
+    if (expected[d].empty() && !taken[p]) {
+      expected[d] = before[p].name;
+      taken[p] = true;
+    }
+  }
+  int matched = 0;
+  int contested = 0;
+  for (std::size_t d = 0; d < moved.size(); ++d) {
+    if (!expected[d].empty()) {
+      EXPECT_EQ(after[d].name, expected[d]) << "detection " << d;
+      ++matched;
+    } else {
+      EXPECT_EQ(after[d].seen, 1) << "detection " << d << " should be new";
+    }
+  }
+  for (std::size_t d = 0; d < moved.size(); ++d) {
+    int candidates = 0;
+    for (const auto& [distance, pd, p] : pairs) {
+      candidates += pd == d ? 1 : 0;
+    }
+    contested += candidates > 1 ? 1 : 0;
+  }
+  EXPECT_GT(matched, 500);    // most keep a name ...
+  EXPECT_GT(contested, 100);  // ... and many had a choice to make
 }
 
 }  // namespace

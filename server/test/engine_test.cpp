@@ -400,6 +400,70 @@ TEST(Ur5Cell, ChoicesComeFromWhatTheCellKnows) {
   EXPECT_TRUE(state["gripper"].contains("open"));
 }
 
+TEST(Ur5Cell, EveryPlaceIsOfferedAndDefaultsAreValidForTheClass) {
+  Harness h(blindCell());
+  json release;
+  json grasp;
+  for (const auto& n : h.get("/api/nodes")) {
+    if (n["id"] == "SmartRelease") {
+      release = n;
+    }
+    if (n["id"] == "SmartGrasp") {
+      grasp = n;
+    }
+  }
+  ASSERT_FALSE(release.is_null());
+  ASSERT_FALSE(grasp.is_null());
+  for (const auto& port : release["ports"]) {
+    if (port["name"] == "target") {
+      EXPECT_EQ(port["choices_from"], "frame");
+      EXPECT_EQ(port["extra_choices"], json::array({"table"}));  // not a frame, but a place
+      EXPECT_EQ(port["excludes"], json::array({"target_class"}));
+    }
+  }
+  for (const auto& port : grasp["ports"]) {
+    if (port["name"] == "grasp") {
+      EXPECT_EQ(port["default"], "");  // the class's first taught grasp, valid for every class
+    }
+  }
+}
+
+// Check (POST /api/validate) catches what would fail at once, on the node it concerns.
+TEST(Ur5Cell, CheckCatchesWhatWouldFailAtOnce) {
+  Harness h(blindCell());
+  const auto check = [&](const std::string& node) {
+    const std::string xml = R"(<root BTCPP_format="4"><BehaviorTree ID="main"><Sequence><Open/>)" + node +
+                            R"(</Sequence></BehaviorTree></root>)";
+    const HttpResponse response = h.call("POST", "/api/validate", {{"xml", xml}});
+    EXPECT_EQ(response.status, 200) << response.body;
+    return json::parse(response.body);
+  };
+  const auto firstProblem = [](const json& result) {
+    return result["diagnostics"].empty() ? std::string() : result["diagnostics"][0]["message"].get<std::string>();
+  };
+
+  json result = check(R"x(<SmartGrasp object_class="link" grasp="top"/>)x");
+  EXPECT_FALSE(result["valid"]) << result.dump();
+  EXPECT_NE(firstProblem(result).find("no grasp 'top' is taught for class 'link' (taught: middle)"), std::string::npos)
+      << firstProblem(result);
+  EXPECT_EQ(result["diagnostics"][0]["node"]["path"], json::array({1}));
+  EXPECT_TRUE(check(R"x(<SmartGrasp object_class="link"/>)x")["valid"]);  // the default grasp fits any class
+  EXPECT_TRUE(check(R"x(<SmartGrasp object_class="link" grasp="middle"/>)x")["valid"]);
+
+  result = check(R"x(<SmartRelease predicates="left_of(table_center)"/>)x");
+  EXPECT_FALSE(result["valid"]) << result.dump();
+  EXPECT_NE(firstProblem(result).find("give target_class"), std::string::npos) << firstProblem(result);
+  result = check(R"x(<SmartRelease target="table_center" predicates="left_of(table_center)"/>)x");
+  EXPECT_FALSE(result["valid"]) << result.dump();
+  EXPECT_NE(firstProblem(result).find("the conditions cannot apply"), std::string::npos) << firstProblem(result);
+  result = check(R"x(<SmartRelease target="table" target_class="node"/>)x");
+  EXPECT_FALSE(result["valid"]) << result.dump();
+  EXPECT_NE(firstProblem(result).find("not both"), std::string::npos) << firstProblem(result);
+  EXPECT_TRUE(check(R"x(<SmartRelease target="table" predicates="left_of(table_center)"/>)x")["valid"]);
+  EXPECT_TRUE(check(R"x(<SmartRelease target_class="node" predicates="left_of(table_center)"/>)x")["valid"]);
+  EXPECT_TRUE(check(R"x(<SmartRelease target="table_center"/>)x")["valid"]);
+}
+
 TEST(Ur5Cell, GroundTruthIsOnlyForTests) {
   Harness h(blindCell());
   EXPECT_EQ(h.call("GET", "/api/test/ground_truth").status, 404);

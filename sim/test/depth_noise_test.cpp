@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace costar::sim {
 namespace {
@@ -138,6 +140,48 @@ TEST(DepthNoise, TheSameSeedGivesTheSameFrame) {
   }
   EXPECT_EQ(same, static_cast<int>(std::count_if(a.begin(), a.end(), [](auto& p) { return std::isfinite(p.z()); })));
   EXPECT_GT(differ, 1000);
+}
+
+TEST(DepthNoise, TheFrameDoesNotDependOnTheNumberOfThreads) {
+  // A step (two planes at different depths), a hole and a grazing band: every branch of the
+  // model, split across threads at different rows.
+  std::vector<float> clean = planeDepth(0.9, 0.4);
+  const auto far = planeDepth(1.6, -0.2);
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 640; ++u) {
+      const int i = v * 640 + u;
+      if (u > 400) {
+        clean[i] = far[i];
+      }
+      if ((u - 200) * (u - 200) + (v - 300) * (v - 300) < 900) {
+        clean[i] = v % 2 == 0 ? 0.0f : std::numeric_limits<float>::quiet_NaN();
+      }
+    }
+  }
+  const auto grazing = planeDepth(1.0, 80.0 * M_PI / 180.0);
+  std::copy(grazing.begin(), grazing.begin() + 640 * 40, clean.begin());
+  DepthNoiseOptions options;
+  std::vector<Eigen::Vector3f> one;
+  noisyPointCloud(clean, kIntrinsics, options, 11, one, 1);
+  const auto same = [](const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+    return (std::isnan(a.z()) && std::isnan(b.z())) || a == b;
+  };
+  int valid = 0;
+  for (const auto& p : one) {
+    valid += std::isfinite(p.z()) ? 1 : 0;
+  }
+  EXPECT_GT(valid, 640 * 480 / 2);
+  EXPECT_LT(valid, 640 * 480 - 640 * 30);  // the grazing rows read nothing
+  for (const int threads : {2, 3, 8}) {
+    std::vector<Eigen::Vector3f> many(7, Eigen::Vector3f::Zero());  // reused storage is overwritten
+    noisyPointCloud(clean, kIntrinsics, options, 11, many, threads);
+    ASSERT_EQ(many.size(), one.size());
+    int differ = 0;
+    for (std::size_t i = 0; i < one.size(); ++i) {
+      differ += same(one[i], many[i]) ? 0 : 1;
+    }
+    EXPECT_EQ(differ, 0) << threads << " threads";
+  }
 }
 
 TEST(DepthNoise, DisabledNoiseGivesTheExactSurface) {

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
+
 #include "core/paths.h"
 
 namespace costar::sim {
@@ -45,23 +48,192 @@ TEST(Scene, PlacementIsDeterministicForASeedAndVariesWithIt) {
   EXPECT_FALSE(a[0].pose.isApprox(c[0].pose));
 }
 
+std::string problem(const std::string& json) {
+  try {
+    placeParts(parseScene(json, "bad.json"), classes());
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+/// Corners of a part's footprint (its class's bounding rectangle turned by its yaw).
+std::vector<Eigen::Vector2d> corners(const PartPlacement& part, const world::ObjectClass& object) {
+  const Eigen::AlignedBox3d bounds = object.bounds();
+  std::vector<Eigen::Vector2d> points;
+  for (const auto& corner :
+       {Eigen::Vector2d(-1, -1), Eigen::Vector2d(1, -1), Eigen::Vector2d(1, 1), Eigen::Vector2d(-1, 1)}) {
+    const Eigen::Vector3d local(bounds.center().x() + 0.5 * corner.x() * bounds.sizes().x(),
+                                bounds.center().y() + 0.5 * corner.y() * bounds.sizes().y(), 0.0);
+    points.push_back((part.pose * local).head<2>());
+  }
+  return points;
+}
+
+double pointToSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+  return (a + t * (b - a) - p).norm();
+}
+
+/// Distance between two disjoint convex polygons: the nearest vertex-to-edge pair.
+double polygonDistance(const std::vector<Eigen::Vector2d>& p, const std::vector<Eigen::Vector2d>& q) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int pass = 0; pass < 2; ++pass) {
+    const auto& points = pass == 0 ? p : q;
+    const auto& edges = pass == 0 ? q : p;
+    for (const auto& point : points) {
+      for (std::size_t i = 0; i < edges.size(); ++i) {
+        nearest = std::min(nearest, pointToSegment(point, edges[i], edges[(i + 1) % edges.size()]));
+      }
+    }
+  }
+  return nearest;
+}
+
+TEST(Scene, CrowdedPartsKeepTheGapBetweenTheirFootprintsNotTheirBoundingCircles) {
+  // 8 nodes and 3 links in the right half with 5 mm gaps: too many for bounding circles
+  // (a link's circle is 15 cm across), room enough for the parts' turned rectangles.
+  const Scene scene = parseScene(R"({"seed": 5, "min_gap": 0.005, "parts": [
+      {"class": "link", "count": 3, "region": "right"}, {"class": "node", "count": 8, "region": "right"}]})",
+                                 "test");
+  const auto all = classes();
+  const auto find = [&](const std::string& name) {
+    return *std::find_if(all.begin(), all.end(), [&](const world::ObjectClass& c) { return c.name == name; });
+  };
+  const auto parts = placeParts(scene, all);
+  ASSERT_EQ(parts.size(), 11u);
+  double closest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      const double gap = polygonDistance(corners(parts[i], find(parts[i].object_class)),
+                                         corners(parts[j], find(parts[j].object_class)));
+      EXPECT_GE(gap, 0.005 - 1e-9) << parts[i].name << " and " << parts[j].name;
+      closest = std::min(closest, gap);
+    }
+  }
+  // Crowded indeed: some pair is closer than a finger is thick.
+  EXPECT_LT(closest, 0.02);
+}
+
 TEST(Scene, ProblemsAreNamed) {
-  const auto problem = [](const std::string& json) {
+  EXPECT_EQ(problem(R"({"parts": [{"class": "gear"}]})"),
+            "scene 'bad.json': parts[0].class: unknown object class 'gear' (known: link, node)");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node"}, {"class": "node", "region": "moon"}]})"),
+            "scene 'bad.json': parts[1].region: unknown region 'moon' (known: left, right, table)");
+  EXPECT_NE(problem(R"({"parts": [{"class": "node", "count": 60, "region": "right"}]})").find("parts[0]: cannot fit"),
+            std::string::npos);
+  EXPECT_NE(problem(R"({"parts": [{"class": "node", "color": "purple"}]})").find("parts[0].color: "),
+            std::string::npos);
+  EXPECT_EQ(problem(R"({"parts": 3})"), "scene 'bad.json': parts: must be a list [...], not 3");
+  EXPECT_THROW(loadScene("/nonexistent.json"), std::runtime_error);
+}
+
+// Issue 10, bug 2: the regions loop iterated items() of a temporary (freed memory; valgrind and
+// AddressSanitizer report it) and failed with "cannot use at() with null".
+TEST(Scene, CustomRegionsAreReadAndUsed) {
+  const Scene scene = parseScene(R"({"seed": 4,
+      "regions": {"corner": {"x": [0.55, 0.7], "y": [0.2, 0.35]}, "strip": {"x": [0.3, 0.35], "y": [-0.3, 0.3]}},
+      "parts": [{"class": "node", "count": 2, "region": "corner"}, {"class": "link", "region": "strip"}]})",
+                                 "regions.json");
+  ASSERT_EQ(scene.regions.size(), 5u);  // table, left, right and the two custom ones
+  EXPECT_EQ(scene.regions.at("corner").min, Eigen::Vector2d(0.55, 0.2));
+  EXPECT_EQ(scene.regions.at("corner").max, Eigen::Vector2d(0.7, 0.35));
+  EXPECT_EQ(scene.regions.at("strip").min, Eigen::Vector2d(0.3, -0.3));
+  const auto parts = placeParts(scene, classes());
+  ASSERT_EQ(parts.size(), 3u);
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const Region& region = scene.regions.at(i < 2 ? "corner" : "strip");
+    const Eigen::Vector2d xy = parts[i].pose.translation().head<2>();
+    EXPECT_TRUE((xy.array() >= region.min.array()).all() && (xy.array() <= region.max.array()).all())
+        << parts[i].name << " at " << xy.transpose();
+  }
+}
+
+// Issue 10, bug 6: values that were silently accepted (or truncated) are errors naming the field.
+TEST(Scene, BadValuesAreErrorsNamingTheField) {
+  const std::string prefix = "scene 'bad.json': ";
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "count": 4294967297}]})"),
+            prefix + "parts[0].count: must be a whole number from 1 to 100, not 4294967297");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "count": 2.5}]})"),
+            prefix + "parts[0].count: must be a whole number from 1 to 100, not 2.5");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "count": -1}]})"),
+            prefix + "parts[0].count: must be a whole number from 1 to 100, not -1");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "count": "3"}]})"),
+            prefix + "parts[0].count: must be a whole number from 1 to 100, not \"3\"");
+  EXPECT_EQ(problem(R"({"min_gap": -0.01, "parts": []})"), prefix + "min_gap: must be from 0 to 0.5 (m), not -0.01");
+  EXPECT_EQ(problem(R"({"min_gap": "wide", "parts": []})"), prefix + "min_gap: must be a finite number, not \"wide\"");
+  EXPECT_EQ(problem(R"({"seed": -3, "parts": []})").substr(0, prefix.size() + 6), prefix + "seed: ");
+  EXPECT_EQ(problem(R"({"parts": [{"class": 7}]})"), prefix + "parts[0].class: must be a string, not 7");
+  EXPECT_EQ(problem(R"({"parts": [{"colour": "red", "class": "node"}]})"),
+            prefix + "parts[0].colour: unknown field (known: class, color, count, at, region)");
+  EXPECT_EQ(problem(R"({"regoins": {}, "parts": []})"),
+            prefix + "regoins: unknown field (known: description, seed, min_gap, camera_offset, regions, parts)");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5]}]})"),
+            prefix + "parts[0].at: must be [x, y] or [x, y, yaw] (m, m, degrees), not [0.5]");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, null]}]})"),
+            prefix + "parts[0].at[1]: must be a finite number, not null");
+  EXPECT_NE(problem(R"({"parts": [{"class": "node", "at": [9, 0]}]})").find("parts[0].at: lies off the table top"),
+            std::string::npos);
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, 0], "region": "left"}]})"),
+            prefix + "parts[0]: has both \"at\" (a fixed place) and \"region\" (a random place); give one");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, 0], "count": 2}]})"),
+            prefix + "parts[0].count: a part placed with \"at\" must have count 1");
+  EXPECT_EQ(problem(R"({"parts": [{}]})"), prefix + "parts[0].class: missing (the object class, e.g. \"node\")");
+  EXPECT_EQ(problem(R"({"regions": {"a": {"x": [0.6, 0.4], "y": [0, 0.1]}}, "parts": []})"),
+            prefix + "regions.a.x: must be [low, high] with low < high, not [0.6,0.4]");
+  EXPECT_EQ(problem(R"({"regions": {"a": {"x": [0.4, 0.6]}}, "parts": []})").substr(0, prefix.size() + 21),
+            prefix + "regions.a.y: missing ");
+  EXPECT_NE(problem(R"({"regions": {"a": {"x": [0.4, 3], "y": [0, 0.1]}}, "parts": []})")
+                .find("regions.a: lies off the table top"),
+            std::string::npos);
+  EXPECT_EQ(problem(R"({"regions": [], "parts": []})"), prefix + "regions: must be an object {...}, not []");
+  EXPECT_EQ(problem(R"({"parts": []})"), "no error");
+}
+
+// Issue 14: the camera moved from its drawn mounting, a scene option validated like the others.
+TEST(Scene, CameraOffsetIsReadAndItsProblemsAreNamed) {
+  const std::string prefix = "scene 'bad.json': ";
+  EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0.03, 0, -0.04], "rpy_deg": [0, 3, 4]}, "parts": []})"),
+            "no error");
+  EXPECT_EQ(problem(R"({"camera_offset": {"distance": 0.05, "angle_deg": 5, "seed": 7}, "parts": []})"), "no error");
+  EXPECT_EQ(problem(R"({"camera_offset": [0.05], "parts": []})"),
+            prefix + "camera_offset: must be an object {...}, not [0.05]");
+  EXPECT_EQ(problem(R"({"camera_offset": {"distanse": 0.05}, "parts": []})"),
+            prefix + "camera_offset.distanse: unknown field (known: xyz, rpy_deg, distance, angle_deg, seed)");
+  EXPECT_EQ(problem(R"({"camera_offset": {}, "parts": []})"),
+            prefix + "camera_offset: needs either \"xyz\"/\"rpy_deg\" (a fixed offset) or \"distance\"/\"angle_deg\" "
+                     "(a random direction), not neither");
+  EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0, 0, 0], "distance": 0.1}, "parts": []})").substr(0, prefix.size() + 28),
+            prefix + "camera_offset: needs either ");
+  EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0, 0]}, "parts": []})"),
+            prefix + "camera_offset.xyz: must be [x, y, z] in m, not [0,0]");
+  EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0, "a", 0]}, "parts": []})"),
+            prefix + "camera_offset.xyz[1]: must be a finite number, not \"a\"");
+  EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0.6, 0, 0]}, "parts": []})"),
+            prefix + "camera_offset.xyz: the camera may move at most 0.5 m, not [0.6,0,0]");
+  EXPECT_EQ(problem(R"({"camera_offset": {"rpy_deg": [0, 90, 0]}, "parts": []})"),
+            prefix + "camera_offset.rpy_deg: the camera may turn at most 45 degrees about each axis, not [0,90,0]");
+  EXPECT_EQ(problem(R"({"camera_offset": {"distance": -0.1}, "parts": []})"),
+            prefix + "camera_offset.distance: must be from 0 to 0.5 (m), not -0.1");
+  EXPECT_EQ(problem(R"({"camera_offset": {"angle_deg": 50}, "parts": []})"),
+            prefix + "camera_offset.angle_deg: must be from 0 to 45 (degrees), not 50");
+  EXPECT_EQ(problem(R"({"camera_offset": {"distance": 0.1, "seed": 1.5}, "parts": []})").substr(0, prefix.size() + 20),
+            prefix + "camera_offset.seed: ");
+}
+
+TEST(Scene, UnreadableFilesAreNamedAsSuch) {
+  const auto message = [](const std::filesystem::path& file) {
     try {
-      placeParts(parseScene(json, "bad.json"), classes());
+      loadScene(file);
     } catch (const std::runtime_error& e) {
       return std::string(e.what());
     }
     return std::string("no error");
   };
-  EXPECT_EQ(problem(R"({"parts": [{"class": "gear"}]})"), "scene 'bad.json': unknown object class 'gear'");
-  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "region": "moon"}]})"), "scene 'bad.json': unknown region 'moon'");
-  EXPECT_NE(problem(R"({"parts": [{"class": "node", "count": 60, "region": "right"}]})").find("cannot fit"),
-            std::string::npos);
-  EXPECT_NE(problem(R"({"parts": [{"class": "node", "color": "purple"}]})").find("no colour 'purple'"),
-            std::string::npos);
-  EXPECT_NE(problem(R"({"parts": 3})").find("scene 'bad.json'"), std::string::npos);
-  EXPECT_THROW(loadScene("/nonexistent.json"), std::runtime_error);
+  EXPECT_EQ(message("/nonexistent/scene.json"),
+            "cannot read scene file '/nonexistent/scene.json': No such file or directory");
+  const std::filesystem::path folder = std::filesystem::temp_directory_path();
+  EXPECT_EQ(message(folder), "cannot read scene file '" + folder.string() + "': it is a folder");
 }
 
 TEST(Scene, TheSceneFilesInTheRepositoryLoad) {

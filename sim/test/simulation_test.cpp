@@ -209,5 +209,28 @@ TEST(Simulation, TheRgbdCameraSeesTheTableAndTheParts) {
   EXPECT_EQ(overview.width, 320);
 }
 
+TEST(Simulation, AFrameWithoutColourHasTheSamePointsAsAFullOne) {
+  // DetectObjects takes colour from its last frame only; the others are rendered flat, without
+  // shadows or colour read-back. Their depth, and so their points, must be the same.
+  const auto sim = Simulation::create(sceneOf(R"({"parts": [
+      {"class": "node", "color": "green", "at": [0.5, 0.0, 0]},
+      {"class": "link", "color": "grey", "at": [0.45, 0.2, 30]}]})"));
+  for (const std::uint64_t seed : {3u, 4u}) {
+    const camera::RgbdFrame full = sim->captureRgbd(seed);
+    const camera::RgbdFrame depth_only = sim->captureRgbd(seed, false);
+    EXPECT_EQ(full.rgb.width, 640);
+    EXPECT_TRUE(depth_only.rgb.pixels.empty());
+    ASSERT_EQ(full.points.size(), depth_only.points.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < full.points.size(); ++i) {
+      const bool both_invalid = !std::isfinite(full.points[i].z()) && !std::isfinite(depth_only.points[i].z());
+      differ += both_invalid || full.points[i] == depth_only.points[i] ? 0 : 1;
+    }
+    EXPECT_EQ(differ, 0u) << "seed " << seed;
+    EXPECT_GT(full.validCount(), 640u * 480u * 8 / 10);
+    sim->stepTo(sim->time() + std::chrono::milliseconds(100));
+  }
+}
+
 }  // namespace
 }  // namespace costar::sim

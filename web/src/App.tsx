@@ -5,13 +5,15 @@
 import { useCallback, useEffect, useMemo, useRef, useState } from 'react';
 import { Api, ApiError, CellState, Choices, Diagnostic, Info, NodeInfo, RunInfo, RunLog } from './api';
 import { Stream, StreamMessage } from './stream';
-import { readToken, storeToken } from './token';
+import { readToken, storeToken, tokenFromHash } from './token';
 import * as T from './model/tree';
 import { EditorPlan } from './model/tree';
 import { canRedo, canUndo, History, push, redo, replace, startHistory, undo } from './model/history';
 import { mapRun, mergeStatuses, NodeRef, NodeStatus, statusesAt, statusesByKey } from './model/status';
 import { Palette } from './components/Palette';
-import { TreeView } from './components/TreeView';
+import { Orientation, SelectMode, TreeCanvas } from './components/TreeCanvas';
+import { HelpOverlay } from './components/HelpOverlay';
+import { SignIn } from './components/SignIn';
 import { NodeEditor } from './components/NodeEditor';
 import { candidatesOf, ObjectsPane } from './components/ObjectsPane';
 import { Waypoints } from './components/Waypoints';
@@ -41,6 +43,21 @@ interface ReplayState {
 
 type Message = { text: string; kind: 'info' | 'error' } | null;
 
+/**
+ * The menu's quick actions (pane 8): each runs one operation of the workcell outside a plan.
+ * Add one here (a label, the node type, and when the cell offers it).
+ */
+function quickActions(info: Info | null): { label: string; node: string; title: string }[] {
+  const actions: { label: string; node: string; title: string; when: boolean }[] = [
+    { label: 'Detect objects', node: info?.features.detect_node ?? '', title: 'Look at the table and update the objects', when: !!info?.features.detect },
+    { label: 'Calibrate', node: info?.features.calibrate_node ?? '', title: 'Calibrate the camera to the arm', when: !!info?.features.calibrate },
+    { label: 'Home', node: 'Home', title: 'Move the arm to its home pose', when: true },
+    { label: 'Open gripper', node: 'Open', title: 'Open the gripper', when: true },
+    { label: 'Close gripper', node: 'Close', title: 'Close the gripper', when: true },
+  ];
+  return actions.filter((a) => a.when);
+}
+
 const NAME_PATTERN = /^[A-Za-z0-9][A-Za-z0-9_-]{0,63}$/;
 
 export function App() {
@@ -52,12 +69,30 @@ export function App() {
   const [cell, setCell] = useState<CellState | null>(null);
   const [connected, setConnected] = useState(false);
 
+  const planNameRef = useRef('');
   const [history, setHistory] = useState<History<EditorPlan>>(() => startHistory(T.emptyPlan()));
   const plan = history.present;
   const [treeId, setTreeId] = useState('main');
-  const [selectedKey, setSelectedKey] = useState<string | null>(() => plan.trees[0].root?.key ?? null);
-  const [paletteType, setPaletteType] = useState<string | null>(null);
-  const [planName, setPlanName] = useState('');
+  const [selectedKey, setSelectedKeyOnly] = useState<string | null>(() => plan.trees[0].root?.key ?? null);
+  // The selection: the primary node (customised in pane 5) and, with Shift or Ctrl, more.
+  const [selectedKeys, setSelectedKeys] = useState<Set<string>>(new Set());
+  const setSelectedKey = (key: string | null) => {
+    setSelectedKeyOnly(key);
+    setSelectedKeys(new Set(key ? [key] : []));
+  };
+  const [clipboard, setClipboard] = useState<T.EditorNode[]>([]);
+  const [orientation, setOrientation] = useState<Orientation>('LR');
+  const [help, setHelp] = useState(false);
+  // Sign-in: 'missing' without a token, 'wrong' when the server refused it.
+  const [signIn, setSignIn] = useState<'missing' | 'wrong' | null>(() => (readToken() ? null : 'missing'));
+  // Plan runs started from this page: their statuses are painted on this plan.
+  const startedHere = useRef(new Set<number>());
+  const endedRuns = useRef(new Set<number>());
+  const [planName, setPlanNameState] = useState('');
+  const setPlanName = (name: string) => {
+    planNameRef.current = name;
+    setPlanNameState(name);
+  };
   const [saved, setSaved] = useState<{ name: string; plan: EditorPlan; version: number } | null>(null);
   const [savedPlans, setSavedPlans] = useState<{ name: string; latest_version: number }[]>([]);
   const [savedSubtrees, setSavedSubtrees] = useState<{ name: string }[]>([]);
@@ -77,6 +112,7 @@ export function App() {
 
   const fail = (e: unknown) => {
     const error = e as ApiError;
+    if (error.status === 401) setSignIn(token ? 'wrong' : 'missing');
     setMessage({ text: error.message, kind: 'error' });
     if (error.diagnostics?.length) setDiagnostics(error.diagnostics);
   };
@@ -99,7 +135,9 @@ export function App() {
           case 'hello':
             setInfo(m.info);
             setCell(m.state);
-            if (m.run && m.run.kind === 'plan' && m.run.nodes) {
+            // The last run paints this plan only if it is a run of this plan (a reload starts
+            // a new plan: another plan's old FAILURE must not show on it).
+            if (m.run && m.run.kind === 'plan' && m.run.nodes && m.run.plan && m.run.plan === planNameRef.current) {
               setLive({
                 run: m.run,
                 statuses: new Map((m.run.statuses ?? []).map((s) => [s.uid, s])),
@@ -120,7 +158,13 @@ export function App() {
           case 'statuses':
             setLive((l) => (l && l.run.id === m.run ? { ...l, statuses: mergeStatuses(l.statuses, m.nodes) } : l));
             break;
+          case 'auth':
+            setSignIn(m.ok ? null : 'wrong');
+            break;
           case 'run_ended':
+            endedRuns.current.add(m.run.id);
+            // "Run #N started." is over: the status line shows how it ended.
+            setMessage((msg) => (msg && /^Run #\d+ started/.test(msg.text) ? null : msg));
             setLive((l) => (l && l.run.id === m.run.id ? { ...l, run: { ...l.run, ...m.run, active: false } } : l));
             setOperation((o) =>
               o && o.id === m.run.id ? { ...o, active: false, result: m.run.result, reason: m.run.failure_reason } : o,
@@ -137,6 +181,19 @@ export function App() {
     // eslint-disable-next-line react-hooks/exhaustive-deps
   }, [api, token]);
 
+  // A #token=... pasted into the address of an open tab signs in at once (no reload).
+  useEffect(() => {
+    const onHash = () => {
+      const fresh = tokenFromHash();
+      if (fresh) {
+        setToken(fresh);
+        setSignIn(null);
+      }
+    };
+    window.addEventListener('hashchange', onHash);
+    return () => window.removeEventListener('hashchange', onHash);
+  }, []);
+
   // --- editing -------------------------------------------------------------------------------
   const edit = (change: (p: EditorPlan) => EditorPlan, select?: string | null) => {
     try {
@@ -149,18 +206,94 @@ export function App() {
     }
   };
 
-  const addNode = (type: string | null, mode: 'child' | 'sibling') => {
-    if (!type) {
-      setMessage({ text: 'Choose an operation in the list first.', kind: 'error' });
+  // Inserting (the palette, paste): inside the selected node when it takes children, else
+  // right after it; the inserted node is selected, so clicking operations one after another
+  // builds a sequence in order.
+  const insert = (nodes: T.EditorNode[], at: string | null = selectedKey) => {
+    if (nodes.length === 0) return;
+    edit((p) => T.insertAt(p, treeId, at, nodes, kindOf), nodes[nodes.length - 1].key);
+  };
+  const addNode = (type: string) => insert([T.makeNode(type)]);
+  const selectedNodes = () => {
+    const root = T.findTree(plan, treeId)?.root ?? null;
+    const keys = selectedKeys.size ? selectedKeys : new Set(selectedKey ? [selectedKey] : []);
+    return T.topmostSelected(root, keys);
+  };
+  const copy = () => {
+    const nodes = selectedNodes();
+    if (nodes.length === 0) return;
+    setClipboard(nodes.map(T.cloneNode));
+    setMessage({ text: `Copied ${nodes.length} node(s) with what is under them: Ctrl+V pastes after the selected node.`, kind: 'info' });
+  };
+  const cut = () => {
+    const nodes = selectedNodes();
+    if (nodes.length === 0) return;
+    const root = T.findTree(plan, treeId)?.root ?? null;
+    const first = T.locate(root, nodes[0].key);
+    const before = first?.parent ? first.parent.children[first.index - 1]?.key ?? first.parent.key : null;
+    try {
+      const next = T.removeNodes(plan, treeId, nodes.map((n) => n.key));
+      setClipboard(nodes.map(T.cloneNode));
+      setHistory(push(history, next));
+      setSelectedKey(before);
+      setMessage({ text: `Cut ${nodes.length} node(s): Ctrl+V pastes them after the selected node.`, kind: 'info' });
+    } catch (e) {
+      setMessage({ text: (e as Error).message, kind: 'error' });
+    }
+  };
+  const paste = () => {
+    if (clipboard.length === 0) {
+      setMessage({ text: 'Nothing to paste: copy (Ctrl+C) or cut (Ctrl+X) nodes first.', kind: 'error' });
       return;
     }
-    const node = T.makeNode(type);
-    const tree = T.findTree(plan, treeId);
-    if (mode === 'sibling' && selectedKey && tree?.root?.key !== selectedKey) {
-      edit((p) => T.addSibling(p, treeId, selectedKey, node, kindOf), node.key);
-    } else {
-      edit((p) => T.addChild(p, treeId, selectedKey, node, kindOf), node.key);
+    // After the last selected node (a copied range stays selected), as fresh copies: the
+    // clipboard pastes again.
+    const chosen = selectedNodes();
+    insert(clipboard.map(T.cloneNode), chosen.length ? chosen[chosen.length - 1].key : selectedKey);
+  };
+  const duplicate = () => {
+    const nodes = selectedNodes();
+    if (nodes.length === 0) return;
+    const root = T.findTree(plan, treeId)?.root ?? null;
+    const last = nodes[nodes.length - 1];
+    if (last.key === root?.key) {
+      setMessage({ text: 'The root cannot be duplicated: select nodes under it.', kind: 'error' });
+      return;
     }
+    const copies = nodes.map(T.cloneNode);
+    edit((p) => {
+      let next = p;
+      let after = last.key;
+      for (const node of copies) {
+        next = T.addSibling(next, treeId, after, node, kindOf);
+        after = node.key;
+      }
+      return next;
+    }, copies[copies.length - 1].key);
+  };
+  const removeSelected = () => {
+    const nodes = selectedNodes();
+    if (nodes.length === 0) return;
+    const root = T.findTree(plan, treeId)?.root ?? null;
+    const first = T.locate(root, nodes[0].key);
+    const next = first?.parent ? first.parent.children[first.index - 1]?.key ?? first.parent.key : null;
+    edit((p) => T.removeNodes(p, treeId, nodes.map((n) => n.key)), next);
+  };
+  const select = (key: string, mode: SelectMode) => {
+    const root = T.findTree(replay ? replay.plan : plan, treeId)?.root ?? null;
+    if (mode === 'range' && selectedKey) {
+      setSelectedKeys(new Set(T.siblingRange(root, selectedKey, key)));
+      return; // the primary node stays where the range started
+    }
+    if (mode === 'toggle') {
+      const next = new Set(selectedKeys);
+      if (next.has(key)) next.delete(key);
+      else next.add(key);
+      setSelectedKeys(next);
+      setSelectedKeyOnly(key);
+      return;
+    }
+    setSelectedKey(key);
   };
 
   const tree = T.findTree(replay ? replay.plan : plan, treeId) ?? T.findTree(replay ? replay.plan : plan, (replay ? replay.plan : plan).mainTree);
@@ -173,19 +306,57 @@ export function App() {
     const onKey = (e: KeyboardEvent) => {
       const target = e.target as HTMLElement;
       if (target && ['INPUT', 'SELECT', 'TEXTAREA'].includes(target.tagName)) return;
-      if ((e.ctrlKey || e.metaKey) && e.key.toLowerCase() === 'z') {
-        e.preventDefault();
-        setHistory(e.shiftKey ? redo(history) : undo(history));
-      } else if ((e.ctrlKey || e.metaKey) && e.key.toLowerCase() === 'y') {
-        e.preventDefault();
-        setHistory(redo(history));
-      } else if (e.key === 'Delete' && selectedKey && !replay) {
-        edit((p) => T.removeNode(p, treeId, selectedKey), null);
-      }
+      const ctrl = e.ctrlKey || e.metaKey;
+      const key = e.key.toLowerCase();
+      const root = tree?.root ?? null;
+      const go = (direction: 'parent' | 'child' | 'previous' | 'next') => {
+        const next = selectedKey ? T.neighbour(root, selectedKey, direction) : root?.key ?? null;
+        if (next) setSelectedKey(next);
+      };
+      // Siblings stand below one another (left to right) or side by side (top down).
+      const lr = orientation === 'LR';
+      const arrows: Record<string, 'parent' | 'child' | 'previous' | 'next'> = lr
+        ? { arrowleft: 'parent', arrowright: 'child', arrowup: 'previous', arrowdown: 'next' }
+        : { arrowup: 'parent', arrowdown: 'child', arrowleft: 'previous', arrowright: 'next' };
+      let handled = true;
+      if (e.key === '?' || e.key === 'F1') setHelp((h) => !h);
+      else if (e.key === 'Escape') {
+        setHelp(false);
+        if (selectedKey) setSelectedKey(selectedKey);
+      } else if (ctrl && key === 'z') setHistory(e.shiftKey ? redo(history) : undo(history));
+      else if (ctrl && key === 'y') setHistory(redo(history));
+      else if (ctrl && key === 'c') copy();
+      else if (ctrl && key === 'x' && !replay) cut();
+      else if (ctrl && key === 'v' && !replay) paste();
+      else if (ctrl && key === 'd' && !replay) duplicate();
+      else if (ctrl && key === 's') void save();
+      else if ((e.key === 'Delete' || e.key === 'Backspace') && selectedKey && !replay) removeSelected();
+      else if (e.altKey && selectedKey && !replay && (key === (lr ? 'arrowup' : 'arrowleft') || key === (lr ? 'arrowdown' : 'arrowright')))
+        edit((p) => T.shiftNode(p, treeId, selectedKey, key === (lr ? 'arrowup' : 'arrowleft') ? -1 : 1));
+      else if (arrows[key] && !ctrl) go(arrows[key]);
+      else if (e.key === ' ' && selectedKey && T.locate(root, selectedKey)?.node.children.length && !replay)
+        setHistory(replace(history, T.toggleCollapsed(plan, treeId, selectedKey)));
+      else handled = false;
+      if (handled) e.preventDefault();
     };
     window.addEventListener('keydown', onKey);
     return () => window.removeEventListener('keydown', onKey);
   });
+
+  // Once Check has found problems, they follow the edits: checked again after each change.
+  const hasDiagnostics = diagnostics.length > 0;
+  useEffect(() => {
+    if (!hasDiagnostics || replay) return;
+    const timer = setTimeout(() => {
+      try {
+        api.validate(T.toPlanJson(plan)).then((r) => setDiagnostics(r.diagnostics), () => undefined);
+      } catch {
+        // an empty tree: Check says so when clicked
+      }
+    }, 250);
+    return () => clearTimeout(timer);
+    // eslint-disable-next-line react-hooks/exhaustive-deps
+  }, [plan, hasDiagnostics]);
 
   // --- files ---------------------------------------------------------------------------------
   const loadPlan = (json: ReturnType<typeof T.toPlanJson>, name: string, version?: number) => {
@@ -197,6 +368,8 @@ export function App() {
     setSaved(version ? { name, plan: next, version } : null);
     setDiagnostics([]);
     setReplay(null);
+    // Another plan: the statuses of the last run belong to the plan that ran.
+    setLive((l) => (l && l.run.active && l.run.plan === name ? { ...l, mapping: mapRun(next, l.run.nodes ?? []) } : null));
   };
 
   const save = async (): Promise<{ name: string; version: number } | null> => {
@@ -232,7 +405,8 @@ export function App() {
       } else {
         started = await api.runPlan(T.toPlanJson(plan), startPaused);
       }
-      setMessage({ text: `Run #${started.run} started.`, kind: 'info' });
+      startedHere.current.add(started.run);
+      if (!endedRuns.current.has(started.run)) setMessage({ text: `Run #${started.run} started.`, kind: 'info' });
       setDiagnostics([]);
     } catch (e) {
       fail(e);
@@ -311,15 +485,18 @@ export function App() {
   };
 
   // --- what the panes show ---------------------------------------------------------------------
+  // A run's statuses are painted on this plan when this page started it, or it is a run of
+  // the plan open here (by name); another plan's run only shows in the status line.
+  const liveIsOurs = !!live && (startedHere.current.has(live.run.id) || (!!live.run.plan && live.run.plan === planName));
   const replayStatuses = useMemo(
     () => (replay ? statusesAt(replay.log.transition_list, replay.index) : null),
     [replay],
   );
   const shownStatuses = useMemo(() => {
     if (replay && replayStatuses) return statusesByKey(replayStatuses, replay.mapping, tree?.id ?? treeId);
-    if (live) return statusesByKey(live.statuses, live.mapping, tree?.id ?? treeId);
+    if (live && liveIsOurs) return statusesByKey(live.statuses, live.mapping, tree?.id ?? treeId);
     return new Map<string, NodeStatus>();
-  }, [replay, replayStatuses, live, tree, treeId]);
+  }, [replay, replayStatuses, live, liveIsOurs, tree, treeId]);
   const problems = useMemo(() => {
     const map = new Map<string, string>();
     for (const d of diagnostics) {
@@ -348,25 +525,11 @@ export function App() {
       <header className="menu" aria-label="Menu">
         <span className="brand">costar</span>
         <span className="pane-number">8</span>
-        {info?.features.detect && (
-          <button type="button" disabled={running} onClick={() => runOperation(info.features.detect_node)}>
-            Detect objects
+        {quickActions(info).map((action) => (
+          <button key={action.label} type="button" disabled={running} title={action.title} onClick={() => runOperation(action.node)}>
+            {action.label}
           </button>
-        )}
-        {info?.features.calibrate && (
-          <button type="button" disabled={running} onClick={() => runOperation(info.features.calibrate_node)}>
-            Calibrate
-          </button>
-        )}
-        <button type="button" disabled={running} onClick={() => runOperation('Home')}>
-          Home
-        </button>
-        <button type="button" disabled={running} onClick={() => runOperation('Open')}>
-          Open gripper
-        </button>
-        <button type="button" disabled={running} onClick={() => runOperation('Close')}>
-          Close gripper
-        </button>
+        ))}
         <span className="separator" />
         <input
           className="plan-name"
@@ -413,6 +576,7 @@ export function App() {
             setPlanName('');
             setSaved(null);
             setDiagnostics([]);
+            setLive((l) => (l && l.run.active ? l : null));
           }}
         >
           New
@@ -458,21 +622,18 @@ export function App() {
         <span className={`connection ${connected ? 'on' : 'off'}`}>{connected ? info?.workcell ?? 'connected' : 'disconnected'}</span>
       </header>
 
-      {!token && (
-        <div className="banner">
-          Changes need the token that <code>costar serve</code> printed:{' '}
-          <input
-            aria-label="token"
-            placeholder="paste the token"
-            onKeyDown={(e) => {
-              if (e.key === 'Enter') {
-                storeToken((e.target as HTMLInputElement).value.trim());
-                setToken((e.target as HTMLInputElement).value.trim());
-              }
-            }}
-          />
-        </div>
+      {signIn && (
+        <SignIn
+          problem={signIn}
+          onToken={(t) => {
+            storeToken(t);
+            setToken(t);
+            setSignIn(null);
+          }}
+          onDismiss={() => setSignIn(null)}
+        />
       )}
+      {help && <HelpOverlay onClose={() => setHelp(false)} />}
       <div className={`status-line ${message?.kind ?? ''}`} role="status">
         <span className="run-label" data-run-result={live && !live.run.active ? live.run.result : ''}>
           {runLabel}
@@ -486,7 +647,7 @@ export function App() {
         {message && <span className="message">{message.text}</span>}
       </div>
 
-      <Palette nodes={nodes} selected={paletteType} onSelect={setPaletteType} onAdd={(id) => addNode(id, 'child')} />
+      <Palette nodes={nodes} disabled={!!replay} onAdd={addNode} />
 
       {/* 4: the workspace (and 7: live status on each node) */}
       <section className="pane workspace" aria-label="Behavior tree">
@@ -495,15 +656,22 @@ export function App() {
           {replay && <span className="replaying">replaying run #{replay.log.id} (read only)</span>}
         </h2>
         <div className="toolbar">
-          <button type="button" disabled={!!replay} onClick={() => addNode(paletteType, 'child')}>
-            Add child
+          <button type="button" disabled={!!replay || !selectedKey} onClick={copy} title="Copy the selected nodes and what is under them (Ctrl+C)">
+            Copy
           </button>
-          <button type="button" disabled={!!replay} onClick={() => addNode(paletteType, 'sibling')}>
-            Add sibling
+          <button type="button" disabled={!!replay || !selectedKey} onClick={cut} title="Cut (Ctrl+X)">
+            Cut
+          </button>
+          <button type="button" disabled={!!replay || clipboard.length === 0} onClick={paste} title="Paste after the selected node, or inside it if it takes children (Ctrl+V)">
+            Paste
+          </button>
+          <button type="button" disabled={!!replay || !selectedKey} onClick={duplicate} title="Duplicate right after (Ctrl+D)">
+            Duplicate
           </button>
           <button
             type="button"
             disabled={!!replay || !selectedKey}
+            title="Move before the previous sibling (Alt+↑)"
             onClick={() => selectedKey && edit((p) => T.shiftNode(p, treeId, selectedKey, -1))}
           >
             ↑
@@ -511,18 +679,25 @@ export function App() {
           <button
             type="button"
             disabled={!!replay || !selectedKey}
+            title="Move after the next sibling (Alt+↓)"
             onClick={() => selectedKey && edit((p) => T.shiftNode(p, treeId, selectedKey, 1))}
           >
             ↓
           </button>
-          <button type="button" disabled={!!replay || !selectedKey} onClick={() => selectedKey && edit((p) => T.removeNode(p, treeId, selectedKey), null)}>
+          <button type="button" disabled={!!replay || !selectedKey} onClick={removeSelected} title="Delete the selected nodes (Delete)">
             Delete
           </button>
-          <button type="button" disabled={!canUndo(history) || !!replay} onClick={() => setHistory(undo(history))}>
+          <button type="button" disabled={!canUndo(history) || !!replay} onClick={() => setHistory(undo(history))} title="Ctrl+Z">
             Undo
           </button>
-          <button type="button" disabled={!canRedo(history) || !!replay} onClick={() => setHistory(redo(history))}>
+          <button type="button" disabled={!canRedo(history) || !!replay} onClick={() => setHistory(redo(history))} title="Ctrl+Y">
             Redo
+          </button>
+          <button type="button" onClick={() => setOrientation((o) => (o === 'LR' ? 'TB' : 'LR'))} title="Lay the tree out left to right or top down">
+            {orientation === 'LR' ? '→ layout' : '↓ layout'}
+          </button>
+          <button type="button" onClick={() => setHelp(true)} title="Keyboard shortcuts (?)">
+            ? Keys
           </button>
           <span className="separator" />
           <button type="button" disabled={!selected || !!replay} onClick={saveSubtree}>
@@ -536,13 +711,14 @@ export function App() {
               </option>
             ))}
           </select>
-          <button type="button" disabled={!subtreeChoice || !!replay} onClick={() => insertSubtree(false)}>
-            Insert copy
+          <button type="button" disabled={!subtreeChoice || !!replay} onClick={() => insertSubtree(false)} title="Insert a copy of the saved subtree">
+            Insert
           </button>
-          <button type="button" disabled={!subtreeChoice || !!replay} onClick={() => insertSubtree(true)}>
-            Insert as SubTree
+          <button type="button" disabled={!subtreeChoice || !!replay} onClick={() => insertSubtree(true)} title="Insert a SubTree node that names it (and add its BehaviorTree to the file)">
+            As SubTree
           </button>
         </div>
+        {(replay ? replay.plan : plan).trees.length > 1 && (
         <div className="tabs">
           {(replay ? replay.plan : plan).trees.map((t) => (
             <button
@@ -559,15 +735,18 @@ export function App() {
             </button>
           ))}
         </div>
-        <div className="tree-scroll">
-          <TreeView
+        )}
+        <div className="tree-canvas" aria-label="tree canvas">
+          <TreeCanvas
             root={tree?.root ?? null}
             nodeInfo={nodeInfo}
             selectedKey={selectedKey}
+            selectedKeys={selectedKeys}
             statuses={shownStatuses}
             problems={problems}
             readOnly={!!replay}
-            onSelect={setSelectedKey}
+            orientation={orientation}
+            onSelect={select}
             onToggle={(key) => setHistory(replace(history, T.toggleCollapsed(plan, treeId, key)))}
             onMove={(key, target, position) => edit((p) => T.moveNode(p, treeId, key, target, position, kindOf))}
             onDropNew={(id, target, position) => {
@@ -580,6 +759,10 @@ export function App() {
             }}
           />
         </div>
+        <p className="hint tree-hint">
+          Click an operation (6) to insert it after the selected node, or inside it if it takes children · Shift+click selects
+          siblings · Ctrl+C/X/V/D · arrows move the selection · ? lists every key
+        </p>
       </section>
 
       <NodeEditor
@@ -589,7 +772,10 @@ export function App() {
         objects={cell?.objects.map((o) => o.name) ?? []}
         trees={plan.trees.map((t) => t.id).filter((id) => id !== treeId)}
         readOnly={!!replay}
-        onChange={(name, value) => selectedKey && edit((p) => T.setAttribute(p, treeId, selectedKey, name, value))}
+        onChange={(name, value, clear) =>
+          selectedKey &&
+          edit((p) => (clear ?? []).reduce((q, other) => T.setAttribute(q, treeId, selectedKey, other, undefined), T.setAttribute(p, treeId, selectedKey, name, value)))
+        }
       />
       <ObjectsPane state={cell} selectedType={selected?.id ?? null} data={selectedData} />
       <View3D

@@ -10,6 +10,10 @@ export interface PortInfo {
   default?: string;
   choices?: string[];
   choices_from?: string;
+  /** Offered besides the choices_from list (SmartRelease's target: 'table'). */
+  extra_choices?: string[];
+  /** Parameters cleared when this one is set (they cannot be given together). */
+  excludes?: string[];
   min?: number;
   max?: number;
 }
@@ -167,5 +171,5 @@ export class Api {
   runs = () => this.request<StoredRun[]>('GET', '/api/runs');
   runLog = (id: number) => this.request<RunLog>('GET', `/api/runs/${id}`);
   pointCloud = (max = 20000) =>
-    this.request<{ points: number[]; colors: number[] }>('GET', `/api/pointcloud?max=${max}`);
+    this.request<{ points: number[]; colors: number[]; t?: number }>('GET', `/api/pointcloud?max=${max}`);
 }

@@ -3,15 +3,18 @@
 
 const KEY = 'costar-token';
 
-export function readToken(): string {
+/** The token in the address's fragment (#token=...), kept and removed from the address bar. */
+export function tokenFromHash(): string {
   const match = /(?:^#|&)token=([^&]+)/.exec(location.hash);
-  if (match) {
-    const token = decodeURIComponent(match[1]);
-    sessionStorage.setItem(KEY, token);
-    history.replaceState(null, '', location.pathname + location.search);
-    return token;
-  }
-  return sessionStorage.getItem(KEY) ?? '';
+  if (!match) return '';
+  const token = decodeURIComponent(match[1]).trim();
+  sessionStorage.setItem(KEY, token);
+  history.replaceState(null, '', location.pathname + location.search);
+  return token;
+}
+
+export function readToken(): string {
+  return tokenFromHash() || (sessionStorage.getItem(KEY) ?? '');
 }
 
 export function storeToken(token: string) {

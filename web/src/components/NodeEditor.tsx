@@ -12,7 +12,8 @@ interface Props {
   objects: string[];
   trees: string[];
   readOnly: boolean;
-  onChange: (name: string, value: string | undefined) => void;
+  /** Sets one parameter; `clear` names others removed in the same edit (one undo step). */
+  onChange: (name: string, value: string | undefined, clear?: string[]) => void;
 }
 
 function value(node: EditorNode, name: string): string | undefined {
@@ -90,12 +91,12 @@ function PredicateList(props: {
                 </option>
               ))}
           </select>
-          (part
+          <span className="predicate-part">(part</span>
           {term.args
             .filter((a) => a !== '?')
             .map((arg, j) => (
-              <span key={j}>
-                ,{' '}
+              <span key={j} className="predicate-arg">
+                ,
                 <select
                   value={arg}
                   disabled={props.disabled}
@@ -116,9 +117,10 @@ function PredicateList(props: {
                 </select>
               </span>
             ))}
-          )
+          <span>)</span>
           <button
             type="button"
+            className="remove-condition"
             disabled={props.disabled}
             onClick={() => update(terms.filter((_, k) => k !== i))}
             aria-label="remove condition"
@@ -127,17 +129,25 @@ function PredicateList(props: {
           </button>
         </div>
       ))}
-      <button
-        type="button"
+      <select
+        aria-label="add condition"
+        className="add-condition"
+        value=""
         disabled={props.disabled}
-        onClick={() => {
-          const name = props.choices.predicate.find((p) => p.name === 'right_of')?.name ??
-            props.choices.predicate.find((p) => p.arity >= 1)?.name ?? 'near';
-          update([...terms, { name, args: withArity(name, []) }]);
+        onChange={(e) => {
+          const name = e.target.value;
+          if (name) update([...terms, { name, args: withArity(name, []) }]);
         }}
       >
-        + condition
-      </button>
+        <option value="">+ condition…</option>
+        {props.choices.predicate
+          .filter((p) => p.arity >= 1)
+          .map((p) => (
+            <option key={p.name} value={p.name} title={p.description}>
+              {p.name}(part{p.arity > 1 ? ', …' : ''})
+            </option>
+          ))}
+      </select>
     </div>
   );
 }
@@ -154,6 +164,16 @@ export function NodeEditor({ node, info, choices, objects, trees, readOnly, onCh
     );
   }
   const frames = choices?.frame ?? ['world'];
+  // Parameters that cannot stand with the new value: those the port excludes (SmartRelease's
+  // target and target_class), and a grasp not taught for a newly chosen class.
+  const changedWith = (port: PortInfo, v: string): string[] => {
+    const clear = [...(port.excludes ?? [])].filter((name) => value(node, name) !== undefined);
+    if (port.name === 'object_class') {
+      const grasp = value(node, 'grasp');
+      if (grasp !== undefined && !(choices?.grasp?.[v] ?? []).includes(grasp)) clear.push('grasp');
+    }
+    return clear;
+  };
   const references = [...new Set([...frames, ...objects, ...(choices?.object_class ?? [])])];
   const inputFor = (port: PortInfo) => {
     const id = `port-${port.name}`;
@@ -192,6 +212,7 @@ export function NodeEditor({ node, info, choices, objects, trees, readOnly, onCh
       return <PredicateList id={id} text={current ?? ''} choices={choices} references={references} disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;
     }
     let list: string[] | undefined = port.choices;
+    let shownPlaceholder = placeholder;
     if (port.choices_from === 'waypoint') list = choices?.waypoint ?? [];
     if (port.choices_from === 'frame') list = frames;
     if (port.choices_from === 'object_class') list = port.choices ?? choices?.object_class ?? [];
@@ -199,9 +220,22 @@ export function NodeEditor({ node, info, choices, objects, trees, readOnly, onCh
       const objectClass = value(node, 'object_class');
       const grasps = choices?.grasp ?? {};
       list = objectClass ? grasps[objectClass] ?? [] : [...new Set(Object.values(grasps).flat())];
+      if (port.default === '') shownPlaceholder = `default: the first taught${objectClass && list[0] ? ` (${list[0]})` : ''}`;
     }
+    if (list && port.extra_choices) list = [...port.extra_choices, ...list.filter((c) => !port.extra_choices!.includes(c))];
     if (list) {
-      return <Select id={id} current={current} options={list} placeholder={placeholder} disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;
+      // The empty choice of an optional list is its default: shown by the placeholder.
+      const options = port.default === '' ? list.filter((c) => c !== '') : list;
+      return (
+        <Select
+          id={id}
+          current={current}
+          options={options}
+          placeholder={shownPlaceholder}
+          disabled={readOnly}
+          onChange={(v) => onChange(port.name, v, v !== undefined ? changedWith(port, v) : undefined)}
+        />
+      );
     }
     if (port.type === 'int' || port.type === 'double') {
       return (

@@ -31,6 +31,63 @@ interface Props {
   data: SmartMoveData | null;
 }
 
+/** Feasible candidates by cost, the chosen one first; rejected ones grouped by their reason. */
+export function groupCandidates(candidates: Candidate[]) {
+  const feasible = candidates
+    .filter((c) => !c.rejected)
+    .sort((a, b) => Number(b.chosen) - Number(a.chosen) || (a.cost ?? Infinity) - (b.cost ?? Infinity));
+  const groups = new Map<string, Candidate[]>();
+  for (const c of candidates) {
+    if (!c.rejected) continue;
+    const list = groups.get(c.rejected) ?? [];
+    list.push(c);
+    groups.set(c.rejected, list);
+  }
+  const rejected = [...groups.entries()]
+    .map(([reason, list]) => ({ reason, candidates: list }))
+    .sort((a, b) => b.candidates.length - a.candidates.length);
+  return { feasible, rejected };
+}
+
+function CandidateTable({ data, known }: { data: SmartMoveData; known: Set<string> }) {
+  const { feasible, rejected } = groupCandidates(data.candidates ?? []);
+  const label = (c: Candidate) => `${c.object}${c.symmetry ? ` ↻${c.symmetry}` : ''}`;
+  const gone = (c: Candidate) => !known.has(c.object) && !c.object.startsWith('table(') && known.size > 0;
+  return (
+    <>
+      <table>
+        <thead>
+          <tr>
+            <th>candidate</th>
+            <th>cost</th>
+            <th></th>
+          </tr>
+        </thead>
+        <tbody>
+          {feasible.map((c, i) => (
+            <tr key={i} className={c.chosen ? 'chosen' : ''}>
+              <td>
+                {label(c)}
+                {gone(c) && <span className="dim"> (not known now)</span>}
+              </td>
+              <td>{c.cost !== undefined ? c.cost.toFixed(3) : ''}</td>
+              <td>{c.chosen ? '✓ chosen' : 'feasible'}</td>
+            </tr>
+          ))}
+        </tbody>
+      </table>
+      {rejected.map((group) => (
+        <details key={group.reason} className="rejected-group">
+          <summary className="group">
+            {group.candidates.length} rejected: {group.reason}
+          </summary>
+          <p className="dim">{[...new Set(group.candidates.map((c) => c.object))].join(', ')}</p>
+        </details>
+      ))}
+    </>
+  );
+}
+
 export function ObjectsPane({ state, selectedType, data }: Props) {
   const objects = state?.objects ?? [];
   const smart = selectedType !== null && selectedType.startsWith('Smart');
@@ -74,26 +131,7 @@ export function ObjectsPane({ state, selectedType, data }: Props) {
             )}
             {data.seconds !== undefined && ` in ${(data.seconds * 1000).toFixed(1)} ms`}
           </p>
-          <table>
-            <thead>
-              <tr>
-                <th>object</th>
-                <th>sym.</th>
-                <th>cost</th>
-                <th>rejected because</th>
-              </tr>
-            </thead>
-            <tbody>
-              {(data.candidates ?? []).map((c, i) => (
-                <tr key={i} className={c.chosen ? 'chosen' : c.rejected ? 'rejected' : ''}>
-                  <td>{c.object}</td>
-                  <td>{c.symmetry}</td>
-                  <td>{c.cost !== undefined ? c.cost.toFixed(3) : ''}</td>
-                  <td>{c.rejected ?? (c.chosen ? '✓ chosen' : '')}</td>
-                </tr>
-              ))}
-            </tbody>
-          </table>
+          <CandidateTable data={data} known={new Set(objects.map((o) => o.name))} />
         </div>
       )}
       {state && state.predicates.length > 0 && (

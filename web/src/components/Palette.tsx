@@ -1,5 +1,6 @@
 // Pane 6: the operations the system offers (GET /api/nodes, the same list as `costar nodes`),
-// grouped by colour: internal nodes blue, robot actions green, knowledge purple.
+// grouped by colour: internal nodes blue, robot actions green, knowledge purple. A click
+// inserts the operation at the selection; dragging it onto a node puts it before, after or in it.
 
 import { useMemo, useState } from 'react';
 import type { NodeInfo } from '../api';
@@ -12,12 +13,12 @@ const GROUPS: { category: NodeInfo['category']; title: string }[] = [
 
 interface Props {
   nodes: NodeInfo[];
-  selected: string | null;
-  onSelect: (id: string) => void;
+  disabled: boolean;
+  /** Inserts the operation at the selection (after the selected node, or inside it). */
   onAdd: (id: string) => void;
 }
 
-export function Palette({ nodes, selected, onSelect, onAdd }: Props) {
+export function Palette({ nodes, disabled, onAdd }: Props) {
   const [filter, setFilter] = useState('');
   const shown = useMemo(() => {
     const f = filter.trim().toLowerCase();
@@ -46,7 +47,8 @@ export function Palette({ nodes, selected, onSelect, onAdd }: Props) {
                 <button
                   key={n.id}
                   type="button"
-                  className={`palette-item cat-${n.category} ${selected === n.id ? 'chosen' : ''}`}
+                  className={`palette-item cat-${n.category}`}
+                  disabled={disabled}
                   data-node-type={n.id}
                   title={n.description}
                   draggable
@@ -54,8 +56,7 @@ export function Palette({ nodes, selected, onSelect, onAdd }: Props) {
                     e.dataTransfer.setData('application/x-costar-new', n.id);
                     e.dataTransfer.effectAllowed = 'copy';
                   }}
-                  onClick={() => onSelect(n.id)}
-                  onDoubleClick={() => onAdd(n.id)}
+                  onClick={() => onAdd(n.id)}
                 >
                   {n.id}
                 </button>

@@ -5,6 +5,7 @@
 
 import { useEffect, useRef, useState } from 'react';
 import * as THREE from 'three';
+import { believe, Belief, emptyBelief } from '../model/belief';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import type { Api, CellState } from '../api';
 import { position, ur5Frames } from '../model/kinematics';
@@ -70,6 +71,8 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
   const sceneRef = useRef<Scene | null>(null);
   const [error, setError] = useState<string | null>(null);
   const [cloudInfo, setCloudInfo] = useState<string>('');
+  const [cloudTime, setCloudTime] = useState<number | null>(null);
+  const beliefRef = useRef<Belief>(emptyBelief());
 
   useEffect(() => {
     const element = mount.current;
@@ -167,14 +170,17 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       s.robot.add(gripper);
     }
     clear(s.parts);
+    const believed = believe(beliefRef.current, state);
+    beliefRef.current = believed.belief;
     for (const object of state.objects) {
+      const pose = believed.poses.get(object.name) ?? object;
       const size = CLASS_SIZES[object.class] ?? [0.04, 0.04, 0.04];
       const mesh = new THREE.Mesh(
         new THREE.BoxGeometry(...size),
         new THREE.MeshLambertMaterial({ color: object.class === 'link' ? 0x3fa34d : 0xd9534f }),
       );
-      mesh.position.set(...object.p);
-      mesh.quaternion.set(...object.q);
+      mesh.position.set(...pose.p);
+      mesh.quaternion.set(...pose.q);
       s.parts.add(mesh);
     }
     clear(s.waypoints);
@@ -234,6 +240,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       s.cloud.add(new THREE.Points(geometry, new THREE.PointsMaterial({ size: 0.004, vertexColors: cloud.colors.length > 0 })));
       s.render();
       setCloudInfo(`${cloud.points.length / 3} points`);
+      setCloudTime(cloud.t ?? state?.t ?? null);
     } catch (e) {
       setCloudInfo((e as Error).message);
     }
@@ -266,11 +273,17 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
                   sceneRef.current.render();
                 }
                 setCloudInfo('');
+                setCloudTime(null);
               }}
             >
               Hide
             </button>
             <span className="dim">{cloudInfo}</span>
+            {cloudTime !== null && state && (
+              <span className={`pointcloud-age ${state.t - cloudTime > 5 ? 'stale' : ''}`} title="The point cloud is a snapshot: capture it again to see the cell now">
+                taken {Math.max(0, state.t - cloudTime).toFixed(0)} s ago
+              </span>
+            )}
           </>
         )}
       </h2>

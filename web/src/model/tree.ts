@@ -333,3 +333,93 @@ export function samePlan(a: EditorPlan, b: EditorPlan): boolean {
     return false;
   }
 }
+
+// --- clipboard and insertion (Ctrl+C/X/V/D, the palette) ------------------------------------------
+
+/** Whether `key` is a node that takes children (a control node, or a decorator without one). */
+export function isContainer(root: EditorNode | null, key: string, kindOf: KindLookup): boolean {
+  const node = locate(root, key)?.node;
+  return !!node && acceptsChild(node, kindOf);
+}
+
+/**
+ * Inserts `nodes` where a technician expects after selecting `key`: inside it as its last
+ * children when it takes children (a Sequence, an empty decorator), else right after it. Into
+ * an empty tree the first node becomes the root.
+ */
+export function insertAt(
+  plan: EditorPlan,
+  treeId: string,
+  key: string | null,
+  nodes: EditorNode[],
+  kindOf: KindLookup,
+): EditorPlan {
+  const tree = findTree(plan, treeId);
+  if (!tree) throw new Error(`no tree '${treeId}'`);
+  if (nodes.length === 0) return plan;
+  if (!tree.root) {
+    if (nodes.length > 1) throw new Error('an empty tree takes one root node: paste into it one by one');
+    return withTree(plan, treeId, () => nodes[0]);
+  }
+  const at = key ?? tree.root.key;
+  if (isContainer(tree.root, at, kindOf)) {
+    const target = locate(tree.root, at)!.node;
+    if (kindOf(target.id) === 'Decorator' && nodes.length > 1) throw new Error(`${target.id} takes exactly one child`);
+    let next = plan;
+    for (const node of nodes) next = addChild(next, treeId, at, node, kindOf);
+    return next;
+  }
+  let next = plan;
+  let after = at;
+  for (const node of nodes) {
+    next = addSibling(next, treeId, after, node, kindOf);
+    after = node.key;
+  }
+  return next;
+}
+
+/** The selected nodes to copy: in tree order, without those inside another selected node. */
+export function topmostSelected(root: EditorNode | null, keys: Iterable<string>): EditorNode[] {
+  const wanted = new Set(keys);
+  const out: EditorNode[] = [];
+  const walk = (node: EditorNode) => {
+    if (wanted.has(node.key)) {
+      out.push(node);
+      return;
+    }
+    node.children.forEach(walk);
+  };
+  if (root) walk(root);
+  return out;
+}
+
+/** Removes every node with one of `keys` (and its subtree); the root cannot be cut. */
+export function removeNodes(plan: EditorPlan, treeId: string, keys: Iterable<string>): EditorPlan {
+  const tree = findTree(plan, treeId);
+  let next = plan;
+  for (const node of topmostSelected(tree?.root ?? null, keys)) {
+    if (node.key === tree?.root?.key) throw new Error('the root cannot be removed: delete its children, or start a new plan');
+    next = removeNode(next, treeId, node.key);
+  }
+  return next;
+}
+
+/** Keys of the siblings from `from` to `to` (inclusive, either order), or [to] if they are not siblings. */
+export function siblingRange(root: EditorNode | null, from: string, to: string): string[] {
+  const a = locate(root, from);
+  const b = locate(root, to);
+  if (!a || !b || !a.parent || a.parent.key !== b.parent?.key) return [to];
+  const [lo, hi] = a.index <= b.index ? [a.index, b.index] : [b.index, a.index];
+  return a.parent.children.slice(lo, hi + 1).map((n) => n.key);
+}
+
+/** For keyboard navigation: the parent, first child, previous or next sibling of `key`. */
+export function neighbour(root: EditorNode | null, key: string, direction: 'parent' | 'child' | 'previous' | 'next'): string | null {
+  const at = locate(root, key);
+  if (!at) return null;
+  if (direction === 'parent') return at.parent?.key ?? null;
+  if (direction === 'child') return at.node.collapsed ? null : at.node.children[0]?.key ?? null;
+  if (!at.parent) return null;
+  const index = at.index + (direction === 'next' ? 1 : -1);
+  return at.parent.children[index]?.key ?? null;
+}

@@ -1,0 +1,122 @@
+// The waypoint file: what a person may write in it, and the errors for everything else (issue
+// 10: duplicate names, zero quaternions and unreadable files were accepted or misreported).
+
+#include "arm/waypoints.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace costar::arm {
+namespace {
+
+class WaypointFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = std::filesystem::temp_directory_path() /
+              ("costar_waypoint_file_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    std::filesystem::remove_all(folder_);
+    std::filesystem::create_directories(folder_);
+  }
+  void TearDown() override { std::filesystem::remove_all(folder_); }
+
+  std::filesystem::path write(const std::string& content) {
+    const auto file = folder_ / "waypoints.json";
+    std::ofstream(file) << content;
+    return file;
+  }
+
+  /// The error loading `content` gives, without the "waypoint file 'PATH': " prefix.
+  std::string problem(const std::string& content) {
+    const auto file = write(content);
+    const std::string prefix = "waypoint file '" + file.string() + "': ";
+    try {
+      WaypointStore store(file);
+    } catch (const std::runtime_error& e) {
+      const std::string message = e.what();
+      return message.rfind(prefix, 0) == 0 ? message.substr(prefix.size()) : "(no file named) " + message;
+    }
+    return "no error";
+  }
+
+  std::filesystem::path folder_;
+};
+
+TEST_F(WaypointFile, AValidFileLoads) {
+  const WaypointStore store(write(R"({"waypoints": [
+      {"name": "above", "frame": "table_center", "position": [0.1, 0.2, 0.3], "orientation": [0, 1, 0, 0]},
+      {"name": "home", "joints": [0, -2.3, 1.9, -1.17, -1.57, 0]}]})"));
+  ASSERT_EQ(store.all().size(), 2u);
+  EXPECT_EQ(store.find("above")->frame, "table_center");
+  EXPECT_TRUE(store.find("above")->pose.translation().isApprox(Eigen::Vector3d(0.1, 0.2, 0.3)));
+  EXPECT_TRUE(store.find("above")->pose.linear().isApprox(Eigen::Vector3d(1, -1, -1).asDiagonal().toDenseMatrix()));
+  EXPECT_EQ(store.find("home")->kind, Waypoint::Kind::kJoints);
+  EXPECT_EQ(store.find("home")->joints[1], -2.3);
+}
+
+TEST_F(WaypointFile, DuplicateNamesAreAnError) {
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "a", "joints": [0, 0, 0, 0, 0, 0]},
+                                      {"name": "b", "joints": [0, 0, 0, 0, 0, 0]},
+                                      {"name": "a", "joints": [1, 0, 0, 0, 0, 0]}]})"),
+            "waypoints[2].name: 'a' is taken already (by waypoints[0]); names must differ");
+}
+
+TEST_F(WaypointFile, AZeroOrNonUnitQuaternionIsAnErrorNamingTheField) {
+  // It used to be normalized to nan and fail much later, as "forearm_link would touch table".
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "p", "position": [0.4, 0, 0.2], "orientation": [0, 0, 0, 0]}]})"),
+            "waypoints[0].orientation: must be a unit quaternion [w, x, y, z], not [0,0,0,0] (length 0)");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "p", "position": [0.4, 0, 0.2], "orientation": [2, 0, 0, 0]}]})"),
+            "waypoints[0].orientation: must be a unit quaternion [w, x, y, z], not [2,0,0,0] (length 2)");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "p", "position": [0.4, 0, 0.2], "orientation": [1, 0, 0]}]})"),
+            "waypoints[0].orientation: must be a unit quaternion [w, x, y, z], not [1,0,0]");
+}
+
+TEST_F(WaypointFile, TypeAndShapeErrorsNameTheField) {
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "j", "joints": [0, 0, 0, 0, 0]}]})"),
+            "waypoints[0].joints: must be 6 angles (radians), not [0,0,0,0,0]");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "j", "joints": [0, 0, 0, 0, 0, 0, 0]}]})"),
+            "waypoints[0].joints: must be 6 angles (radians), not [0,0,0,0,0,0,0]");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "j", "joints": [0, 0, "1", 0, 0, 0]}]})"),
+            "waypoints[0].joints[2]: must be a finite number, not \"1\"");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "p", "position": [0.4, 0], "orientation": [1, 0, 0, 0]}]})"),
+            "waypoints[0].position: must be [x, y, z] (m), not [0.4,0]");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "p", "orientation": [1, 0, 0, 0]}]})"),
+            "waypoints[0].position: missing (a waypoint has \"joints\", or \"position\" [x, y, z] and \"orientation\" "
+            "[w, x, y, z])");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": 5, "joints": [0, 0, 0, 0, 0, 0]}]})"),
+            "waypoints[0].name: must be a string, not 5");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "x y", "joints": [0, 0, 0, 0, 0, 0]}]})"),
+            "waypoints[0].name: waypoint name 'x y' may contain only letters, digits, '_' and '-'");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "j", "joints": [0, 0, 0, 0, 0, 0], "frame": "world"}]})"),
+            "waypoints[0]: has both \"joints\" (a joint configuration) and \"frame\" (of a pose); give one");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "j", "joint": [0, 0, 0, 0, 0, 0]}]})"),
+            "waypoints[0].joint: unknown field (known: name, joints, frame, position, orientation)");
+  EXPECT_EQ(
+      problem(R"({"waypoints": [{"name": "p", "frame": 3, "position": [0, 0, 0], "orientation": [1, 0, 0, 0]}]})"),
+      "waypoints[0].frame: must be a string, not 3");
+  EXPECT_EQ(problem(R"({"waypoints": [7]})"), "waypoints[0]: must be an object {\"name\": ..., ...}, not 7");
+  EXPECT_EQ(problem(R"({"points": []})"), "waypoints: missing: the file is {\"waypoints\": [...]}");
+  // JSON syntax errors keep nlohmann's line and column.
+  EXPECT_NE(problem("{\"waypoints\": [\n  {\"name\": }]}").find("line 2"), std::string::npos);
+}
+
+TEST_F(WaypointFile, AnUnreadableFileIsReportedAsUnreadableNotAsBadJson) {
+  const auto message = [](const std::filesystem::path& file) {
+    try {
+      WaypointStore store(file);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(folder_), "cannot read waypoint file '" + folder_.string() + "': it is a folder");
+  const auto loop = folder_ / "loop.json";
+  std::filesystem::create_symlink(loop, loop);
+  EXPECT_EQ(message(loop), "cannot read waypoint file '" + loop.string() + "': Too many levels of symbolic links");
+  // A file that does not exist yet is an empty store (the first waypoint taught creates it).
+  EXPECT_TRUE(WaypointStore(folder_ / "new.json").all().empty());
+}
+
+}  // namespace
+}  // namespace costar::arm

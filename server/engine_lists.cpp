@@ -1,0 +1,160 @@
+// What the editor offers: the palette of node types with their ports (where each parameter's
+// choices come from, extra choices, exclusions, ranges), the workcell's info, and the choice
+// lists read from what the cell knows now (waypoints, frames, object classes, predicates, the
+// grasps taught per class).
+
+#include "server/engine_parts.h"
+
+#include <algorithm>
+#include <set>
+#include "sim/simulation.h"
+#include "smartmove/grasps.h"
+#include "workcell/workcell.h"
+
+namespace costar::server {
+
+void Engine::describeNodes() {
+  // The palette: every node type with its ports; operation parameters add where their
+  // choices come from and their range.
+  json nodes = json::array();
+  bool detect = false;
+  bool calibrate = false;
+  for (const bt::NodeSpec* spec : cell_.nodes().all()) {
+    const component::Component* provider = cell_.components().provider(spec->id);
+    const component::OperationSpec* operation =
+        provider != nullptr ? provider->description().operation(spec->id) : nullptr;
+    json ports = json::array();
+    for (const auto& port : spec->ports) {
+      json item = {{"name", port.name}, {"type", port.type_name}, {"description", port.description}};
+      if (port.default_value) {
+        item["default"] = *port.default_value;
+      }
+      if (!port.choices.empty()) {
+        item["choices"] = port.choices;
+      }
+      if (const component::ParamSpec* param = operation != nullptr ? operation->param(port.name) : nullptr) {
+        if (!param->choices_from.empty()) {
+          item["choices_from"] = param->choices_from;
+        }
+        if (!param->extra_choices.empty()) {
+          item["extra_choices"] = param->extra_choices;
+        }
+        if (!param->excludes.empty()) {
+          item["excludes"] = param->excludes;
+        }
+        if (param->min) {
+          item["min"] = *param->min;
+        }
+        if (param->max) {
+          item["max"] = *param->max;
+        }
+      }
+      ports.push_back(std::move(item));
+    }
+    json node = {{"id", spec->id},
+                 {"kind", bt::toString(spec->kind)},
+                 {"category", bt::toString(spec->category)},
+                 {"description", spec->description},
+                 {"asynchronous", spec->asynchronous},
+                 {"ports", std::move(ports)}};
+    if (provider != nullptr) {
+      node["component"] = provider->description().name;
+    }
+    nodes.push_back(std::move(node));
+    detect = detect || spec->id == "DetectObjects";
+    calibrate = calibrate || spec->id == "Calibrate" || spec->id == "HandEyeCalibration";
+  }
+  nodes_json_ = nodes.dump();
+  info_ = {{"workcell", cell_.name()},
+           {"description", cell_.description()},
+           {"simulated_clock", cell_.clock().simulated()},
+           {"simulator", cell_.simulation() != nullptr},
+           {"features",
+            {{"detect", detect},
+             {"calibrate", calibrate},
+             {"pointcloud", cell_.simulation() != nullptr},
+             {"detect_node", detect ? "DetectObjects" : ""},
+             {"calibrate_node", cell_.nodes().find("Calibrate") != nullptr ? "Calibrate" : "HandEyeCalibration"}}},
+           {"version", "0.1.0"}};
+}
+
+json Engine::info() {
+  json out = info_;
+  const std::lock_guard lock(mutex_);
+  out["pace"] = options_.pace;
+  out["active_run"] = active_run_.load();
+  if (!last_error_.empty()) {
+    out["last_error"] = last_error_;
+  }
+  out["stats"] = {{"ticks", stats_.ticks},
+                  {"snapshots", stats_.snapshots},
+                  {"snapshot_seconds", stats_.snapshot_seconds},
+                  {"paced_wait_seconds", stats_.paced_wait_seconds},
+                  {"runs", stats_.runs}};
+  return out;
+}
+
+json Engine::choices() {
+  return call([this] {
+    const world::WorldState& world = cell_.components().world();
+    std::set<std::string> waypoints;
+    std::set<std::string> frames = {"world"};
+    std::set<std::string> classes;
+    std::set<std::string> arm_sources;
+    std::set<std::string> declared;
+    for (const auto& component : cell_.components().components()) {
+      const auto& description = component->description();
+      if (std::find(description.implements.begin(), description.implements.end(), "Arm") !=
+          description.implements.end()) {
+        arm_sources.insert(description.name);
+      }
+      for (const auto& symbol : description.symbols) {
+        declared.insert(symbol.name);
+      }
+    }
+    for (const world::Symbol* symbol : world.symbols()) {
+      if (symbol->frame() != nullptr) {
+        frames.insert(symbol->name);
+      }
+      if (arm_sources.contains(symbol->source) && !declared.contains(symbol->name)) {
+        waypoints.insert(symbol->name);
+      }
+    }
+    for (const world::Predicate* predicate : world.predicates("is_a")) {
+      if (predicate->args.size() == 2) {
+        classes.insert(predicate->args[1]);
+      }
+    }
+    if (sim::Simulation* simulation = cell_.simulation()) {
+      for (const auto& object_class : simulation->objectClasses()) {
+        classes.insert(object_class.name);
+      }
+    }
+    json predicates = json::array();
+    for (const auto& [name, decl] : cell_.components().predicates()) {
+      predicates.push_back({{"name", name}, {"arity", decl.arity}, {"description", decl.description}});
+    }
+    json grasps = json::object();
+    try {
+      if (!options_.grasp_defaults.empty() && std::filesystem::exists(options_.grasp_defaults)) {
+        const smartmove::GraspLibrary library(options_.grasp_defaults, options_.grasp_taught);
+        for (const std::string& object_class : classes) {
+          json names = json::array();
+          for (const auto& grasp : library.forClass(object_class)) {
+            names.push_back(grasp.name);
+          }
+          grasps[object_class] = std::move(names);
+        }
+      }
+    } catch (const std::exception&) {
+      // An unreadable grasp file: SmartMove reports it when it runs; offer no list.
+    }
+    return json{{"waypoint", waypoints},
+                {"frame", frames},
+                {"object_class", classes},
+                {"predicate", std::move(predicates)},
+                {"grasp", std::move(grasps)}};
+  });
+}
+
+}  // namespace costar::server

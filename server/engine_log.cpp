@@ -1,0 +1,66 @@
+// The run-log writer: a thread that writes each plan run's nodes and transitions to the store
+// in batches (every 200 ms), so ticks never wait for the disk.
+
+#include "server/engine_parts.h"
+
+namespace costar::server {
+
+void Engine::pushLog(LogCommand command) {
+  {
+    const std::lock_guard lock(log_mutex_);
+    if (command.kind == LogCommand::Kind::kEnd && !log_pending_.empty()) {
+      LogCommand transitions;
+      transitions.kind = LogCommand::Kind::kTransitions;
+      transitions.record.id = log_pending_run_;
+      transitions.transitions.swap(log_pending_);
+      log_queue_.push_back(std::move(transitions));
+    }
+    log_queue_.push_back(std::move(command));
+  }
+  log_cv_.notify_all();
+}
+
+void Engine::logWriterLoop() {
+  while (true) {
+    std::deque<LogCommand> commands;
+    bool stopping = false;
+    {
+      std::unique_lock lock(log_mutex_);
+      log_cv_.wait_for(lock, std::chrono::milliseconds(200), [this] { return log_stopping_ || !log_queue_.empty(); });
+      if (!log_pending_.empty()) {
+        LogCommand transitions;
+        transitions.kind = LogCommand::Kind::kTransitions;
+        transitions.record.id = log_pending_run_;
+        transitions.transitions.swap(log_pending_);
+        log_queue_.push_back(std::move(transitions));
+      }
+      commands.swap(log_queue_);
+      stopping = log_stopping_;
+    }
+    for (LogCommand& command : commands) {
+      if (store_ == nullptr) {
+        continue;
+      }
+      try {
+        switch (command.kind) {
+          case LogCommand::Kind::kBegin:
+            store_->beginRun(command.record, command.nodes);
+            break;
+          case LogCommand::Kind::kTransitions:
+            store_->appendTransitions(command.record.id, command.transitions);
+            break;
+          case LogCommand::Kind::kEnd:
+            store_->endRun(command.record);
+            break;
+        }
+      } catch (const std::exception&) {
+        // The run log is best effort: a full disk must not stop the robot.
+      }
+    }
+    if (stopping && commands.empty()) {
+      return;
+    }
+  }
+}
+
+}  // namespace costar::server

@@ -1,0 +1,73 @@
+// The simulated cell's views: the RGB-D camera's point cloud (in the world frame) and, for
+// end-to-end tests only, the simulator's true state.
+
+#include "server/engine_parts.h"
+
+#include "sim/simulation.h"
+#include "workcell/workcell.h"
+
+namespace costar::server {
+
+std::optional<json> Engine::groundTruth() {
+  return call([this]() -> std::optional<json> {
+    sim::Simulation* simulation = cell_.simulation();
+    if (simulation == nullptr) {
+      return std::nullopt;
+    }
+    json parts = json::array();
+    for (const sim::PartState& part : simulation->parts()) {
+      json item = poseJson(part.pose);
+      item["name"] = part.name;
+      item["class"] = part.object_class;
+      parts.push_back(std::move(item));
+    }
+    const sim::FingerState fingers = simulation->fingers();
+    return json{{"TEST_ONLY", "the simulator's true state; never used by plans"},
+                {"t", toSeconds(simulation->time())},
+                {"parts", std::move(parts)},
+                {"tcp", poseJson(simulation->tcpPose())},
+                {"finger_opening", fingers.opening},
+                {"arm_table_contact_steps", simulation->armTableContactSteps()}};
+  });
+}
+
+std::optional<json> Engine::pointCloud(std::size_t max_points) {
+  return call([this, max_points]() -> std::optional<json> {
+    sim::Simulation* simulation = cell_.simulation();
+    if (simulation == nullptr) {
+      return std::nullopt;
+    }
+    static std::uint64_t noise_seed = 1;
+    const camera::RgbdFrame frame = simulation->captureRgbd(noise_seed++);
+    const std::size_t valid = frame.validCount();
+    const std::size_t stride =
+        std::max<std::size_t>(1, (valid + max_points - 1) / std::max<std::size_t>(1, max_points));
+    json points = json::array();
+    json colors = json::array();
+    std::size_t seen = 0;
+    for (int v = 0; v < frame.intrinsics.height; ++v) {
+      for (int u = 0; u < frame.intrinsics.width; ++u) {
+        if (!frame.valid(u, v) || (seen++ % stride) != 0) {
+          continue;
+        }
+        const Eigen::Vector3d p = frame.camera_pose * frame.point(u, v).cast<double>();
+        points.push_back(rounded(p.x(), 1e4));
+        points.push_back(rounded(p.y(), 1e4));
+        points.push_back(rounded(p.z(), 1e4));
+        if (frame.rgb.width == frame.intrinsics.width && frame.rgb.height == frame.intrinsics.height) {
+          const std::uint8_t* rgb = frame.rgb.at(u, v);
+          colors.push_back(rgb[0]);
+          colors.push_back(rgb[1]);
+          colors.push_back(rgb[2]);
+        }
+      }
+    }
+    return json{{"frame", "world"},
+                {"camera", poseJson(frame.camera_pose)},
+                {"t", toSeconds(frame.stamp)},
+                {"points", std::move(points)},
+                {"colors", std::move(colors)}};
+  });
+}
+
+}  // namespace costar::server

@@ -1,0 +1,304 @@
+// End-to-end test of the task editor in a real browser (Debian's Chromium, headless, driven by
+// playwright-core), as a technician would use it: start `costar serve` on the simulated UR5
+// cell with the paper's assembly scene, open the address it prints (the token is in it), build
+// the structure assembly (examples/ur5/assemble_structure.xml) by clicks and keys alone,
+// counting every UI action, save it, run it, and judge it from the simulator's true state (a
+// TEST ONLY endpoint, on only with --test-endpoints): a node on the table left of centre, a
+// link on it, a node on the link. No coordinates or names are typed but the plan's name.
+// Then: replay the run, sign in through the sign-in box, the help overlay, screenshots at
+// 1600x1000 and 1280x800, and the saved plan's XML run by `costar run`.
+//
+//   node web/e2e/assemble_by_clicks.mjs [--costar build/cli/costar] [--artifacts build/test-artifacts]
+//                                       [--chromium /usr/bin/chromium] [--docs-screenshot docs/editor.png]
+
+import { spawn, spawnSync } from 'node:child_process';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const MAX_ACTIONS = 30;
+const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+const args = Object.fromEntries(
+  process.argv.slice(2).reduce((pairs, arg, i, all) => (arg.startsWith('--') ? [...pairs, [arg.slice(2), all[i + 1]]] : pairs), []),
+);
+const costar = path.resolve(args.costar ?? path.join(root, 'build/cli/costar'));
+const artifacts = path.resolve(args.artifacts ?? path.join(root, 'build/test-artifacts'));
+const chromiumPath = args.chromium ?? '/usr/bin/chromium';
+fs.mkdirSync(artifacts, { recursive: true });
+
+const work = fs.mkdtempSync(path.join(os.tmpdir(), 'costar-e2e-'));
+const waypoints = path.join(work, 'waypoints.json');
+fs.copyFileSync(path.join(root, 'examples/ur5/blind_waypoints.json'), waypoints);
+const tokenFile = path.join(work, 'token');
+const scene = path.join(root, 'sim/scenes/assembly.json');
+
+let server;
+let browser;
+const log = (...m) => console.log('e2e:', ...m);
+function check(condition, message) {
+  if (!condition) throw new Error(message);
+  log('ok -', message);
+}
+
+async function startServer() {
+  server = spawn(
+    costar,
+    ['serve', '--port', '0', '--scene', scene, '--waypoints', waypoints, '--store', path.join(work, 'editor.sqlite'),
+      '--token-file', tokenFile, '--web-root', path.join(root, 'web/dist'), '--pace', '0', '--test-endpoints'],
+    { stdio: ['ignore', 'pipe', 'pipe'] },
+  );
+  server.stderr.on('data', (d) => process.stderr.write(`serve: ${d}`));
+  return new Promise((resolve, reject) => {
+    let text = '';
+    const timer = setTimeout(() => reject(new Error('costar serve did not start within 60 s')), 60000);
+    server.stdout.on('data', (d) => {
+      text += d;
+      const listening = /listening on (http:\/\/\S+)/.exec(text);
+      if (listening) {
+        clearTimeout(timer);
+        resolve({ url: listening[1], open: /open the editor at (\S+)/.exec(text)?.[1] ?? '' });
+      }
+    });
+    server.on('exit', (code) => reject(new Error(`costar serve exited with ${code}`)));
+  });
+}
+
+async function groundTruth(url, token) {
+  const response = await fetch(`${url}api/test/ground_truth`, { headers: { Authorization: `Bearer ${token}` } });
+  if (!response.ok) throw new Error(`ground truth: ${response.status}`);
+  return response.json();
+}
+
+// The judge of `costar trials --judge assembly` (trials/judge.cpp), on the simulator's true state.
+const NODE_HALF = 0.025;
+const LINK_HALF = 0.0125;
+function judgeAssembly(parts, still) {
+  const xy = (a, b) => Math.hypot(a.p[0] - b.p[0], a.p[1] - b.p[1]);
+  for (const base of parts.filter((p) => p.class === 'node' && p.p[1] > 0.02 && Math.abs(p.p[2] - NODE_HALF) < 0.005 && still(p))) {
+    for (const link of parts.filter((p) => p.class === 'link' && still(p) && xy(p, base) < 0.02 && Math.abs(p.p[2] - 2 * NODE_HALF - LINK_HALF) < 0.006)) {
+      for (const top of parts.filter((p) => p.class === 'node' && p.name !== base.name && still(p) && xy(p, link) < 0.02 &&
+        Math.abs(p.p[2] - 2 * NODE_HALF - 2 * LINK_HALF - NODE_HALF) < 0.006)) {
+        return `${base.name} / ${link.name} / ${top.name}`;
+      }
+    }
+  }
+  return null;
+}
+
+async function main() {
+  check(fs.existsSync(costar), `the costar executable exists (${costar})`);
+  check(fs.existsSync(path.join(root, 'web/dist/index.html')), 'the page is built (web/dist)');
+  const { url, open } = await startServer();
+  const token = fs.readFileSync(tokenFile, 'utf8').trim();
+  check(open === `${url}#token=${token}`, `costar serve --token-file prints the address with the token (${open.replace(token, '…')})`);
+
+  browser = await chromium.launch({
+    executablePath: chromiumPath,
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync',
+      '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  });
+  const context = await browser.newContext({ viewport: { width: 1600, height: 1000 } });
+  const page = await context.newPage();
+  const pageErrors = [];
+  page.on('pageerror', (e) => pageErrors.push(e.message));
+  await page.goto(open);
+  await page.waitForSelector('.connection.on', { timeout: 30000 });
+  await page.waitForSelector('[data-node-type="SmartRelease"].palette-item');
+  check((await page.$('[role="dialog"][aria-label="Sign in"]')) === null, 'the printed address signs in: no sign-in box');
+
+  // --- build the structure assembly: every UI action is counted ---------------------------
+  let actions = 0;
+  const act = async (what, fn) => {
+    actions += 1;
+    await fn();
+    log(`action ${actions}: ${what}`);
+  };
+  const palette = (type) => act(`click ${type} in the operations`, () => page.click(`.palette-item[data-node-type="${type}"]`));
+  const choose = (port, value) => act(`choose ${port} = ${value}`, () => page.selectOption(`#port-${port}`, value));
+  const condition = (name) => act(`add condition ${name}(part, table_center)`, () => page.selectOption('select[aria-label="add condition"]', name));
+  const node = (type, n) => page.locator(`.tree-node[data-node-type="${type}"]`).nth(n);
+  const clickNode = (type, n, modifiers) =>
+    act(`${modifiers ? 'shift+' : ''}click ${type} #${n + 1} in the tree`, () => node(type, n).click({ modifiers }));
+  const key = (combo) => act(`press ${combo}`, () => page.keyboard.press(combo));
+
+  // The new plan's root Sequence is selected: each operation clicked goes after the last one.
+  await palette('Open');
+  await palette('Home');
+  await palette('DetectObjects');
+  await palette('SmartGrasp');
+  await choose('object_class', 'node');
+  await condition('right_of');
+  await palette('SmartRelease');
+  await act('click Check', () => page.click('button:text-is("Check")'));
+  const problem = await page.locator('.tree-node.problem[data-node-type="SmartRelease"]').textContent();
+  check(/give target_class/.test(problem ?? ''), `Check shows what is missing on the node itself: "${problem}"`);
+  const targets = await page.$$eval('#port-target option', (o) => o.map((x) => x.value));
+  check(targets.includes('table') && targets.includes('table_center'), `SmartRelease's target offers 'table' beside the frames (${targets.filter(Boolean).join(', ')})`);
+  await choose('target', 'table');
+  await condition('left_of');
+  // The other two pick-and-place steps: copy Home..SmartRelease, paste twice, change what differs.
+  await clickNode('Home', 0);
+  await clickNode('SmartRelease', 0, ['Shift']);
+  await key('Control+c');
+  await key('Control+v');
+  await clickNode('SmartGrasp', 1);
+  await choose('object_class', 'link');
+  const grasps = await page.$$eval('#port-grasp option', (o) => o.map((x) => x.value).filter(Boolean));
+  check(!grasps.includes('top') && grasps.includes('middle'), `a link is offered only the grasps taught for links (${grasps.join(', ')})`);
+  await clickNode('SmartRelease', 1);
+  await choose('target_class', 'node');
+  check((await page.inputValue('#port-target')) === '', 'choosing target_class clears target (they cannot be given together)');
+  await key('Control+v');
+  await clickNode('SmartRelease', 2);
+  await choose('target_class', 'link');
+  await palette('Home');
+
+  const types = await page.$$eval('.tree-node', (nodes) => nodes.map((n) => n.getAttribute('data-node-type')));
+  const expected = ['Sequence', 'Open', 'Home', 'DetectObjects', 'SmartGrasp', 'SmartRelease', 'Home', 'DetectObjects',
+    'SmartGrasp', 'SmartRelease', 'Home', 'DetectObjects', 'SmartGrasp', 'SmartRelease', 'Home'];
+  check(JSON.stringify(types) === JSON.stringify(expected), `the tree built by clicks is ${types.join(' > ')}`);
+  const rows = await page.$$eval('.tree-node[data-node-type="SmartRelease"] .node-summary', (n) => n.map((x) => x.textContent));
+  check(rows.join(' | ') === 'at table  left_of(table_center) | on node  left_of(table_center) | on link  left_of(table_center)',
+    `the three SmartReleases tell apart in the tree: ${rows.join(' | ')}`);
+
+  await page.click('.tree-node[data-node-type="Sequence"]'); // not counted: a look at the whole tree
+  await page.screenshot({ path: path.join(artifacts, 'editor_built_1600x1000.png') });
+
+  await act('type the plan name', () => page.fill('input[aria-label="plan name"]', 'assemble_structure'));
+  await act('click Save', () => page.click('button:has-text("Save")'));
+  await page.waitForSelector('text=Saved assemble_structure version 1', { timeout: 15000 });
+  await act('click Run', () => page.click('button:has-text("Run")'));
+  check(actions <= MAX_ACTIONS, `the whole task took ${actions} UI actions (at most ${MAX_ACTIONS}), save and run included`);
+
+  let sawRunning = false;
+  const deadline = Date.now() + 240000;
+  while (Date.now() < deadline) {
+    if (await page.$('.tree-node[data-running="true"]')) sawRunning = true;
+    if (await page.getAttribute('.run-label', 'data-run-result')) break;
+    await page.waitForTimeout(100);
+  }
+  const result = await page.getAttribute('.run-label', 'data-run-result');
+  const label = await page.textContent('.run-label');
+  check(result === 'SUCCESS', `the run ended with ${result}: ${label}`);
+  check(/^Run #1 /.test(label ?? ''), `plan runs are numbered by plan runs only: "${label}"`);
+  check(sawRunning, 'the running node was highlighted while it ran');
+  const statuses = await page.$$eval('.tree-node', (nodes) => nodes.map((n) => n.getAttribute('data-status')));
+  check(statuses.every((s) => s === 'SUCCESS'), `every node is green (SUCCESS): ${statuses.join(', ')}`);
+  check(!(await page.textContent('.status-line')).includes('started.'), 'the status line no longer says the run started');
+
+  // Judged from the simulator's true state, twice half a second apart (the parts at rest).
+  const first = await groundTruth(url, token);
+  await page.waitForTimeout(500);
+  const second = await groundTruth(url, token);
+  const still = (p) => {
+    const q = first.parts.find((x) => x.name === p.name);
+    return q && Math.hypot(...p.p.map((v, i) => v - q.p[i])) < 0.002;
+  };
+  const structure = judgeAssembly(second.parts, still);
+  check(structure !== null, `the simulator's true state holds the structure (base / link / top): ${structure ?? second.parts.map((p) => `${p.name} ${p.p.map((v) => v.toFixed(3))}`).join('; ')}`);
+
+  // Screenshots of the finished run at both sizes: select a SmartRelease to show its candidates.
+  await node('SmartRelease', 1).click();
+  await page.waitForTimeout(600);
+  await page.screenshot({ path: path.join(artifacts, 'editor_run_1600x1000.png') });
+  if (args['docs-screenshot']) fs.copyFileSync(path.join(artifacts, 'editor_run_1600x1000.png'), path.resolve(args['docs-screenshot']));
+  await page.setViewportSize({ width: 1280, height: 800 });
+  await page.waitForTimeout(600);
+  await page.screenshot({ path: path.join(artifacts, 'editor_run_1280x800.png') });
+  const visible = await page.$$eval('.tree-node', (nodes) => {
+    const pane = document.querySelector('.tree-canvas').getBoundingClientRect();
+    return nodes.filter((n) => {
+      const b = n.getBoundingClientRect();
+      return b.top >= pane.top && b.bottom <= pane.bottom && b.left >= pane.left && b.right <= pane.right;
+    }).length;
+  });
+  check(visible >= 8, `at 1280x800 the tree shows ${visible} of 15 nodes whole`);
+
+  // Undo, redo, keyboard help.
+  await page.keyboard.press('?');
+  await page.waitForSelector('[role="dialog"][aria-label="Keyboard shortcuts"]');
+  await page.screenshot({ path: path.join(artifacts, 'editor_help_1280x800.png') });
+  await page.keyboard.press('Escape');
+  check((await page.$('[role="dialog"][aria-label="Keyboard shortcuts"]')) === null, 'the help overlay lists the keys and closes with Escape');
+  await node('Home', 3).click();
+  await page.keyboard.press('Delete');
+  check((await page.$$('.tree-node')).length === 14, 'Delete removes the selected node');
+  await page.keyboard.press('Control+z');
+  check((await page.$$('.tree-node')).length === 15, 'Ctrl+Z brings it back');
+
+  // Replay: pick the run from the run log and scrub through its transitions.
+  await page.setViewportSize({ width: 1600, height: 1000 });
+  await page.waitForFunction(() => document.querySelectorAll('select[aria-label="past run"] option').length > 1);
+  const runId = await page.$eval('select[aria-label="past run"] option:nth-child(2)', (o) => o.value);
+  await page.selectOption('select[aria-label="past run"]', runId);
+  await page.waitForSelector('text=replaying run');
+  const slider = 'input[aria-label="replay position"]';
+  const total = Number(await page.getAttribute(slider, 'max'));
+  const statusesAt = async (index) => {
+    await page.fill(slider, String(index));
+    return page.$$eval('.tree-node', (nodes) => nodes.map((n) => n.getAttribute('data-status')));
+  };
+  const atStart = await statusesAt(0);
+  const atMiddle = await statusesAt(Math.floor(total / 2));
+  const atEnd = await statusesAt(total);
+  check(total > 20 && atStart.every((s) => s === 'IDLE'), `replay of run #${runId} starts with every node idle (${total} transitions)`);
+  check(atMiddle.includes('SUCCESS') && !atMiddle.every((s) => s === 'SUCCESS'), 'half way some nodes are done');
+  check(atEnd.every((s) => s === 'SUCCESS'), 'at the end of the replay every node is green');
+  await page.click('button:text-is("Back to editing")');
+
+  // Reloaded, a new plan shows no status of the plan that ran.
+  await page.reload();
+  await page.waitForSelector('.connection.on', { timeout: 30000 });
+  await page.waitForSelector('.tree-node[data-node-type="Sequence"]');
+  await page.waitForTimeout(300);
+  const fresh = await page.$$eval('.tree-node', (nodes) => nodes.map((n) => n.getAttribute('data-status')));
+  check(fresh.every((s) => s === 'IDLE'), `after a reload the new plan is not painted with the last run's statuses (${fresh.join(', ')})`);
+
+  // Signing in: a tab without the token shows the sign-in box; a wrong token is refused.
+  const other = await context.newPage();
+  other.on('pageerror', (e) => pageErrors.push(e.message));
+  await other.goto(url);
+  await other.waitForSelector('[role="dialog"][aria-label="Sign in"]', { timeout: 15000 });
+  await other.fill('input[aria-label="token"]', 'not-the-token');
+  await other.click('button:text-is("Sign in")');
+  await other.waitForSelector('text=The server refused this token', { timeout: 15000 });
+  await other.screenshot({ path: path.join(artifacts, 'editor_signin_1600x1000.png') });
+  await other.fill('input[aria-label="token"]', open);
+  await other.click('button:text-is("Sign in")');
+  await other.waitForTimeout(1500);
+  check((await other.$('[role="dialog"][aria-label="Sign in"]')) === null, 'the sign-in box takes the printed address and lets the technician in');
+  await other.close();
+
+  // The saved plan is the file the CLI runs.
+  const xml = await (await fetch(`${url}api/plans/assemble_structure/xml`)).text();
+  const file = path.join(work, 'assemble_structure.xml');
+  fs.writeFileSync(file, xml);
+  fs.copyFileSync(file, path.join(artifacts, 'assemble_structure.xml'));
+  const cli = spawnSync(costar, ['run', file, '--scene', scene, '--waypoints', waypoints, '-q'], { encoding: 'utf8' });
+  check(cli.status === 0, `costar run on the saved plan succeeds: ${cli.stdout.trim()} ${cli.stderr.trim()}`);
+
+  check(pageErrors.length === 0, `no errors in the page${pageErrors.length ? ': ' + pageErrors.join('; ') : ''}`);
+}
+
+let failed = false;
+try {
+  await main();
+  log('PASSED');
+} catch (error) {
+  failed = true;
+  console.error('e2e: FAILED -', error.message);
+  try {
+    const pages = browser?.contexts()[0]?.pages() ?? [];
+    if (pages[0]) await pages[0].screenshot({ path: path.join(artifacts, 'editor_failure.png') });
+  } catch {
+    // no screenshot
+  }
+} finally {
+  await browser?.close();
+  server?.kill('SIGTERM');
+  fs.rmSync(work, { recursive: true, force: true });
+}
+process.exit(failed ? 1 : 0);

@@ -1,0 +1,87 @@
+// The world the system believes, drawn as it changes: object symbols come from the last
+// DetectObjects, but a part the gripper holds (the predicate holding(part)) moves with the
+// tool, and a part put down stays where it was put until the next detection sees it again.
+
+import type { CellState, Pose } from '../api';
+
+type Vec3 = [number, number, number];
+type Quat = [number, number, number, number];
+
+function qmul(a: Quat, b: Quat): Quat {
+  const [ax, ay, az, aw] = a;
+  const [bx, by, bz, bw] = b;
+  return [
+    aw * bx + ax * bw + ay * bz - az * by,
+    aw * by - ax * bz + ay * bw + az * bx,
+    aw * bz + ax * by - ay * bx + az * bw,
+    aw * bw - ax * bx - ay * by - az * bz,
+  ];
+}
+const qinv = (q: Quat): Quat => [-q[0], -q[1], -q[2], q[3]];
+function rotate(q: Quat, v: Vec3): Vec3 {
+  const r = qmul(qmul(q, [v[0], v[1], v[2], 0]), qinv(q));
+  return [r[0], r[1], r[2]];
+}
+/** a * b for poses. */
+export function compose(a: Pose, b: Pose): Pose {
+  const p = rotate(a.q, b.p);
+  return { p: [a.p[0] + p[0], a.p[1] + p[1], a.p[2] + p[2]], q: qmul(a.q, b.q) };
+}
+/** a^-1 * b. */
+export function relative(a: Pose, b: Pose): Pose {
+  const qi = qinv(a.q);
+  const d: Vec3 = [b.p[0] - a.p[0], b.p[1] - a.p[1], b.p[2] - a.p[2]];
+  return { p: rotate(qi, d), q: qmul(qi, b.q) };
+}
+
+const same = (a: Pose, b: Pose) => a.p.every((v, i) => Math.abs(v - b.p[i]) < 1e-6);
+
+export interface Belief {
+  /** The part held and its pose in the tool frame (taken when the hold began). */
+  held?: { name: string; inTool: Pose };
+  /** Parts put down since their last detection: where they were put, and the detected pose then. */
+  placed: Map<string, { pose: Pose; detected: Pose }>;
+}
+
+export const emptyBelief = (): Belief => ({ placed: new Map() });
+
+export function heldPart(state: CellState): string | undefined {
+  for (const p of state.predicates) {
+    const match = /^holding\(([^,()]+)\)$/.exec(p);
+    if (match) return match[1];
+  }
+  return undefined;
+}
+
+/** The next belief after a snapshot, and each part's pose to draw. */
+export function believe(previous: Belief, state: CellState): { belief: Belief; poses: Map<string, Pose> } {
+  const tool = state.arm.endpoint;
+  const held = heldPart(state);
+  const belief: Belief = { held: undefined, placed: new Map(previous.placed) };
+  const poses = new Map<string, Pose>();
+  for (const o of state.objects) {
+    const detected: Pose = { p: o.p, q: o.q };
+    const put = belief.placed.get(o.name);
+    if (put && !same(put.detected, detected)) belief.placed.delete(o.name); // seen again since
+    poses.set(o.name, belief.placed.get(o.name)?.pose ?? detected);
+  }
+  if (held && tool) {
+    const before = previous.held?.name === held ? previous.held.inTool : undefined;
+    const where = poses.get(held);
+    const inTool = before ?? (where ? relative(tool, where) : undefined);
+    if (inTool) {
+      belief.held = { name: held, inTool };
+      poses.set(held, compose(tool, inTool));
+    }
+  }
+  if (previous.held && previous.held.name !== held && tool) {
+    // Let go: the part stays where the tool left it until a detection sees it.
+    const detected = state.objects.find((o) => o.name === previous.held!.name);
+    if (detected) {
+      const pose = compose(tool, previous.held.inTool);
+      belief.placed.set(detected.name, { pose, detected: { p: detected.p, q: detected.q } });
+      poses.set(detected.name, pose);
+    }
+  }
+  return { belief, poses };
+}

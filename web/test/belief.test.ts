@@ -1,0 +1,36 @@
+import { describe, expect, it } from 'vitest';
+import type { CellState } from '../src/api';
+import { believe, emptyBelief } from '../src/model/belief';
+
+const I: [number, number, number, number] = [0, 0, 0, 1];
+function snapshot(tool: [number, number, number], holding: boolean, part: [number, number, number] = [0.5, 0.2, 0.02]): CellState {
+  return {
+    type: 'state', t: 0, run: 0, mode: 'idle',
+    arm: { endpoint: { p: tool, q: I } },
+    gripper: { open: !holding, closed: holding, holding },
+    objects: [{ name: 'node_1', class: 'node', p: part, q: I }],
+    waypoints: [], frames: [],
+    predicates: holding ? ['holding(node_1)', 'gripper_holding()'] : [],
+  };
+}
+
+describe('the world the system believes', () => {
+  it('moves a held part with the tool and leaves it where it was put', () => {
+    let belief = emptyBelief();
+    // Grasped: the tool is 2 cm above the part's centre.
+    let step = believe(belief, snapshot([0.5, 0.2, 0.04], true));
+    expect(step.poses.get('node_1')!.p).toEqual([0.5, 0.2, 0.02]);
+    belief = step.belief;
+    step = believe(belief, snapshot([0.3, -0.1, 0.2], true));
+    step.poses.get('node_1')!.p.forEach((v, i) => expect(v).toBeCloseTo([0.3, -0.1, 0.18][i], 9));
+    belief = step.belief;
+    // Released there: the stale detection (still at the start) does not pull it back.
+    step = believe(belief, snapshot([0.3, -0.1, 0.2], false));
+    step.poses.get('node_1')!.p.forEach((v, i) => expect(v).toBeCloseTo([0.3, -0.1, 0.18][i], 9));
+    step = believe(step.belief, snapshot([0.4, 0, 0.3], false));
+    step.poses.get('node_1')!.p.forEach((v, i) => expect(v).toBeCloseTo([0.3, -0.1, 0.18][i], 9));
+    // A new detection wins.
+    step = believe(step.belief, snapshot([0.4, 0, 0.3], false, [0.3, -0.1, 0.02]));
+    expect(step.poses.get('node_1')!.p).toEqual([0.3, -0.1, 0.02]);
+  });
+});
