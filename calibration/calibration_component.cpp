@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "calibration/marker_corners.h"
 #include "calibration/view_planner.h"
 #include "perception/aruco_marker.h"
 
@@ -60,6 +61,8 @@ class CalibrationRun final : public component::RunningOperation {
       plan.tilt_deg = component.config_.tilt_deg;
       plan.roll_deg = component.config_.roll_deg;
       plan.min_separation_deg = component.config_.min_view_separation_deg;
+    } else {
+      plan.facing_roll_deg = component.config_.camera_roll_deg;
     }
     candidates_ = candidateMarkerPoses(aim_camera_, plan, 4 * views + 8);
   }
@@ -156,6 +159,12 @@ class CalibrationRun final : public component::RunningOperation {
       view.marker_in_camera = detection.pose_in_camera;
       for (std::size_t k = 0; k < 4; ++k) {
         view.corners[k] = detection.corners[k];
+      }
+      if (c_.config_.refine_corners) {
+        view.corners = refineMarkerCorners(frame.rgb, view.corners);
+        if (const auto pose = markerPoseFromCorners(view.corners, frame.intrinsics, c_.config_.solve.marker_size)) {
+          view.marker_in_camera = *pose;
+        }
       }
       views_.push_back(view);
       // Aim the next views with what this one says about the camera.

@@ -50,6 +50,12 @@ struct CalibrationConfig {
   double min_view_separation_deg = 12.0;
   double tilt_deg = 35.0;
   double roll_deg = 60.0;
+  /// Stage (b): the marker facing the camera, turned about its normal by up to this much
+  /// (degrees; ViewPlanOptions::facing_roll_deg).
+  double camera_roll_deg = 20.0;
+  /// Refine ArUco's corners on the marker's edges (marker_corners.h) and take each view's
+  /// marker pose from them (IPPE); off: ArUco's corners and pose as they are.
+  bool refine_corners = true;
   int marker_views = 12;
   int camera_views = 5;
   /// Fraction of the arm's top speed.

@@ -45,8 +45,13 @@ std::vector<world::Pose> candidateMarkerPoses(const world::Pose& camera_in_world
                                                     Eigen::Vector3d(hi.x(), lo.y(), lo.z()),
                                                     Eigen::Vector3d(lo.x(), lo.y(), hi.z()),
                                                     Eigen::Vector3d(hi.x(), hi.y(), hi.z())};
-    for (const auto& p : pattern) {
-      out.push_back(facingCamera(p, camera_in_world));
+    const std::array<double, 4> rolls = {1.0, -1.0, 0.5, -0.5};
+    for (std::size_t i = 0; i < pattern.size(); ++i) {
+      world::Pose pose = facingCamera(pattern[i], camera_in_world);
+      pose.linear() = pose.linear() * Eigen::AngleAxisd(options.facing_roll_deg * kDeg * rolls[i % rolls.size()],
+                                                        Eigen::Vector3d::UnitZ())
+                                          .toRotationMatrix();
+      out.push_back(pose);
     }
   }
   std::mt19937_64 random(options.seed);
@@ -55,6 +60,10 @@ std::vector<world::Pose> candidateMarkerPoses(const world::Pose& camera_in_world
   for (int attempt = 0; attempt < 200 * count && static_cast<int>(out.size()) < count; ++attempt) {
     const Eigen::Vector3d p = lo + (hi - lo).cwiseProduct(Eigen::Vector3d(unit(random), unit(random), unit(random)));
     world::Pose pose = facingCamera(p, camera_in_world);
+    if (!tilted) {
+      const double roll = options.facing_roll_deg * kDeg * signedUnit();
+      pose.linear() = pose.linear() * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    }
     if (tilted) {
       const Eigen::Matrix3d turn =
           (Eigen::AngleAxisd(options.tilt_deg * kDeg * signedUnit(), Eigen::Vector3d::UnitX()) *

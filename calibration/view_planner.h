@@ -19,6 +19,10 @@ struct ViewPlanOptions {
   /// y) and roll (about its normal), degrees. Zero: facing the camera squarely, upright.
   double tilt_deg = 0.0;
   double roll_deg = 0.0;
+  /// Without tilt (stage b): the spread poses turned about the marker's normal by this much in
+  /// turn (+, -, +1/2, -1/2 of it, degrees), so that the marker's edges cross the image's pixel
+  /// grid at different angles and their corners' sub-pixel errors average out.
+  double facing_roll_deg = 0.0;
   /// Candidates differ from each earlier one by at least this rotation (degrees).
   double min_separation_deg = 0.0;
   std::uint64_t seed = 1;
@@ -29,8 +33,8 @@ struct ViewPlanOptions {
 world::Pose facingCamera(const Eigen::Vector3d& position, const world::Pose& camera_in_world);
 
 /// `count` candidate marker poses. Without tilt: spread over the region (its corners and
-/// centre first), facing the camera (stage b). With tilt: random positions and orientations,
-/// each differing from the earlier ones by min_separation_deg (stage a).
+/// centre first), facing the camera (stage b), rolled by facing_roll_deg in turn. With tilt: random positions and
+/// orientations, each differing from the earlier ones by min_separation_deg (stage a).
 std::vector<world::Pose> candidateMarkerPoses(const world::Pose& camera_in_world, const ViewPlanOptions& options,
                                               int count);
 

@@ -180,8 +180,10 @@ CameraOffset parseCameraOffset(const json& value, const std::string& field) {
   const bool fixed = value.contains("xyz") || value.contains("rpy_deg");
   offset.random = value.contains("distance") || value.contains("angle_deg");
   if (fixed == offset.random) {
-    fail(field, "needs either \"xyz\"/\"rpy_deg\" (a fixed offset) or \"distance\"/\"angle_deg\" (a random "
-                "direction), not " + std::string(fixed ? "both" : "neither"));
+    fail(field,
+         "needs either \"xyz\"/\"rpy_deg\" (a fixed offset) or \"distance\"/\"angle_deg\" (a random "
+         "direction), not " +
+             std::string(fixed ? "both" : "neither"));
   }
   if (value.contains("xyz")) {
     const auto xyz = numbers(value.at("xyz"), field + ".xyz", 3, 3, "[x, y, z] in m");
@@ -194,8 +196,8 @@ CameraOffset parseCameraOffset(const json& value, const std::string& field) {
     const auto rpy = numbers(value.at("rpy_deg"), field + ".rpy_deg", 3, 3, "[roll, pitch, yaw] in degrees");
     offset.rpy_deg = Eigen::Vector3d(rpy[0], rpy[1], rpy[2]);
     if (offset.rpy_deg.cwiseAbs().maxCoeff() > 45) {
-      fail(field + ".rpy_deg", "the camera may turn at most 45 degrees about each axis, not " +
-                                   shown(value.at("rpy_deg")));
+      fail(field + ".rpy_deg",
+           "the camera may turn at most 45 degrees about each axis, not " + shown(value.at("rpy_deg")));
     }
   }
   if (value.contains("distance")) {

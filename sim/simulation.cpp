@@ -104,6 +104,7 @@ struct Simulation::Impl {
   int rgbd_camera = 0;
   int gripper_marker_geom = 0;
   world::Pose rgbd_nominal = world::Pose::Identity();  // optical frame as drawn
+  bool camera_moved = false;                            // mounted elsewhere than drawn
   int first_arm_body = 0;
   int tool_body = 0;
 
@@ -161,6 +162,10 @@ struct Simulation::Impl {
     mujoco_camera.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
     mujoco_camera.translation() = Eigen::Map<const Eigen::Vector3d>(model->cam_pos + 3 * cam);
     rgbd_nominal = mujoco_camera * opticalInMujocoCamera();
+    camera_moved = offset.matrix() != Eigen::Matrix4d::Identity();
+    if (!camera_moved) {
+      return;  // the model untouched: not even rounded through a quaternion
+    }
     mujoco_camera.linear() = offset.linear() * mujoco_camera.linear();
     mujoco_camera.translation() += offset.translation();
     const Eigen::Quaterniond moved(mujoco_camera.linear());
@@ -472,7 +477,11 @@ world::Pose Simulation::rgbdPose() const {
   return mujoco_camera * optical;
 }
 
-world::Pose Simulation::rgbdNominalPose() const { return impl_->rgbd_nominal; }
+world::Pose Simulation::rgbdNominalPose() const {
+  // Not moved: exactly the pose MuJoCo puts the camera at (the drawing's quaternion through
+  // MuJoCo's own arithmetic), so a cell that believes its drawings sees what it saw before.
+  return impl_->camera_moved ? impl_->rgbd_nominal : rgbdPose();
+}
 
 world::Pose Simulation::gripperMarkerPose() const { return impl_->geomPose(impl_->gripper_marker_geom); }
 

@@ -47,6 +47,33 @@ TEST(ViewPlanner, CameraStageSpreadsOverTheRegionFacingTheCamera) {
   EXPECT_EQ(in_view, 9);
 }
 
+TEST(ViewPlanner, CameraStageRollsTheMarkerAboutItsNormalInTurn) {
+  ViewPlanOptions options;
+  options.facing_roll_deg = 20;
+  const auto poses = candidateMarkerPoses(camera(), options, 12);
+  ASSERT_EQ(poses.size(), 12u);
+  const double expected[] = {20, 20, 10, 10};
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const world::Pose facing = facingCamera(poses[i].translation(), camera());
+    // Still facing the camera; turned about the normal only.
+    EXPECT_NEAR(poses[i].linear().col(2).dot(facing.linear().col(2)), 1.0, 1e-9);
+    const double roll = world::rotationAngle(poses[i], facing) / kDeg;
+    if (i < 9) {
+      EXPECT_NEAR(roll, expected[i % 4], 1e-6) << i;
+    } else {
+      EXPECT_LE(roll, 20 + 1e-6) << i;
+    }
+  }
+  // Turned one way, then the other.
+  const auto signedRoll = [&](const world::Pose& pose) {
+    const world::Pose facing = facingCamera(pose.translation(), camera());
+    const Eigen::Vector3d x = facing.linear().transpose() * pose.linear().col(0);
+    return std::atan2(x.y(), x.x());
+  };
+  EXPECT_GT(signedRoll(poses[0]), 0);
+  EXPECT_LT(signedRoll(poses[1]), 0);
+}
+
 TEST(ViewPlanner, MarkerStageSeparatesRotationsAndIsSeeded) {
   ViewPlanOptions options;
   options.tilt_deg = 35;

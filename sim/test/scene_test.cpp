@@ -193,18 +193,19 @@ TEST(Scene, BadValuesAreErrorsNamingTheField) {
 // Issue 14: the camera moved from its drawn mounting, a scene option validated like the others.
 TEST(Scene, CameraOffsetIsReadAndItsProblemsAreNamed) {
   const std::string prefix = "scene 'bad.json': ";
-  EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0.03, 0, -0.04], "rpy_deg": [0, 3, 4]}, "parts": []})"),
-            "no error");
+  EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0.03, 0, -0.04], "rpy_deg": [0, 3, 4]}, "parts": []})"), "no error");
   EXPECT_EQ(problem(R"({"camera_offset": {"distance": 0.05, "angle_deg": 5, "seed": 7}, "parts": []})"), "no error");
   EXPECT_EQ(problem(R"({"camera_offset": [0.05], "parts": []})"),
             prefix + "camera_offset: must be an object {...}, not [0.05]");
   EXPECT_EQ(problem(R"({"camera_offset": {"distanse": 0.05}, "parts": []})"),
             prefix + "camera_offset.distanse: unknown field (known: xyz, rpy_deg, distance, angle_deg, seed)");
   EXPECT_EQ(problem(R"({"camera_offset": {}, "parts": []})"),
-            prefix + "camera_offset: needs either \"xyz\"/\"rpy_deg\" (a fixed offset) or \"distance\"/\"angle_deg\" "
-                     "(a random direction), not neither");
-  EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0, 0, 0], "distance": 0.1}, "parts": []})").substr(0, prefix.size() + 28),
-            prefix + "camera_offset: needs either ");
+            prefix +
+                "camera_offset: needs either \"xyz\"/\"rpy_deg\" (a fixed offset) or \"distance\"/\"angle_deg\" "
+                "(a random direction), not neither");
+  EXPECT_EQ(
+      problem(R"({"camera_offset": {"xyz": [0, 0, 0], "distance": 0.1}, "parts": []})").substr(0, prefix.size() + 28),
+      prefix + "camera_offset: needs either ");
   EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0, 0]}, "parts": []})"),
             prefix + "camera_offset.xyz: must be [x, y, z] in m, not [0,0]");
   EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0, "a", 0]}, "parts": []})"),

@@ -224,7 +224,9 @@ INSTANTIATE_TEST_SUITE_P(Ur5, PaperTask,
 // recorded with this build's placement: a change that moves any of it shows here. Recorded first
 // when the camera was made faster (33.63 s, 33.78 s, unchanged by it); re-recorded after oriented part
 // footprints (which change where a seed puts the parts) and per-class grasp defaults were merged
-// (33.83 s, 33.89 s; the same in every run and build since).
+// (33.83 s, 33.89 s; the same in every run and build since); re-recorded when the calibration
+// marker was fixed to the gripper (issue 14: the camera sees it, and the calibration component
+// joins the cell; 33.79 s, 33.93 s, the same in repeated runs).
 TEST(Trials, TheSameSeedsGiveTheSameAssemblyTrials) {
   TrialOptions options;
   options.plan = dataRoot() / "examples/ur5/assemble_structure.xml";
@@ -235,7 +237,7 @@ TEST(Trials, TheSameSeedsGiveTheSameAssemblyTrials) {
   options.jobs = 2;
   const Summary summary = runTrials(options);
   ASSERT_EQ(summary.trials.size(), 2u);
-  const double recorded[] = {33.83, 33.89};
+  const double recorded[] = {33.79, 33.93};
   for (std::size_t i = 0; i < 2; ++i) {
     const TrialResult& trial = summary.trials[i];
     EXPECT_TRUE(trial.success) << "seed " << trial.seed << ": " << trial.failure_path << ": " << trial.reason;
