@@ -194,6 +194,7 @@ class CalibrationRun final : public component::RunningOperation {
         next.camera_views = result.views;
         data["marker_in_flange"] = poseSummary(result.marker_in_flange);
         data["method"] = next.marker_method;
+        data["views_rejected"] = result.rejected;
         // The unrefined solution of every method on the same views, for comparison.
         nlohmann::json methods = nlohmann::json::object();
         for (const HandEyeMethod method : allMethods()) {
@@ -216,6 +217,7 @@ class CalibrationRun final : public component::RunningOperation {
         next.camera_in_world = result.camera_in_world;
         next.camera_residuals = result.residuals;
         next.camera_views = result.views;
+        data["views_rejected"] = result.rejected;
       }
       data["camera"] = poseSummary(*next.camera_in_world);
       data["camera_moved_mm"] = round((next.camera_in_world->translation() - before.translation()).norm() * 1000, 1e-2);

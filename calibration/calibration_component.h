@@ -57,7 +57,7 @@ struct CalibrationConfig {
   /// marker pose from them (IPPE); off: ArUco's corners and pose as they are.
   bool refine_corners = true;
   int marker_views = 12;
-  int camera_views = 5;
+  int camera_views = 10;
   /// Fraction of the arm's top speed.
   double speed = 0.7;
   /// Time the arm rests at a view before the frame is taken.

@@ -182,6 +182,38 @@ std::pair<double, double> rotationSpread(const std::vector<MarkerView>& views) {
   return {largest, spread};
 }
 
+/// Corner RMS (pixels) of each view with X and Y.
+std::vector<double> viewErrors(const std::vector<MarkerView>& views, const camera::Intrinsics& intrinsics,
+                               const world::Pose& marker_in_flange, const world::Pose& camera_in_world,
+                               double marker_size);
+
+/// The views to keep: all but those fitting worse than outlier_factor x the median view (and
+/// outlier_floor_px), the worst first, at most a quarter of them, never below `fewest`.
+std::vector<MarkerView> inliers(const std::vector<MarkerView>& views, const std::vector<double>& errors,
+                                const SolveOptions& options, int fewest) {
+  if (options.outlier_factor <= 0 || views.size() < 4) {
+    return views;
+  }
+  const double limit = std::max(options.outlier_factor * median(errors), options.outlier_floor_px);
+  std::vector<std::size_t> order(views.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    order[i] = i;
+  }
+  std::sort(order.begin(), order.end(), [&errors](std::size_t a, std::size_t b) { return errors[a] > errors[b]; });
+  const std::size_t most = std::min(views.size() / 4, views.size() - static_cast<std::size_t>(std::max(fewest, 0)));
+  std::vector<bool> drop(views.size(), false);
+  for (std::size_t n = 0; n < most && errors[order[n]] > limit; ++n) {
+    drop[order[n]] = true;
+  }
+  std::vector<MarkerView> kept;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    if (!drop[i]) {
+      kept.push_back(views[i]);
+    }
+  }
+  return kept;
+}
+
 }  // namespace
 
 std::array<Eigen::Vector3d, 4> markerCorners(double s) {
@@ -250,6 +282,21 @@ Residuals residualsOf(const std::vector<MarkerView>& views, const camera::Intrin
   residuals.translation_m = median(translations);
   return residuals;
 }
+
+namespace {
+
+std::vector<double> viewErrors(const std::vector<MarkerView>& views, const camera::Intrinsics& intrinsics,
+                               const world::Pose& marker_in_flange, const world::Pose& camera_in_world,
+                               double marker_size) {
+  std::vector<double> errors;
+  for (const auto& view : views) {
+    errors.push_back(
+        residualsOf({view}, intrinsics, marker_in_flange, camera_in_world, marker_size).reprojection_rms_px);
+  }
+  return errors;
+}
+
+}  // namespace
 
 MarkerCalibration solveMarker(const std::vector<MarkerView>& views, const camera::Intrinsics& intrinsics,
                               HandEyeMethod method, bool refine_result, const SolveOptions& options) {
@@ -351,8 +398,20 @@ MarkerCalibration solveMarker(const std::vector<MarkerView>& views, const camera
       }
     }
   }
+  std::vector<MarkerView> used = views;
+  if (refine_result) {
+    // Views that do not fit the others left out, and the refinement run again without them.
+    used = inliers(views,
+                   viewErrors(views, intrinsics, result.marker_in_flange, result.camera_in_world, options.marker_size),
+                   options, options.min_marker_views);
+    if (used.size() < views.size()) {
+      refine(used, intrinsics, options.marker_size, result.marker_in_flange, result.camera_in_world, true);
+    }
+  }
+  result.views = static_cast<int>(used.size());
+  result.rejected = static_cast<int>(views.size() - used.size());
   result.residuals =
-      residualsOf(views, intrinsics, result.marker_in_flange, result.camera_in_world, options.marker_size);
+      residualsOf(used, intrinsics, result.marker_in_flange, result.camera_in_world, options.marker_size);
   if (result.residuals.reprojection_rms_px > options.max_reprojection_rms_px) {
     throw CalibrationError("marker calibration (" + methodName(method) + ")" +
                            format(": the marker's corners are off by %.2f px (RMS) with the solution, more than %.2f "
@@ -362,41 +421,27 @@ MarkerCalibration solveMarker(const std::vector<MarkerView>& views, const camera
   return result;
 }
 
-CameraCalibration solveCamera(const std::vector<MarkerView>& views, const camera::Intrinsics& intrinsics,
-                              const world::Pose& marker_in_flange, const SolveOptions& options) {
-  if (static_cast<int>(views.size()) < options.min_camera_views) {
-    throw CalibrationError("Calibrate: " + std::to_string(views.size()) +
-                           " view(s) of the gripper's marker, at least " + std::to_string(options.min_camera_views) +
-                           " needed (is the marker in the camera's view? is the path to it free?)");
-  }
-  // Where the corners are in the world, and where they are seen.
-  const auto corners = markerCorners(options.marker_size);
+namespace {
+
+/// The camera by one PnP (SQPnP, then Levenberg-Marquardt) over the corners of every view,
+/// each corner's world position being F_i X c_k.
+world::Pose cameraByPnp(const std::vector<MarkerView>& views, const camera::Intrinsics& intrinsics,
+                        const world::Pose& marker_in_flange, double marker_size) {
+  const auto corners = markerCorners(marker_size);
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
-  Eigen::Vector3d lowest = Eigen::Vector3d::Constant(1e9);
-  Eigen::Vector3d highest = -lowest;
   for (const auto& view : views) {
     const world::Pose marker = view.flange_in_world * marker_in_flange;
-    lowest = lowest.cwiseMin(marker.translation());
-    highest = highest.cwiseMax(marker.translation());
     for (std::size_t k = 0; k < 4; ++k) {
       const Eigen::Vector3d p = marker * corners[k];
       object.emplace_back(p.x(), p.y(), p.z());
       image.emplace_back(view.corners[k].x(), view.corners[k].y());
     }
   }
-  if ((highest - lowest).norm() < options.min_position_spread) {
-    throw CalibrationError(
-        format("Calibrate: the marker's positions span %.3f m, at least %.2f m needed to fix the "
-               "camera's orientation",
-               (highest - lowest).norm(), options.min_position_spread));
-  }
   const cv::Matx33d k(intrinsics.fx, 0, intrinsics.cx, 0, intrinsics.fy, intrinsics.cy, 0, 0, 1);
   const cv::Mat distortion = cv::Mat::zeros(1, 5, CV_64F);
   cv::Mat rvec;
   cv::Mat tvec;
-  CameraCalibration result;
-  result.views = static_cast<int>(views.size());
   try {
     if (!cv::solvePnP(object, image, k, distortion, rvec, tvec, false, cv::SOLVEPNP_SQPNP)) {
       throw CalibrationError("Calibrate: no camera pose explains the marker's corners (PnP failed)");
@@ -407,11 +452,47 @@ CameraCalibration solveCamera(const std::vector<MarkerView>& views, const camera
   }
   cv::Mat r;
   cv::Rodrigues(rvec, r);
-  result.camera_in_world = fromCv(r, tvec).inverse();  // PnP gives world -> camera
-  if (!result.camera_in_world.matrix().allFinite()) {
+  const world::Pose camera = fromCv(r, tvec).inverse();  // PnP gives world -> camera
+  if (!camera.matrix().allFinite()) {
     throw CalibrationError("Calibrate: the solution is degenerate (not finite)");
   }
-  result.residuals = residualsOf(views, intrinsics, marker_in_flange, result.camera_in_world, options.marker_size);
+  return camera;
+}
+
+}  // namespace
+
+CameraCalibration solveCamera(const std::vector<MarkerView>& views, const camera::Intrinsics& intrinsics,
+                              const world::Pose& marker_in_flange, const SolveOptions& options) {
+  if (static_cast<int>(views.size()) < options.min_camera_views) {
+    throw CalibrationError("Calibrate: " + std::to_string(views.size()) +
+                           " view(s) of the gripper's marker, at least " + std::to_string(options.min_camera_views) +
+                           " needed (is the marker in the camera's view? is the path to it free?)");
+  }
+  Eigen::Vector3d lowest = Eigen::Vector3d::Constant(1e9);
+  Eigen::Vector3d highest = -lowest;
+  for (const auto& view : views) {
+    const Eigen::Vector3d p = (view.flange_in_world * marker_in_flange).translation();
+    lowest = lowest.cwiseMin(p);
+    highest = highest.cwiseMax(p);
+  }
+  if ((highest - lowest).norm() < options.min_position_spread) {
+    throw CalibrationError(
+        format("Calibrate: the marker's positions span %.3f m, at least %.2f m needed to fix the "
+               "camera's orientation",
+               (highest - lowest).norm(), options.min_position_spread));
+  }
+  CameraCalibration result;
+  result.camera_in_world = cameraByPnp(views, intrinsics, marker_in_flange, options.marker_size);
+  // Views that do not fit the others left out, and the camera found again without them.
+  const std::vector<MarkerView> used =
+      inliers(views, viewErrors(views, intrinsics, marker_in_flange, result.camera_in_world, options.marker_size),
+              options, options.min_camera_views);
+  if (used.size() < views.size()) {
+    result.camera_in_world = cameraByPnp(used, intrinsics, marker_in_flange, options.marker_size);
+  }
+  result.views = static_cast<int>(used.size());
+  result.rejected = static_cast<int>(views.size() - used.size());
+  result.residuals = residualsOf(used, intrinsics, marker_in_flange, result.camera_in_world, options.marker_size);
   if (result.residuals.reprojection_rms_px > options.max_reprojection_rms_px) {
     throw CalibrationError(
         format("Calibrate: the marker's corners are off by %.2f px (RMS) with the new camera pose, "

@@ -68,13 +68,15 @@ struct MarkerCalibration {
   world::Pose marker_in_flange = world::Pose::Identity();  // X
   world::Pose camera_in_world = world::Pose::Identity();   // Y
   Residuals residuals;
-  int views = 0;
+  int views = 0;     // views used
+  int rejected = 0;  // views left out as outliers (SolveOptions::outlier_factor)
 };
 
 struct CameraCalibration {
   world::Pose camera_in_world = world::Pose::Identity();
   Residuals residuals;
-  int views = 0;
+  int views = 0;     // views used
+  int rejected = 0;  // views left out as outliers
 };
 
 struct SolveOptions {
@@ -89,6 +91,12 @@ struct SolveOptions {
   double min_position_spread = 0.15;
   /// A solution whose corner reprojection error exceeds this (pixels, RMS) is refused.
   double max_reprojection_rms_px = 3.0;
+  /// After a first solution, a view whose corners fit worse than this many times the median
+  /// view (and worse than outlier_floor_px, RMS) is left out and the solution found again
+  /// without it (a misdetected or partly hidden marker); at most a quarter of the views, and
+  /// never below the fewest views needed. 0: keep every view.
+  double outlier_factor = 3.0;
+  double outlier_floor_px = 0.75;
   /// Stage (a): where the marker roughly is on the flange (the drawings). When set, the
   /// refinement also starts from it (with the camera by PnP) and keeps the better fit: a
   /// small marker's ArUco tilt is often off by many degrees, and the hand-eye methods with it.

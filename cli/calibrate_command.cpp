@@ -150,6 +150,10 @@ int evaluate(EvalOptions options) {
               "%.3f deg, simulated %.1f + %.1f s\n",
               s.setup, s.method.empty() ? "cell" : s.method.c_str(), s.camera_mm, s.camera_deg, s.camera_before_mm,
               s.camera_before_deg, s.marker_mm, s.marker_deg, s.marker_simulated_s, s.camera_simulated_s);
+          if (s.parts > 0) {
+            std::printf("  DetectObjects: %d/%d parts within 5 mm and 5 deg before Calibrate, %d/%d after\n",
+                        s.parts_accurate_before, s.parts, s.parts_accurate_after, s.parts);
+          }
         } else {
           std::printf("set-up %d %-10s FAILED: %s\n", s.setup, s.method.empty() ? "cell" : s.method.c_str(),
                       s.reason.c_str());
@@ -199,7 +203,8 @@ void addCalibrateCommand(CLI::App& app, int& exit_code) {
   marker
       ->add_option("--method", marker_options->method,
                    "hand-eye method: daniilidis (the paper's), tsai, park, horaud, andreff, shah, li")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::IsMember({"daniilidis", "tsai", "park", "horaud", "andreff", "shah", "li"}));
   marker->add_flag("--no-refine", marker_options->no_refine,
                    "keep the method's own solution (no reprojection refinement)");
   marker->callback([marker_options, &exit_code] { exit_code = calibrate(*marker_options, true); });
@@ -207,13 +212,22 @@ void addCalibrateCommand(CLI::App& app, int& exit_code) {
   auto eval_options = std::make_shared<EvalOptions>();
   CLI::App* eval = command->add_subcommand(
       "eval", "Simulation: calibrate N seeded set-ups with the camera moved, and compare with its true pose");
-  eval->add_option("--setups", eval_options->eval.setups, "number of set-ups")->capture_default_str();
+  eval->add_option("--setups", eval_options->eval.setups, "number of set-ups")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
   eval->add_option("--seed", eval_options->eval.seed, "seed of the first set-up")->capture_default_str();
   eval->add_option("--camera-move", eval_options->camera_move, "DISTANCE_M,ANGLE_DEG")->capture_default_str();
   eval->add_option("--methods", eval_options->methods,
                    "comma-separated hand-eye methods to run the marker calibration with in each set-up (default: "
                    "none, Calibrate with the cell's marker calibration)");
   eval->add_flag("--no-refine", eval_options->no_refine, "the methods' own solutions, unrefined");
+  eval->add_flag("--perception", eval_options->eval.perception,
+                 "also run DetectObjects before and after Calibrate and score the parts against the truth");
+  eval->add_option("--marker-views", eval_options->eval.marker_views,
+                   "views of the marker calibration (default: the cell's)")
+      ->check(CLI::Range(6, 40));
+  eval->add_option("--views", eval_options->eval.camera_views, "views of Calibrate (default: the cell's)")
+      ->check(CLI::Range(3, 20));
   eval->add_option("--json", eval_options->json, "write every sample as JSON");
   eval->callback([eval_options, &exit_code] { exit_code = evaluate(*eval_options); });
 

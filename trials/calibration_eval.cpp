@@ -6,6 +6,8 @@
 #include <map>
 
 #include "core/paths.h"
+#include "perception/canonical_orientation.h"
+#include "perception/perception_component.h"
 #include "sim/simulation.h"
 #include "workcell/workcell.h"
 
@@ -33,6 +35,49 @@ std::unique_ptr<workcell::Workcell> makeCell(const CalibrationEvalOptions& optio
   return workcell::makeWorkcell(cell);
 }
 
+/// DetectObjects once in `cell`; the parts found within 5 mm and 5 degrees of their true pose
+/// (one detection per part: same class, nearest centre within 2.5 cm; rotation error the
+/// smallest over the class's symmetries).
+int accurateParts(workcell::Workcell& cell) {
+  const component::OperationResult detected =
+      workcell::runOperation(cell, "DetectObjects", {}, std::chrono::seconds(30));
+  if (detected.state != component::OperationState::kSuccess) {
+    return 0;
+  }
+  auto* perception = dynamic_cast<perception::PerceptionComponent*>(cell.components().provider("DetectObjects"));
+  if (perception == nullptr) {
+    return 0;
+  }
+  std::vector<perception::TrackedObject> objects = perception->objects();
+  std::erase_if(objects, [](const perception::TrackedObject& o) { return o.missed > 0; });
+  std::vector<bool> used(objects.size(), false);
+  int accurate = 0;
+  for (const sim::PartState& part : cell.simulation()->parts()) {
+    int best = -1;
+    double nearest = 0.025;
+    for (std::size_t d = 0; d < objects.size(); ++d) {
+      const double distance = (objects[d].pose.translation() - part.pose.translation()).norm();
+      if (!used[d] && objects[d].object_class == part.object_class && distance < nearest) {
+        nearest = distance;
+        best = static_cast<int>(d);
+      }
+    }
+    if (best < 0) {
+      continue;
+    }
+    used[static_cast<std::size_t>(best)] = true;
+    const perception::ObjectModel* model = perception->pipeline().model(part.object_class);
+    const double angle =
+        model == nullptr ? M_PI
+                         : perception::symmetricRotationDistance(objects[static_cast<std::size_t>(best)].pose.linear(),
+                                                                 part.pose.linear(), model->object_class);
+    if (nearest <= 0.005 && angle <= 5 * kDeg) {
+      ++accurate;
+    }
+  }
+  return accurate;
+}
+
 void runSample(const CalibrationEvalOptions& options, int setup, const std::string& method, CalibrationSample& s) {
   const std::uint64_t seed = options.seed + static_cast<std::uint64_t>(setup);
   const auto cell = makeCell(options, seed);
@@ -43,9 +88,11 @@ void runSample(const CalibrationEvalOptions& options, int setup, const std::stri
   s.camera_before_deg = world::rotationAngle(drawn, truth) / kDeg;
   const Duration limit = std::chrono::seconds(300);
   if (!method.empty()) {
-    const component::OperationResult marker = workcell::runOperation(
-        *cell, "CalibrateMarker", {{"method", component::Value(method)}, {"refine", component::Value(options.refine)}},
-        limit);
+    component::ParamMap params{{"method", component::Value(method)}, {"refine", component::Value(options.refine)}};
+    if (options.marker_views > 0) {
+      params.emplace("views", component::Value(static_cast<long long>(options.marker_views)));
+    }
+    const component::OperationResult marker = workcell::runOperation(*cell, "CalibrateMarker", params, limit);
     if (marker.state != component::OperationState::kSuccess) {
       s.marker_ok = false;
       s.reason = marker.reason;
@@ -60,7 +107,15 @@ void runSample(const CalibrationEvalOptions& options, int setup, const std::stri
     s.stage_a_camera_deg = world::rotationAngle(y, truth) / kDeg;
     s.marker_simulated_s = marker.data.value("simulated_s", 0.0);
   }
-  const component::OperationResult camera = workcell::runOperation(*cell, "Calibrate", {}, limit);
+  if (options.perception) {
+    s.parts = static_cast<int>(simulation.parts().size());
+    s.parts_accurate_before = accurateParts(*cell);
+  }
+  component::ParamMap camera_params;
+  if (options.camera_views > 0) {
+    camera_params.emplace("views", component::Value(static_cast<long long>(options.camera_views)));
+  }
+  const component::OperationResult camera = workcell::runOperation(*cell, "Calibrate", camera_params, limit);
   if (camera.state != component::OperationState::kSuccess) {
     s.reason = camera.reason;
     return;
@@ -71,6 +126,9 @@ void runSample(const CalibrationEvalOptions& options, int setup, const std::stri
   s.camera_deg = world::rotationAngle(y, truth) / kDeg;
   s.camera_simulated_s = camera.data.value("simulated_s", 0.0);
   s.reprojection_rms_px = camera.data.at("residuals").value("reprojection_rms_px", 0.0);
+  if (options.perception) {
+    s.parts_accurate_after = accurateParts(*cell);
+  }
 }
 
 double median(std::vector<double> v) {
@@ -124,7 +182,10 @@ nlohmann::json CalibrationEvalSummary::toJson() const {
                     {"camera_deg", s.camera_deg},
                     {"marker_simulated_s", s.marker_simulated_s},
                     {"camera_simulated_s", s.camera_simulated_s},
-                    {"reprojection_rms_px", s.reprojection_rms_px}});
+                    {"reprojection_rms_px", s.reprojection_rms_px},
+                    {"parts", s.parts},
+                    {"parts_accurate_before", s.parts_accurate_before},
+                    {"parts_accurate_after", s.parts_accurate_after}});
   }
   return {{"samples", list}};
 }
@@ -164,6 +225,25 @@ std::string CalibrationEvalSummary::text() const {
         "%5.1f / %5.1f\n",
         method.c_str(), ok, list.size(), median(xm), median(xd), median(am), median(ad), median(cm), median(cd),
         largest(cm), largest(cd), median(ms), median(cs));
+    out += line;
+  }
+  int parts = 0;
+  int before = 0;
+  int after = 0;
+  for (const auto& s : samples) {
+    if (s.camera_ok && s.parts > 0) {
+      parts += s.parts;
+      before += s.parts_accurate_before;
+      after += s.parts_accurate_after;
+    }
+  }
+  if (parts > 0) {
+    char line[300];
+    std::snprintf(
+        line, sizeof line,
+        "DetectObjects, parts within 5 mm and 5 deg of the truth: %d/%d (%.1f %%) with the drawn camera pose, "
+        "%d/%d (%.1f %%) after Calibrate\n",
+        before, parts, 100.0 * before / parts, after, parts, 100.0 * after / parts);
     out += line;
   }
   return out;

@@ -25,6 +25,12 @@ struct CalibrationEvalOptions {
   std::vector<std::string> methods;
   /// Refine the methods' solutions on the corners' reprojection.
   bool refine = true;
+  /// Also run DetectObjects before and after Calibrate and score the parts' poses against the
+  /// simulator's (within 5 mm and 5 degrees, symmetry-aware).
+  bool perception = false;
+  /// Views taken by the marker calibration and by Calibrate (0: the component's defaults).
+  int marker_views = 0;
+  int camera_views = 0;
 };
 
 /// One calibration in one set-up.
@@ -40,6 +46,11 @@ struct CalibrationSample {
   double camera_mm = 0, camera_deg = 0;  // after Calibrate
   double marker_simulated_s = 0, camera_simulated_s = 0;
   double reprojection_rms_px = 0;
+  /// With `perception`: parts in the scene, and those DetectObjects put within 5 mm and 5
+  /// degrees of their true pose, with the drawn camera pose and after Calibrate.
+  int parts = 0;
+  int parts_accurate_before = 0;
+  int parts_accurate_after = 0;
 };
 
 struct CalibrationEvalSummary {

@@ -124,6 +124,29 @@ TEST(HandEye, CameraFromAFewViewsOnceTheMarkerIsKnown) {
   EXPECT_EQ(result.views, 5);
 }
 
+TEST(HandEye, AViewThatDoesNotFitIsLeftOut) {
+  Synthetic s = makeViews(10, 0, 0.2, 11);
+  // One misdetection: a corner 6 px off.
+  s.views[3].corners[2] += Eigen::Vector2d(6, -3);
+  const CameraCalibration kept = solveCamera(s.views, intrinsics(), s.marker, {.outlier_factor = 0});
+  const CameraCalibration cleaned = solveCamera(s.views, intrinsics(), s.marker);
+  EXPECT_EQ(kept.rejected, 0);
+  EXPECT_EQ(kept.views, 10);
+  EXPECT_EQ(cleaned.rejected, 1);
+  EXPECT_EQ(cleaned.views, 9);
+  EXPECT_LT(cleaned.residuals.reprojection_rms_px, kept.residuals.reprojection_rms_px);
+  EXPECT_LT(millimetres(cleaned.camera_in_world, s.camera), millimetres(kept.camera_in_world, s.camera));
+  // Clean views: none left out.
+  const Synthetic clean = makeViews(10, 0, 0.2, 12);
+  EXPECT_EQ(solveCamera(clean.views, intrinsics(), clean.marker).rejected, 0);
+  // The marker stage too.
+  Synthetic tilted = makeViews(15, 30, 0.2, 13);
+  tilted.views[5].corners[1] += Eigen::Vector2d(-7, 5);
+  const MarkerCalibration marker = solveMarker(tilted.views, intrinsics(), HandEyeMethod::kDaniilidis, true);
+  EXPECT_EQ(marker.rejected, 1);
+  EXPECT_LT(millimetres(marker.marker_in_flange, tilted.marker), 1.0);
+}
+
 TEST(HandEye, TooFewViewsFailWithTheReason) {
   const Synthetic s = makeViews(4, 30, 0.0, 4);
   try {
