@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bt/plan.h"
+#include "cli/inject_option.h"
 #include "trials/judge.h"
 #include "trials/trials.h"
 
@@ -224,6 +225,7 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
       "the camera moved from its drawn mounting in each trial: DISTANCE_M,ANGLE_DEG, direction from the trial's seed");
   command->add_flag("--calibrate", options->trials.calibrate,
                     "run Calibrate in each trial's cell before the plan (as a technician would after set-up)");
+  addInjectOption(command, options->trials.inject);
   command->add_option("--json", options->json, "write the summary and every trial as JSON");
   command->add_option("--plot", options->plot, "write a PNG: success rate, failures, cycle times");
   command->add_option("--require", options->require, "exit 1 when the success rate is below this (0..1)")
