@@ -104,7 +104,7 @@ struct Simulation::Impl {
   int rgbd_camera = 0;
   int gripper_marker_geom = 0;
   world::Pose rgbd_nominal = world::Pose::Identity();  // optical frame as drawn
-  bool camera_moved = false;                            // mounted elsewhere than drawn
+  bool camera_moved = false;                           // mounted elsewhere than drawn
   int first_arm_body = 0;
   int tool_body = 0;
 

@@ -41,7 +41,8 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
         .memory_only = true,
         .faults = options.inject.empty() ? nullptr : faults::Injector::fromText(options.inject, result.seed)};
     if (options.camera_move_m > 0 || options.camera_turn_deg > 0) {
-      cell_options.camera_move = workcell::WorkcellOptions::CameraMove{options.camera_move_m, options.camera_turn_deg, {}};
+      cell_options.camera_move =
+          workcell::WorkcellOptions::CameraMove{options.camera_move_m, options.camera_turn_deg, {}};
     }
     const auto cell = workcell::makeWorkcell(cell_options);
     sim::Simulation& simulation = *cell->simulation();
