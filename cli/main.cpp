@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/calibrate_command.h"
 #include "cli/describe_command.h"
 #include "cli/perception_commands.h"
 #include "cli/plan_commands.h"
@@ -26,6 +27,7 @@ int main(int argc, char** argv) {
   costar::cli::addTeachCommand(app, exit_code);
   costar::cli::addSmartMoveCommands(app, exit_code);
   costar::cli::addTrialsCommand(app, exit_code);
+  costar::cli::addCalibrateCommand(app, exit_code);
   costar::cli::addServeCommand(app, exit_code);
   try {
     app.parse(argc, argv);

@@ -27,6 +27,9 @@ inline constexpr std::array kRobotCommands = {
                  "them)"},
     RobotCommand{"smartmove", "SmartMove set-up"},
     RobotCommand{"trials", "Rerun a plan as N randomized trials in the simulated cell, judged from its true state"},
+    RobotCommand{"calibrate",
+                 "Calibrate the camera: the arm shows the marker on its gripper to the camera from poses it chooses, "
+                 "and the camera's pose is saved with the cell (the editor's Calibrate button)"},
     RobotCommand{"serve", "Serve the task editor (a web page) and its API: build, run and watch plans on a workcell"},
 };
 

@@ -207,6 +207,24 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
   command->add_option("--time-limit", options->trials.time_limit_s, "simulated seconds allowed per trial")
       ->check(numberIn(0.0, trials::kMaxTimeLimitSeconds, true, " s"))
       ->capture_default_str();
+  command->add_option_function<std::string>(
+      "--camera-move",
+      [options](const std::string& text) {
+        const auto comma = text.find(',');
+        try {
+          options->trials.camera_move_m = std::stod(text.substr(0, comma));
+          options->trials.camera_turn_deg = comma == std::string::npos ? 0.0 : std::stod(text.substr(comma + 1));
+        } catch (const std::exception&) {
+          throw CLI::ValidationError("--camera-move", "'" + text + "' should be DISTANCE_M,ANGLE_DEG (e.g. 0.05,5)");
+        }
+        if (options->trials.camera_move_m < 0 || options->trials.camera_move_m > 0.5 ||
+            options->trials.camera_turn_deg < 0 || options->trials.camera_turn_deg > 45) {
+          throw CLI::ValidationError("--camera-move", "at most 0.5 m and 45 degrees");
+        }
+      },
+      "the camera moved from its drawn mounting in each trial: DISTANCE_M,ANGLE_DEG, direction from the trial's seed");
+  command->add_flag("--calibrate", options->trials.calibrate,
+                    "run Calibrate in each trial's cell before the plan (as a technician would after set-up)");
   addInjectOption(command, options->trials.inject);
   command->add_option("--json", options->json, "write the summary and every trial as JSON");
   command->add_option("--plot", options->plot, "write a PNG: success rate, failures, cycle times");

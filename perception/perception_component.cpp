@@ -89,6 +89,9 @@ class DetectObjectsOperation final : public component::RunningOperation {
             "DetectObjects: the camera stopped sending new frames (the frame's stamp did not advance)");
       }
     }
+    if (component_.config_.camera_pose) {
+      frame.camera_pose = component_.config_.camera_pose();
+    }
     frames_.push_back(std::move(frame));
     next_capture_ = component_.clock_.now() + component_.camera_.framePeriod();
   }

@@ -15,6 +15,7 @@
 // class's symmetries and axis priority. It reads camera frames only, never simulator ground
 // truth.
 
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -41,6 +42,10 @@ struct PerceptionConfig {
   /// Frames per DetectObjects (the median filter's N); the operation's `frames` parameter
   /// overrides it.
   int frames = 15;
+  /// Where the camera is in the world as calibrated (calibration/): when set, every frame is
+  /// seen from this pose instead of the one it carries, so a new calibration takes effect at
+  /// the next frame.
+  std::function<world::Pose()> camera_pose;
 };
 
 /// Loads the pipeline `config` describes: its files and options, the workspace centre from

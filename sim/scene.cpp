@@ -174,12 +174,80 @@ PartRequest parsePart(const json& item, const std::string& field, const std::map
   return request;
 }
 
+/// "camera_offset": fixed {"xyz", "rpy_deg"} or random {"distance", "angle_deg", "seed"}.
+CameraOffset parseCameraOffset(const json& value, const std::string& field) {
+  onlyKnownFields(object(value, field), field, {"xyz", "rpy_deg", "distance", "angle_deg", "seed"});
+  CameraOffset offset;
+  const bool fixed = value.contains("xyz") || value.contains("rpy_deg");
+  offset.random = value.contains("distance") || value.contains("angle_deg");
+  if (fixed == offset.random) {
+    fail(field,
+         "needs either \"xyz\"/\"rpy_deg\" (a fixed offset) or \"distance\"/\"angle_deg\" (a random "
+         "direction), not " +
+             std::string(fixed ? "both" : "neither"));
+  }
+  if (value.contains("xyz")) {
+    const auto xyz = numbers(value.at("xyz"), field + ".xyz", 3, 3, "[x, y, z] in m");
+    offset.xyz = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+    if (offset.xyz.norm() > 0.5) {
+      fail(field + ".xyz", "the camera may move at most 0.5 m, not " + shown(value.at("xyz")));
+    }
+  }
+  if (value.contains("rpy_deg")) {
+    const auto rpy = numbers(value.at("rpy_deg"), field + ".rpy_deg", 3, 3, "[roll, pitch, yaw] in degrees");
+    offset.rpy_deg = Eigen::Vector3d(rpy[0], rpy[1], rpy[2]);
+    if (offset.rpy_deg.cwiseAbs().maxCoeff() > 45) {
+      fail(field + ".rpy_deg",
+           "the camera may turn at most 45 degrees about each axis, not " + shown(value.at("rpy_deg")));
+    }
+  }
+  if (value.contains("distance")) {
+    offset.distance = number(value.at("distance"), field + ".distance");
+    if (offset.distance < 0 || offset.distance > 0.5) {
+      fail(field + ".distance", "must be from 0 to 0.5 (m), not " + shown(value.at("distance")));
+    }
+  }
+  if (value.contains("angle_deg")) {
+    offset.angle_deg = number(value.at("angle_deg"), field + ".angle_deg");
+    if (offset.angle_deg < 0 || offset.angle_deg > 45) {
+      fail(field + ".angle_deg", "must be from 0 to 45 (degrees), not " + shown(value.at("angle_deg")));
+    }
+  }
+  if (value.contains("seed")) {
+    offset.seed = whole(value.at("seed"), field + ".seed", 0, std::numeric_limits<std::uint64_t>::max());
+  }
+  return offset;
+}
+
 }  // namespace
+
+world::Pose cameraOffsetPose(const CameraOffset& offset, std::uint64_t seed) {
+  world::Pose pose = world::Pose::Identity();
+  if (!offset.random) {
+    const Eigen::Vector3d rpy = offset.rpy_deg * M_PI / 180.0;
+    pose = world::poseFromXyzRpy(offset.xyz.x(), offset.xyz.y(), offset.xyz.z(), rpy.x(), rpy.y(), rpy.z());
+    return pose;
+  }
+  // Directions uniform on the sphere: normalized Gaussian vectors.
+  std::mt19937_64 random(offset.seed.value_or(seed) ^ 0x63616d657261ULL);  // "camera": apart from placement
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const auto direction = [&] {
+    Eigen::Vector3d v;
+    do {
+      v = Eigen::Vector3d(normal(random), normal(random), normal(random));
+    } while (v.norm() < 1e-6);
+    return v.normalized();
+  };
+  pose.translation() = offset.distance * direction();
+  pose.linear() = Eigen::AngleAxisd(offset.angle_deg * M_PI / 180.0, direction()).toRotationMatrix();
+  return pose;
+}
 
 Scene parseScene(const std::string& text, const std::string& label) {
   try {
     const json file = json::parse(text);
-    onlyKnownFields(object(file, "the file"), "", {"description", "seed", "min_gap", "regions", "parts"});
+    onlyKnownFields(object(file, "the file"), "",
+                    {"description", "seed", "min_gap", "camera_offset", "regions", "parts"});
     Scene scene;
     scene.label = label;
     if (file.contains("description")) {
@@ -193,6 +261,9 @@ Scene parseScene(const std::string& text, const std::string& label) {
       if (scene.min_gap < 0.0 || scene.min_gap > 0.5) {
         fail("min_gap", "must be from 0 to 0.5 (m), not " + shown(file.at("min_gap")));
       }
+    }
+    if (file.contains("camera_offset")) {
+      scene.camera_offset = parseCameraOffset(file.at("camera_offset"), "camera_offset");
     }
     scene.regions = defaultRegions();
     if (file.contains("regions")) {

@@ -43,6 +43,26 @@ struct PartRequest {
   std::string region;
 };
 
+/// Where the RGB-D camera really is relative to its drawn mounting (the set-up a technician
+/// finds after the camera was bumped or the cell moved). Either fixed ("xyz", m, world axes;
+/// "rpy_deg", degrees) or random ("distance" m in a uniformly random direction and "angle_deg"
+/// about a uniformly random axis, drawn from "seed", default: the placement seed).
+/// Scene JSON: "camera_offset": {"xyz": [0.03, 0, -0.04], "rpy_deg": [0, 3, 4]} or
+///             "camera_offset": {"distance": 0.05, "angle_deg": 5, "seed": 7}.
+struct CameraOffset {
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rpy_deg = Eigen::Vector3d::Zero();
+  bool random = false;
+  double distance = 0.0;
+  double angle_deg = 0.0;
+  std::optional<std::uint64_t> seed;
+};
+
+/// The offset as a pose (translation in world axes; rotation about the camera's centre in
+/// world axes): Simulation's camera_offset. Random offsets draw from `seed` unless the offset
+/// names its own.
+world::Pose cameraOffsetPose(const CameraOffset& offset, std::uint64_t seed);
+
 struct Scene {
   std::string label;  // the file it came from
   std::string description;
@@ -51,6 +71,8 @@ struct Scene {
   std::vector<PartRequest> parts;
   /// Smallest gap between the footprints of randomly placed parts (m).
   double min_gap = 0.02;
+  /// The camera away from its drawn mounting (absent: as drawn).
+  std::optional<CameraOffset> camera_offset;
 };
 
 /// The table top (x, y in m), as sim/models/ur5_workcell.xml has it; regions and fixed

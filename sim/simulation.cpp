@@ -102,7 +102,11 @@ struct Simulation::Impl {
   int table_surface_geom = 0;  // the plane parts rest on
   int tcp_site = 0;
   int rgbd_camera = 0;
+  int gripper_marker_geom = 0;
+  world::Pose rgbd_nominal = world::Pose::Identity();  // optical frame as drawn
+  bool camera_moved = false;                           // mounted elsewhere than drawn
   int first_arm_body = 0;
+  int tool_body = 0;  // the flange's body
 
   std::int64_t steps = 0;         // physics steps since time 0
   std::int64_t settle_steps = 0;  // steps taken before time 0
@@ -147,6 +151,52 @@ struct Simulation::Impl {
 
   TimePoint now() const {
     return TimePoint(Duration(static_cast<std::int64_t>(std::llround(steps * model->opt.timestep * 1e9))));
+  }
+
+  /// Remembers the camera's mounting as drawn (a camera of the world body: its model pose is
+  /// its world pose) and moves it by `offset` (SimulationOptions::camera_offset).
+  void mountCamera(const world::Pose& offset) {
+    const int cam = rgbd_camera;
+    const mjtNum* q = model->cam_quat + 4 * cam;
+    world::Pose mujoco_camera = world::Pose::Identity();
+    mujoco_camera.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized().toRotationMatrix();
+    mujoco_camera.translation() = Eigen::Map<const Eigen::Vector3d>(model->cam_pos + 3 * cam);
+    rgbd_nominal = mujoco_camera * opticalInMujocoCamera();
+    camera_moved = offset.matrix() != Eigen::Matrix4d::Identity();
+    if (!camera_moved) {
+      return;  // the model untouched: not even rounded through a quaternion
+    }
+    mujoco_camera.linear() = offset.linear() * mujoco_camera.linear();
+    mujoco_camera.translation() += offset.translation();
+    const Eigen::Quaterniond moved(mujoco_camera.linear());
+    model->cam_quat[4 * cam + 0] = moved.w();
+    model->cam_quat[4 * cam + 1] = moved.x();
+    model->cam_quat[4 * cam + 2] = moved.y();
+    model->cam_quat[4 * cam + 3] = moved.z();
+    Eigen::Map<Eigen::Vector3d>(model->cam_pos + 3 * cam) = mujoco_camera.translation();
+  }
+
+  /// MuJoCo's camera looks along -z with y up; the optical frame looks along +z with y down.
+  static world::Pose opticalInMujocoCamera() {
+    world::Pose optical = world::Pose::Identity();
+    optical.linear() = Eigen::Vector3d(1, -1, -1).asDiagonal();
+    return optical;
+  }
+
+  world::Pose geomPose(int geom) const {
+    world::Pose pose = world::Pose::Identity();
+    const mjtNum* r = data->geom_xmat + 9 * geom;
+    pose.linear() << r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8];
+    pose.translation() = Eigen::Map<const Eigen::Vector3d>(data->geom_xpos + 3 * geom);
+    return pose;
+  }
+
+  world::Pose bodyPose(int body) const {
+    world::Pose pose = world::Pose::Identity();
+    const mjtNum* r = data->xmat + 9 * body;
+    pose.linear() << r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8];
+    pose.translation() = Eigen::Map<const Eigen::Vector3d>(data->xpos + 3 * body);
+    return pose;
   }
 
   bool isArmBody(int body) const {
@@ -300,6 +350,11 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->tcp_site = impl->id(mjOBJ_SITE, "tcp");
   impl->rgbd_camera = impl->id(mjOBJ_CAMERA, "rgbd");
   impl->first_arm_body = impl->id(mjOBJ_BODY, robot.first_moving_link.c_str());
+  impl->gripper_marker_geom = impl->id(mjOBJ_GEOM, "gripper_marker");
+  impl->mountCamera(options.camera_offset.value_or(
+      scene.camera_offset ? cameraOffsetPose(*scene.camera_offset, options.placement_seed.value_or(scene.seed))
+                          : world::Pose::Identity()));
+  impl->tool_body = impl->id(mjOBJ_BODY, robot.urdf_tool_link.c_str());  // the flange (tool0 on a UR)
   for (const auto& part : impl->placements) {
     impl->part_bodies.push_back(impl->id(mjOBJ_BODY, part.name.c_str()));
   }
@@ -436,6 +491,18 @@ world::Pose Simulation::rgbdPose() const {
   world::Pose optical = world::Pose::Identity();
   optical.linear() = Eigen::Vector3d(1, -1, -1).asDiagonal();
   return mujoco_camera * optical;
+}
+
+world::Pose Simulation::rgbdNominalPose() const {
+  // Not moved: exactly the pose MuJoCo puts the camera at (the drawing's quaternion through
+  // MuJoCo's own arithmetic), so a cell that believes its drawings sees what it saw before.
+  return impl_->camera_moved ? impl_->rgbd_nominal : rgbdPose();
+}
+
+world::Pose Simulation::gripperMarkerPose() const { return impl_->geomPose(impl_->gripper_marker_geom); }
+
+world::Pose Simulation::gripperMarkerInFlange() const {
+  return impl_->bodyPose(impl_->tool_body).inverse() * gripperMarkerPose();
 }
 
 camera::RgbdFrame Simulation::captureRgbd(std::uint64_t noise_seed, bool colour) {

@@ -62,6 +62,12 @@ struct SimulationOptions {
   DepthNoiseOptions depth_noise;
   /// Physics time to let parts settle before time 0.
   double settle_seconds = 0.3;
+  /// Where the RGB-D camera really is, relative to where the cell's drawings put it (the
+  /// model's nominal mounting): its optical centre moved by the translation (world axes) and
+  /// its orientation turned by the rotation (world axes, about the optical centre). Identity:
+  /// mounted as drawn. Absent: the scene's camera_offset (seeded by the placement seed), if
+  /// any. Components never learn it; only calibration recovers it.
+  std::optional<world::Pose> camera_offset;
 };
 
 /// A part's true state, for tests and the trial judge.
@@ -120,8 +126,12 @@ class Simulation {
 
   // --- camera ----------------------------------------------------------------------------
   const camera::Intrinsics& rgbdIntrinsics() const;
-  /// Pose of the RGB-D camera's optical frame (x right, y down, z forward) in the world.
+  /// Pose of the RGB-D camera's optical frame (x right, y down, z forward) in the world: the
+  /// true pose (nominal mounting moved by SimulationOptions::camera_offset).
   world::Pose rgbdPose() const;
+  /// The optical frame where the cell's drawings put it (the model's mounting, without the
+  /// offset): what the system believes before it calibrates the camera.
+  world::Pose rgbdNominalPose() const;
   /// Renders the RGB-D camera now and applies the depth noise model with `noise_seed`.
   /// Without `colour` the frame's colour image is left empty and only depth is rendered
   /// (faster; the points are the same).
@@ -131,6 +141,13 @@ class Simulation {
 
   // --- ground truth (tests and the trial judge only) ----------------------------------------
   std::vector<PartState> parts() const;
+  /// The calibration marker fixed to the gripper (DICT_4X4_50 id kGripperMarkerId, black
+  /// square kGripperMarkerSize wide): its frame (x to the image's right, y up, z out of it) in
+  /// the world, and in the flange frame (tool0), true values.
+  world::Pose gripperMarkerPose() const;
+  world::Pose gripperMarkerInFlange() const;
+  static constexpr int kGripperMarkerId = 1;
+  static constexpr double kGripperMarkerSize = 0.05;
   /// Puts a part elsewhere at rest, as a person who moves or takes away a part mid-task would
   /// (scenario tests and evaluation; plans never call it). Takes effect at once (positions
   /// are recomputed); physics carries on from there.

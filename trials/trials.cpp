@@ -33,14 +33,29 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
   result.seed = options.seed + static_cast<std::uint64_t>(index);
   const auto wall_start = std::chrono::steady_clock::now();
   try {
-    const auto cell = workcell::makeWorkcell(
-        {.name = "ur5-sim",
-         .scene = options.scene,
-         .seed = result.seed,
-         .waypoints = options.waypoints,
-         .memory_only = true,
-         .faults = options.inject.empty() ? nullptr : faults::Injector::fromText(options.inject, result.seed)});
+    workcell::WorkcellOptions cell_options{
+        .name = "ur5-sim",
+        .scene = options.scene,
+        .seed = result.seed,
+        .waypoints = options.waypoints,
+        .memory_only = true,
+        .faults = options.inject.empty() ? nullptr : faults::Injector::fromText(options.inject, result.seed)};
+    if (options.camera_move_m > 0 || options.camera_turn_deg > 0) {
+      cell_options.camera_move =
+          workcell::WorkcellOptions::CameraMove{options.camera_move_m, options.camera_turn_deg, {}};
+    }
+    const auto cell = workcell::makeWorkcell(cell_options);
     sim::Simulation& simulation = *cell->simulation();
+    if (options.calibrate) {
+      const component::OperationResult calibrated =
+          workcell::runOperation(*cell, "Calibrate", {}, std::chrono::seconds(120));
+      if (calibrated.state != component::OperationState::kSuccess) {
+        result.failure_path = "Calibrate";
+        result.reason = calibrated.reason;
+        result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+        return result;
+      }
+    }
     const std::vector<sim::PartState> initial = simulation.parts();
     bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
     bt::Executor executor(tree, cell->clock(), {.time_limit = fromSeconds(options.time_limit_s)});

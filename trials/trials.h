@@ -25,6 +25,14 @@ struct TrialOptions {
   double time_limit_s = 600.0;      // simulated seconds per trial
   double settle_s = 2.0;            // simulated after the plan, before judging
   int jobs = 1;                     // trials run at once (threads)
+  /// The camera moved from its drawn mounting in each trial by this distance (m) and angle
+  /// (degrees) in a direction drawn from the trial's seed (0, 0: mounted as drawn).
+  double camera_move_m = 0.0;
+  double camera_turn_deg = 0.0;
+  /// Calibrate the camera once in each trial's cell before the plan runs, as a technician does
+  /// after setting the cell up (not counted in the cycle time; a failed calibration fails the
+  /// trial).
+  bool calibrate = false;
   /// This run's slice of the trials, for spreading them over machines: trials i with
   /// i % shard_count == shard_index (trial i keeps seed + i whichever shard runs it).
   int shard_index = 0;

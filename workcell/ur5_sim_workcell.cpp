@@ -4,6 +4,7 @@
 
 #include "arm/arm_component.h"
 #include "arm/robot_description.h"
+#include "calibration/calibration_component.h"
 #include "core/paths.h"
 #include "faults/injector.h"
 #include "gripper/finger_geometry.h"
@@ -152,6 +153,9 @@ class Ur5SimWorkcell final : public Workcell {
     }
     add(arm);
     components().add(gripper);
+    // HandEyeCalibration: the camera's pose comes from it (the drawings until calibrated).
+    calibration_ = makeCalibration(options, *arm, camera);
+    add(calibration_);
     add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{{"table_center", tableCenter()},
                                                                                        {"robot_base", kBaseInWorld}}));
     if (options.test_oracle_perception) {
@@ -160,6 +164,7 @@ class Ur5SimWorkcell final : public Workcell {
       // DetectObjects: the camera's frames only, never the simulator's true poses.
       perception::PerceptionConfig perception_config;
       perception_config.table_center = tableCenter();
+      perception_config.camera_pose = [calibration = calibration_.get()] { return calibration->cameraPose(); };
       add(std::make_shared<perception::PerceptionComponent>(camera, clock(), threadPipeline(perception_config),
                                                             perception_config));
     }
@@ -225,7 +230,44 @@ class Ur5SimWorkcell final : public Workcell {
     sim::SimulationOptions sim_options;
     sim_options.robot = robot;
     sim_options.placement_seed = options.seed;
+    if (options.camera_move) {
+      sim::CameraOffset offset;
+      offset.random = true;
+      offset.distance = options.camera_move->distance;
+      offset.angle_deg = options.camera_move->angle_deg;
+      offset.seed = options.camera_move->seed;
+      sim_options.camera_offset = sim::cameraOffsetPose(offset, options.seed.value_or(1));
+    }
     return sim_options;
+  }
+
+  /// The calibration component with the cell's saved calibration (the marker's shipped one
+  /// when none was saved).
+  std::shared_ptr<calibration::CalibrationComponent> makeCalibration(const WorkcellOptions& options,
+                                                                     arm::ArmComponent& arm,
+                                                                     camera::RgbdCamera& camera) {
+    const std::filesystem::path file =
+        !options.calibration.empty()
+            ? options.calibration
+            : (options.memory_only ? std::filesystem::path() : defaultCalibrationFile("ur5-sim"));
+    calibration::CellCalibration initial = calibration::loadCalibration(file).value_or(calibration::CellCalibration{});
+    if (!initial.marker_in_flange) {
+      if (const auto shipped = calibration::loadCalibration(dataRoot() / "data/calibration/ur5-sim.json")) {
+        initial.marker_in_flange = shipped->marker_in_flange;
+        initial.marker_method = shipped->marker_method;
+        initial.marker_residuals = shipped->marker_residuals;
+        initial.marker_views = shipped->marker_views;
+      }
+    }
+    calibration::CalibrationConfig config;
+    config.file = options.memory_only ? std::filesystem::path() : file;
+    config.seed = options.seed.value_or(scene_.seed);
+    // The drawings: the marker on the gripper body's +x face, 7.5 cm from the flange.
+    config.marker_in_flange_guess = world::poseFromXyzRpy(0.035, 0, 0.075, -M_PI / 2, 0, -M_PI / 2);
+    config.solve.marker_size = sim::Simulation::kGripperMarkerSize;
+    config.marker_id = sim::Simulation::kGripperMarkerId;
+    return std::make_shared<calibration::CalibrationComponent>(arm, camera, clock(), simulation_->rgbdNominalPose(),
+                                                               std::move(initial), config);
   }
   static Eigen::VectorXd toEigen(const sim::ArmJoints& q) { return q.eigen(); }
 
@@ -241,6 +283,7 @@ class Ur5SimWorkcell final : public Workcell {
   arm::WaypointStore waypoints_;
   smartmove::GraspLibrary grasps_;
   std::shared_ptr<smartmove::SmartMoveComponent> smartmove_;
+  std::shared_ptr<calibration::CalibrationComponent> calibration_;
   std::shared_ptr<faults::Injector> faults_;
 };
 

@@ -31,6 +31,48 @@ std::filesystem::path stateDir() {
 
 std::filesystem::path defaultGraspFile(const std::string& workcell) { return stateDir() / workcell / "grasps.json"; }
 
+component::OperationResult runOperation(Workcell& cell, const std::string& operation, const component::ParamMap& params,
+                                        Duration limit,
+                                        const std::function<void(const component::OperationResult&)>& progress,
+                                        Duration tick) {
+  component::Component* component = cell.components().provider(operation);
+  if (component == nullptr) {
+    throw std::invalid_argument("no component of workcell '" + cell.name() + "' offers the operation '" + operation +
+                                "'");
+  }
+  const component::OperationSpec* spec = component->description().operation(operation);
+  component::ParamMap full = params;
+  for (const auto& param : spec->params) {
+    if (full.find(param.name) == full.end() && param.default_value) {
+      full.emplace(param.name, *param.default_value);
+    }
+  }
+  cell.beforeTick();
+  const component::OperationId id = component->start(operation, full);
+  const TimePoint end = cell.clock().now() + limit;
+  for (;;) {
+    const component::OperationResult result = component->poll(id);
+    if (progress) {
+      progress(result);
+    }
+    if (result.state != component::OperationState::kRunning) {
+      cell.beforeTick();
+      return result;
+    }
+    if (cell.clock().now() >= end) {
+      component->cancel(id);
+      return component::OperationResult::failure(operation + " did not finish within " +
+                                                 std::to_string(toSeconds(limit)) + " s");
+    }
+    cell.clock().sleepUntil(cell.clock().now() + tick);
+    cell.beforeTick();
+  }
+}
+
+std::filesystem::path defaultCalibrationFile(const std::string& workcell) {
+  return stateDir() / workcell / "calibration.json";
+}
+
 std::filesystem::path defaultWaypointFile(const std::string& workcell) {
   return stateDir() / workcell / "waypoints.json";
 }

@@ -36,6 +36,19 @@ struct WorkcellOptions {
   /// Never write waypoints or taught grasps (tests, trials): the waypoint file, if given, is
   /// read only.
   bool memory_only = false;
+  /// Simulated cells: the camera moved from where the cell's drawings put it, by `distance`
+  /// (m) in a random direction and turned by `angle_deg` about a random axis, drawn from
+  /// `seed` (default: the cell's seed); overrides the scene's camera_offset.
+  struct CameraMove {
+    double distance = 0.0;
+    double angle_deg = 0.0;
+    std::optional<std::uint64_t> seed;
+  };
+  std::optional<CameraMove> camera_move;
+  /// Where the cell's calibration (calibration/) is kept (default: beside the waypoints,
+  /// calibration.json; in `memory_only` mode read from here if given, never written). Without
+  /// a marker calibration there, the one shipped in data/calibration/<workcell>.json is used.
+  std::filesystem::path calibration;
   /// TEST ONLY: report the simulator's true part poses as object symbols in place of
   /// perception, to test SmartMove apart from perception. Never set by the CLI.
   bool test_oracle_perception = false;
@@ -109,6 +122,18 @@ std::unique_ptr<Workcell> makeBareWorkcell();
 
 /// Where waypoints of `workcell` are kept by default.
 std::filesystem::path defaultWaypointFile(const std::string& workcell);
+/// Runs one operation of the cell (the component offering it) to its end outside a plan, as a
+/// one-node plan would: the world is refreshed and the clock advanced in `tick` steps (on a
+/// simulated clock, simulated time passes); `progress` is called after each poll. Gives up
+/// with a FAILURE after `limit` of clock time, cancelling the operation.
+/// @throws std::invalid_argument for an operation no component offers.
+component::OperationResult runOperation(Workcell& cell, const std::string& operation, const component::ParamMap& params,
+                                        Duration limit,
+                                        const std::function<void(const component::OperationResult&)>& progress = {},
+                                        Duration tick = std::chrono::milliseconds(10));
+
+/// Where the calibration of `workcell` is kept by default.
+std::filesystem::path defaultCalibrationFile(const std::string& workcell);
 /// Where grasps taught on `workcell` are kept by default.
 std::filesystem::path defaultGraspFile(const std::string& workcell);
 

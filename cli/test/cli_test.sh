@@ -56,6 +56,12 @@ check "trials merge: missing" 2 '1 of 3 trials are missing \(a shard not merged\
 check "trials merge: twice" 2 'trial 1 appears twice' -- "$costar" trials merge "$tmp/s0.json" "$tmp/s1.json" "$tmp/s1.json"
 check "trials: bad shard"   2 "needs 0 <= I < N" -- "$costar" trials examples/ur5/pick_up_node.xml --judge lift --shard 4/4
 
+# Calibration (issue 14): bad options are refused before any cell is built.
+check "calibrate: bad move"   2 "'5cm' should be DISTANCE_M,ANGLE_DEG" -- "$costar" calibrate --camera-move 5cm
+check "calibrate: bad method" 2 "--method: nope not in" -- "$costar" calibrate marker --method nope
+check "calibrate eval: 0"     2 "--setups: Value 0 not in range" -- "$costar" calibrate eval --setups 0
+check "trials: bad move"      2 "--camera-move: at most 0.5 m and 45 degrees" -- "$costar" trials examples/ur5/pick_up_node.xml --judge lift --camera-move 1,1
+
 # Teaching: jog, teach, move back, rename; waypoints persist in the file.
 printf 'jog z 0.05\nteach up\nhome\nmove up\nrename up lifted\nmove nowhere\nquit\n' |
   "$costar" teach --scene sim/scenes/one_node.json --waypoints "$tmp/waypoints.json" >"$tmp/teach.out" 2>&1

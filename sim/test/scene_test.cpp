@@ -167,7 +167,7 @@ TEST(Scene, BadValuesAreErrorsNamingTheField) {
   EXPECT_EQ(problem(R"({"parts": [{"colour": "red", "class": "node"}]})"),
             prefix + "parts[0].colour: unknown field (known: class, color, count, at, region)");
   EXPECT_EQ(problem(R"({"regoins": {}, "parts": []})"),
-            prefix + "regoins: unknown field (known: description, seed, min_gap, regions, parts)");
+            prefix + "regoins: unknown field (known: description, seed, min_gap, camera_offset, regions, parts)");
   EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5]}]})"),
             prefix + "parts[0].at: must be [x, y] or [x, y, yaw] (m, m, degrees), not [0.5]");
   EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, null]}]})"),
@@ -188,6 +188,38 @@ TEST(Scene, BadValuesAreErrorsNamingTheField) {
             std::string::npos);
   EXPECT_EQ(problem(R"({"regions": [], "parts": []})"), prefix + "regions: must be an object {...}, not []");
   EXPECT_EQ(problem(R"({"parts": []})"), "no error");
+}
+
+// Issue 14: the camera moved from its drawn mounting, a scene option validated like the others.
+TEST(Scene, CameraOffsetIsReadAndItsProblemsAreNamed) {
+  const std::string prefix = "scene 'bad.json': ";
+  EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0.03, 0, -0.04], "rpy_deg": [0, 3, 4]}, "parts": []})"), "no error");
+  EXPECT_EQ(problem(R"({"camera_offset": {"distance": 0.05, "angle_deg": 5, "seed": 7}, "parts": []})"), "no error");
+  EXPECT_EQ(problem(R"({"camera_offset": [0.05], "parts": []})"),
+            prefix + "camera_offset: must be an object {...}, not [0.05]");
+  EXPECT_EQ(problem(R"({"camera_offset": {"distanse": 0.05}, "parts": []})"),
+            prefix + "camera_offset.distanse: unknown field (known: xyz, rpy_deg, distance, angle_deg, seed)");
+  EXPECT_EQ(problem(R"({"camera_offset": {}, "parts": []})"),
+            prefix +
+                "camera_offset: needs either \"xyz\"/\"rpy_deg\" (a fixed offset) or \"distance\"/\"angle_deg\" "
+                "(a random direction), not neither");
+  EXPECT_EQ(
+      problem(R"({"camera_offset": {"xyz": [0, 0, 0], "distance": 0.1}, "parts": []})").substr(0, prefix.size() + 28),
+      prefix + "camera_offset: needs either ");
+  EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0, 0]}, "parts": []})"),
+            prefix + "camera_offset.xyz: must be [x, y, z] in m, not [0,0]");
+  EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0, "a", 0]}, "parts": []})"),
+            prefix + "camera_offset.xyz[1]: must be a finite number, not \"a\"");
+  EXPECT_EQ(problem(R"({"camera_offset": {"xyz": [0.6, 0, 0]}, "parts": []})"),
+            prefix + "camera_offset.xyz: the camera may move at most 0.5 m, not [0.6,0,0]");
+  EXPECT_EQ(problem(R"({"camera_offset": {"rpy_deg": [0, 90, 0]}, "parts": []})"),
+            prefix + "camera_offset.rpy_deg: the camera may turn at most 45 degrees about each axis, not [0,90,0]");
+  EXPECT_EQ(problem(R"({"camera_offset": {"distance": -0.1}, "parts": []})"),
+            prefix + "camera_offset.distance: must be from 0 to 0.5 (m), not -0.1");
+  EXPECT_EQ(problem(R"({"camera_offset": {"angle_deg": 50}, "parts": []})"),
+            prefix + "camera_offset.angle_deg: must be from 0 to 45 (degrees), not 50");
+  EXPECT_EQ(problem(R"({"camera_offset": {"distance": 0.1, "seed": 1.5}, "parts": []})").substr(0, prefix.size() + 20),
+            prefix + "camera_offset.seed: ");
 }
 
 TEST(Scene, UnreadableFilesAreNamedAsSuch) {
