@@ -211,6 +211,14 @@ async function main() {
   const structure = judgeAssembly(second.parts, still);
   check(structure !== null, `the simulator's true state holds the structure (base / link / top): ${structure ?? second.parts.map((p) => `${p.name} ${p.p.map((v) => v.toFixed(3))}`).join('; ')}`);
 
+  // The world the page believes: the top part was put down after the last detection, so only
+  // the page's belief (it moved with the tool while held) has it on the structure.
+  const top = second.parts.find((p) => p.name === structure.split(' / ')[2]);
+  const putDown = await page.$$eval('.objects-table tbody tr', (rows) => rows.map((r) => r.textContent).filter((t) => t.includes('(put down)')));
+  const believedAt = putDown.map((t) => /(-?\d+\.\d+), (-?\d+\.\d+), (-?\d+\.\d+)/.exec(t).slice(1).map(Number));
+  const off = Math.min(...believedAt.map((p) => Math.hypot(...p.map((v, i) => v - top.p[i]))));
+  check(putDown.length === 1 && off < 0.05, `the Objects pane shows the top part where it was put down, ${(off * 100).toFixed(1)} cm from where it is: ${putDown.join('; ')}`);
+
   // Screenshots of the finished run at both sizes: select a SmartRelease to show its candidates.
   await node('SmartRelease', 1).click();
   await page.waitForTimeout(600);

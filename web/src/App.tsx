@@ -109,14 +109,17 @@ export function App() {
   const [replay, setReplay] = useState<ReplayState | null>(null);
   const [runsRefresh, setRunsRefresh] = useState(0);
 
-  // The world the system believes, one step per snapshot (pane 1 lists it, pane 2 draws it).
+  // The world the system believes (pane 1 lists it, pane 2 draws it): one step for every
+  // snapshot as it arrives, not per render, so that a grasp or a release between two renders
+  // is not missed.
   const beliefRef = useRef(emptyBelief());
-  const believed = useMemo<Believed | undefined>(() => {
-    if (!cell) return undefined;
-    const next = believe(beliefRef.current, cell);
+  const [believed, setBelieved] = useState<Believed | undefined>(undefined);
+  const showCell = (state: CellState) => {
+    const next = believe(beliefRef.current, state);
     beliefRef.current = next.belief;
-    return next;
-  }, [cell]);
+    setBelieved(next);
+    setCell(state);
+  };
 
   const planRef = useRef(plan);
   planRef.current = plan;
@@ -147,7 +150,7 @@ export function App() {
         switch (m.type) {
           case 'hello':
             setInfo(m.info);
-            setCell(m.state);
+            if (m.state) showCell(m.state);
             // The last run paints this plan only if it is a run of this plan (a reload starts
             // a new plan: another plan's old FAILURE must not show on it).
             if (m.run && m.run.kind === 'plan' && m.run.nodes && m.run.plan && m.run.plan === planNameRef.current) {
@@ -159,7 +162,7 @@ export function App() {
             }
             break;
           case 'state':
-            setCell(m as CellState);
+            showCell(m as CellState);
             break;
           case 'run_started':
             if (m.run.kind === 'plan') {
