@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 namespace costar::arm {
 
@@ -30,32 +31,77 @@ double maxAbs(const JointVector& a, const JointVector& b) {
   return largest;
 }
 
+/// Why a reading cannot be trusted, or empty.
+std::string problemWith(const ArmState& state, TimePoint now, Duration timeout) {
+  for (int j = 0; j < kJointCount; ++j) {
+    if (!std::isfinite(state.position[j]) || !std::isfinite(state.velocity[j])) {
+      return std::string("arm driver: the joint state is not a number (") + kJointNames[j] + ")";
+    }
+  }
+  if (state.stamp != TimePoint{} && now - state.stamp > timeout) {
+    return "arm driver: the joint state stopped updating (" + format("%.3f", toSeconds(now - state.stamp)) + " s old)";
+  }
+  return {};
+}
+
+/// Decelerates the motion being followed along its path, if it is not over.
+void stopMotion(ArmMotion& motion, ArmDriver& driver, const Clock& clock, const JointLimits& limits) {
+  ++motion.counter;
+  if (!motion.trajectory) {
+    return;
+  }
+  const TimePoint now = clock.now();
+  if (now - motion.start < motion.trajectory->duration()) {
+    const TrajectoryPoint state = motion.trajectory->sample(now - motion.start);
+    auto stop = std::make_shared<JointTrajectory>(JointTrajectory::stopFrom(state, limits));
+    driver.execute(stop, now);
+    motion.trajectory = std::move(stop);
+    motion.start = now;
+  }
+}
+
 /// A motion being executed by the driver.
 class MotionOperation final : public component::RunningOperation {
  public:
-  MotionOperation(ArmDriver& driver, const Clock& clock, MotionPlan plan, std::shared_ptr<std::uint64_t> counter,
+  MotionOperation(ArmDriver& driver, const Clock& clock, MotionPlan plan, std::shared_ptr<ArmMotion> motion,
                   const ArmConfig& config, std::string what)
       : driver_(driver),
         clock_(clock),
         plan_(std::move(plan)),
-        counter_(std::move(counter)),
-        id_(++*counter_),
+        motion_(std::move(motion)),
+        id_(++motion_->counter),
         config_(config),
         what_(std::move(what)),
         start_(clock.now()) {
+    motion_->trajectory = plan_.trajectory;
+    motion_->start = start_;
     driver_.execute(plan_.trajectory, start_);
   }
 
   OperationResult poll() override {
-    if (*counter_ != id_) {
-      return OperationResult::failure("another motion took over the arm before " + what_ + " finished");
+    if (motion_->counter != id_) {
+      return OperationResult::failure("the arm was stopped, or another motion took over, before " + what_ +
+                                      " finished");
     }
     const TimePoint now = clock_.now();
+    // Every poll checks the driver's reading: a driver that fails, reads NaN or stopped
+    // updating stops the motion at once.
+    ArmState state;
+    std::string problem;
+    try {
+      state = driver_.read();
+      problem = problemWith(state, now, config_.state_timeout);
+    } catch (const std::exception& e) {
+      problem = e.what();
+    }
+    if (!problem.empty()) {
+      stopMotion(*motion_, driver_, clock_, config_.limits);
+      return OperationResult::failure(what_ + ": " + problem + "; the arm was stopped");
+    }
     const TimePoint end = start_ + plan_.trajectory->duration();
     if (now < end) {
       return OperationResult::running();
     }
-    const ArmState state = driver_.read();
     const double error = maxAbs(state.position, plan_.goal);
     const double speed = maxAbs(state.velocity, JointVector{});
     if (error < config_.arrival_tolerance && speed < 0.05) {
@@ -69,20 +115,16 @@ class MotionOperation final : public component::RunningOperation {
   }
 
   void cancel() override {
-    if (*counter_ != id_) {
-      return;
+    if (motion_->counter == id_) {
+      stopMotion(*motion_, driver_, clock_, config_.limits);
     }
-    ++*counter_;
-    const TimePoint now = clock_.now();
-    const TrajectoryPoint state = plan_.trajectory->sample(now - start_);
-    driver_.execute(std::make_shared<JointTrajectory>(JointTrajectory::stopFrom(state, config_.limits)), now);
   }
 
  private:
   ArmDriver& driver_;
   const Clock& clock_;
   MotionPlan plan_;
-  std::shared_ptr<std::uint64_t> counter_;
+  std::shared_ptr<ArmMotion> motion_;
   std::uint64_t id_;
   const ArmConfig& config_;
   std::string what_;
@@ -168,8 +210,18 @@ Eigen::VectorXd ArmComponent::toEigen(const JointVector& q) const {
 }
 
 world::Pose ArmComponent::endpoint() const {
-  return config_.base_in_world * kinematics_.forward(driver_.read().position) * config_.tcp_in_flange;
+  return config_.base_in_world * kinematics_.forward(checkedRead().position) * config_.tcp_in_flange;
 }
+
+ArmState ArmComponent::checkedRead() const {
+  const ArmState state = driver_.read();
+  if (const std::string problem = problemWith(state, clock_.now(), config_.state_timeout); !problem.empty()) {
+    throw std::runtime_error(problem);
+  }
+  return state;
+}
+
+void ArmComponent::stop() { stopMotion(*motion_, driver_, clock_, config_.limits); }
 
 world::Pose ArmComponent::flangeInBase(const world::Pose& tcp_in_world) const {
   return config_.base_in_world.inverse() * tcp_in_world * config_.tcp_in_flange.inverse();
@@ -248,7 +300,7 @@ MotionPlan ArmComponent::planToJoints(const JointVector& start, const JointVecto
 }
 
 MotionPlan ArmComponent::planToPose(const world::Pose& tcp_in_world, double speed) const {
-  const JointVector current = driver_.read().position;
+  const JointVector current = checkedRead().position;
   const std::vector<JointVector> candidates = solutions(tcp_in_world, current);
   if (candidates.empty()) {
     return {nullptr, current, "the pose is out of reach (no inverse kinematics solution within the joint limits)"};
@@ -320,7 +372,7 @@ std::unique_ptr<component::RunningOperation> ArmComponent::execute(MotionPlan pl
   if (!plan.ok()) {
     return std::make_unique<component::FinishedOperation>(OperationResult::failure(what + ": " + plan.failure));
   }
-  return std::make_unique<MotionOperation>(driver_, clock_, std::move(plan), motion_counter_, config_, what);
+  return std::make_unique<MotionOperation>(driver_, clock_, std::move(plan), motion_, config_, what);
 }
 
 std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::string& operation,
@@ -394,7 +446,7 @@ std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::stri
     return execute(planLine(target, speed()), operation);
   }
   if (operation == "JogJoint") {
-    JointVector goal = driver_.read().position;
+    JointVector goal = checkedRead().position;
     goal[params.at("joint").asInt() - 1] += params.at("degrees").asDouble() * M_PI / 180.0;
     return execute(planToJoints(goal, speed()), "JogJoint");
   }
@@ -403,7 +455,7 @@ std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::stri
     waypoint.name = params.at("waypoint").asString();
     if (params.at("kind").asString() == "joints") {
       waypoint.kind = Waypoint::Kind::kJoints;
-      waypoint.joints = driver_.read().position;
+      waypoint.joints = checkedRead().position;
     } else {
       waypoint.frame = params.at("frame").asString();
       const auto frame = waypoint.frame == "world" ? std::optional<world::Pose>(world::Pose::Identity())
@@ -438,7 +490,8 @@ std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::stri
 }
 
 world::Report ArmComponent::report() const {
-  const ArmState state = driver_.read();
+  // A reading that cannot be trusted makes the report throw: the registry then stops the cell.
+  const ArmState state = checkedRead();
   const world::Pose tcp = config_.base_in_world * kinematics_.forward(state.position) * config_.tcp_in_flange;
   const TimePoint now = clock_.now();
   world::Report report;

@@ -49,6 +49,8 @@ struct ArmConfig {
   /// A motion fails if the arm is not within this of its goal this long after the end.
   double arrival_tolerance = 0.005;  // rad
   Duration settle_time = std::chrono::seconds(1);
+  /// A joint state older than this (by the driver's stamp) means the driver stopped updating.
+  Duration state_timeout = std::chrono::milliseconds(50);
   /// Cartesian straight lines are followed through IK points this far apart.
   double line_step = 0.005;  // m
   planning::PlannerOptions planner;
@@ -60,6 +62,13 @@ struct MotionPlan {
   JointVector goal{};
   std::string failure;
   bool ok() const { return trajectory != nullptr; }
+};
+
+/// The motion the driver follows, shared by the component and the motion's operation.
+struct ArmMotion {
+  std::uint64_t counter = 0;  // bumped by every new motion and every stop
+  std::shared_ptr<const JointTrajectory> trajectory;
+  TimePoint start{};
 };
 
 class ArmComponent final : public component::LocalComponent {
@@ -82,7 +91,15 @@ class ArmComponent final : public component::LocalComponent {
   /// the joint limits, nearest first.
   std::vector<JointVector> solutions(const world::Pose& tcp_in_world, const JointVector& seed) const;
   /// The joint configuration now (from the encoders).
-  JointVector joints() const { return driver_.read().position; }
+  JointVector joints() const { return checkedRead().position; }
+  /// The driver's reading, checked: finite and fresh.
+  /// @throws std::runtime_error naming the problem (NaN joints, a state that stopped updating,
+  /// or the driver's own error).
+  ArmState checkedRead() const;
+  /// Stops any motion now: decelerates along its path within the acceleration limits. Needs
+  /// no reading from the driver (it may be the thing that failed). The motion's operation
+  /// then fails.
+  void stop();
   /// A collision-free motion from the current configuration to the TCP pose.
   MotionPlan planToPose(const world::Pose& tcp_in_world, double speed) const;
   /// A collision-free motion from `from` (default: where the arm is) to `goal`.
@@ -119,7 +136,7 @@ class ArmComponent final : public component::LocalComponent {
   FrameLookup frames_;
   ArmConfig config_;
   Ur5Kinematics kinematics_;
-  std::shared_ptr<std::uint64_t> motion_counter_ = std::make_shared<std::uint64_t>(0);
+  std::shared_ptr<ArmMotion> motion_ = std::make_shared<ArmMotion>();
 };
 
 }  // namespace costar::arm

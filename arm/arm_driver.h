@@ -13,6 +13,9 @@ namespace costar::arm {
 struct ArmState {
   JointVector position{};
   JointVector velocity{};
+  /// When the controller measured it; TimePoint{} from a driver that does not stamp its
+  /// readings (the Arm component then cannot tell a reading that stopped updating).
+  TimePoint stamp{};
 };
 
 class ArmDriver {

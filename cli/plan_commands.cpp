@@ -15,6 +15,7 @@
 #include "bt/nodes_model.h"
 #include "bt/plan_xml.h"
 #include "bt/trace.h"
+#include "cli/inject_option.h"
 #include "cli/workcell_access.h"
 #include "workcell/workcell.h"
 
@@ -116,9 +117,13 @@ struct RunOptions {
   double time_limit_s = 0.0;
   bool quiet = false;
   bool all_nodes = false;
+  std::vector<std::string> inject;
 };
 
-int runPlan(const RunOptions& options) {
+int runPlan(RunOptions options) {
+  if (!options.inject.empty()) {
+    options.workcell.faults = makeFaultInjector(options.inject, options.workcell.seed.value_or(1));
+  }
   const std::unique_ptr<workcell::Workcell> cell = openWorkcell(options.workcell, WorkcellUse::kRun);
   if (!cell) {
     return kExitInvalid;
@@ -167,6 +172,9 @@ int runPlan(const RunOptions& options) {
   g_running_executor.store(nullptr);
 
   const char* clock_kind = cell->clock().simulated() ? "simulated" : "real";
+  if (options.workcell.faults) {
+    std::printf("%s", faultSummary(*options.workcell.faults).c_str());
+  }
   const std::uint64_t node_ticks = tree->context().nodeTicks();
   if (result.stopped) {
     std::printf("%sSTOPPED%s by the user after %.3f s %s; running operations were cancelled\n", colors.red,
@@ -264,6 +272,7 @@ void addPlanCommands(CLI::App& app, int& exit_code) {
       ->check(CLI::NonNegativeNumber);
   run->add_flag("-q,--quiet", options->quiet, "print only the result");
   run->add_flag("--all-nodes", options->all_nodes, "status lines for internal nodes too");
+  addInjectOption(run, options->inject);
   run->footer(
       "Exit code: 0 SUCCESS, 1 FAILURE (the failing node's path and reason are printed), 2 invalid plan,\n"
       "130 stopped with Ctrl-C (running operations are cancelled).");

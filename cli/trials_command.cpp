@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bt/plan.h"
+#include "cli/inject_option.h"
 #include "trials/judge.h"
 #include "trials/trials.h"
 
@@ -206,6 +207,7 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
   command->add_option("--time-limit", options->trials.time_limit_s, "simulated seconds allowed per trial")
       ->check(numberIn(0.0, trials::kMaxTimeLimitSeconds, true, " s"))
       ->capture_default_str();
+  addInjectOption(command, options->trials.inject);
   command->add_option("--json", options->json, "write the summary and every trial as JSON");
   command->add_option("--plot", options->plot, "write a PNG: success rate, failures, cycle times");
   command->add_option("--require", options->require, "exit 1 when the success rate is below this (0..1)")

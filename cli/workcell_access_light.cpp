@@ -10,6 +10,9 @@ std::unique_ptr<workcell::Workcell> openWorkcellFor(const workcell::WorkcellOpti
   if (auto cell = workcell::makeLightWorkcell(options)) {
     return cell;
   }
+  if (!options.inject.empty() || options.faults) {
+    runInRobotBinary();  // the fault injector lives with the robot libraries
+  }
   // A robot cell. Its description (written at build time by `costar-robot describe-workcell`)
   // holds its node types for the default scene; another scene may have other object classes.
   if (use == WorkcellUse::kDescribe && options.scene.empty()) {
@@ -20,5 +23,11 @@ std::unique_ptr<workcell::Workcell> openWorkcellFor(const workcell::WorkcellOpti
   }
   runInRobotBinary();
 }
+
+std::shared_ptr<faults::Injector> makeFaultInjector(const std::vector<std::string>& /*specs*/, std::uint64_t /*seed*/) {
+  runInRobotBinary();  // the fault injector lives with the robot libraries
+}
+
+std::string faultSummary(const faults::Injector& /*injector*/) { return {}; }
 
 }  // namespace costar::cli

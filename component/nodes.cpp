@@ -5,11 +5,12 @@
 namespace costar::component {
 
 OperationNode::OperationNode(std::string id, std::string name, Component& component, ParamMap params,
-                             std::function<void()> on_completion)
+                             std::function<void()> on_completion, std::function<std::string()> stopped)
     : bt::LeafNode(std::move(id), std::move(name)),
       component_(component),
       params_(std::move(params)),
-      on_completion_(std::move(on_completion)) {}
+      on_completion_(std::move(on_completion)),
+      stopped_(std::move(stopped)) {}
 
 bt::Status OperationNode::finish(OperationResult result) {
   active_ = false;
@@ -24,6 +25,12 @@ bt::Status OperationNode::finish(OperationResult result) {
 }
 
 bt::Status OperationNode::onTick() {
+  if (stopped_) {
+    if (const std::string reason = stopped_(); !reason.empty()) {
+      onHalt();  // cancels the operation, best effort
+      return finish(OperationResult::failure("the cell stopped: " + reason));
+    }
+  }
   if (!active_) {
     try {
       operation_ = component_.start(id(), params_);
@@ -36,6 +43,7 @@ bt::Status OperationNode::onTick() {
   try {
     result = component_.poll(operation_);
   } catch (const std::exception& e) {
+    onHalt();  // the operation may still be running (a motion): cancel it, best effort
     return finish(OperationResult::failure(component_.description().name + " failed: " + e.what()));
   }
   if (result.state == OperationState::kRunning) {

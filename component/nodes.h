@@ -14,10 +14,12 @@ namespace costar::component {
 /// when halted. An exception from the component becomes a FAILURE with its message.
 /// `on_completion` runs when the operation completes, before the next node is ticked (the
 /// registry refreshes the world state there, so a condition right after sees the effect).
+/// `stopped` says why the cell stopped (empty while it runs): then the node cancels its
+/// operation and fails with that reason instead of starting or polling it.
 class OperationNode final : public bt::LeafNode {
  public:
   OperationNode(std::string id, std::string name, Component& component, ParamMap params,
-                std::function<void()> on_completion = {});
+                std::function<void()> on_completion = {}, std::function<std::string()> stopped = {});
   const ParamMap& params() const { return params_; }
   /// The last result reported by the operation (reason, data), for observers.
   const OperationResult& lastResult() const { return last_result_; }
@@ -30,6 +32,7 @@ class OperationNode final : public bt::LeafNode {
   Component& component_;
   ParamMap params_;
   std::function<void()> on_completion_;
+  std::function<std::string()> stopped_;
   OperationResult last_result_;
   OperationId operation_ = 0;
   bool active_ = false;

@@ -136,8 +136,9 @@ void ComponentRegistry::registerNodes(bt::NodeRegistry& nodes) {
         };
       }
       spec.build = [this, target, operation](const bt::NodeArgs& args) {
-        return std::make_unique<OperationNode>(operation.name, args.name(), *target, parseParams(operation, args),
-                                               [this] { refreshWorld(); });
+        return std::make_unique<OperationNode>(
+            operation.name, args.name(), *target, parseParams(operation, args), [this] { refreshWorld(); },
+            [this] { return stop_reason_; });
       };
       nodes.add(std::move(spec));
     }
@@ -180,10 +181,33 @@ void ComponentRegistry::registerNodes(bt::NodeRegistry& nodes) {
   nodes.add(std::move(check));
 }
 
+void ComponentRegistry::stopCell(const std::string& reason) {
+  if (!stop_reason_.empty()) {
+    return;
+  }
+  stop_reason_ = reason;
+  spdlog::error("the cell stopped: {}", reason);
+  if (on_stop_) {
+    try {
+      on_stop_(reason);
+    } catch (const std::exception& e) {
+      spdlog::error("stopping the cell: {}", e.what());
+    }
+  }
+}
+
 void ComponentRegistry::refreshWorld() {
   for (const auto& component : components_) {
     const ComponentDescription& description = component->description();
-    world::Report report = component->report();
+    world::Report report;
+    try {
+      report = component->report();
+    } catch (const std::exception& e) {
+      // Its symbols and predicates are no longer known; the cell stops.
+      world_.update(description.name, {});
+      stopCell("component '" + description.name + "' failed: " + e.what());
+      continue;
+    }
     std::erase_if(report.predicates, [&](const world::Predicate& predicate) {
       const bool declared =
           std::any_of(description.predicates.begin(), description.predicates.end(), [&](const PredicateDecl& decl) {

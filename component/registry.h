@@ -3,6 +3,7 @@
 // implement, turns their operations into behavior-tree node types, and aggregates their
 // symbols and predicates into the world state a plan sees.
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <set>
@@ -50,8 +51,20 @@ class ComponentRegistry {
   void registerNodes(bt::NodeRegistry& nodes);
 
   /// Pulls every component's report into world(). A predicate its source did not declare is
-  /// dropped, with a warning logged once.
+  /// dropped, with a warning logged once. A component whose report throws (it stopped
+  /// answering, or its driver's readings cannot be trusted) stops the cell: see stopCell().
   void refreshWorld();
+
+  /// The safety stop: from now on every operation node fails at its next tick with
+  /// `reason` (cancelling its operation), and the on-stop hook runs once (the workcell stops
+  /// the arm there). The first reason is kept until resetStop().
+  void stopCell(const std::string& reason);
+  /// Why the cell stopped; empty while it runs.
+  const std::string& stopReason() const { return stop_reason_; }
+  /// Clears the stop (after a person has dealt with its cause).
+  void resetStop() { stop_reason_.clear(); }
+  /// Called once per stop, with the reason.
+  void setOnStop(std::function<void(const std::string&)> hook) { on_stop_ = std::move(hook); }
   world::WorldState& world() { return world_; }
   const world::WorldState& world() const { return world_; }
 
@@ -62,6 +75,8 @@ class ComponentRegistry {
   std::map<std::string, PredicateDecl, std::less<>> predicates_;
   std::set<std::string> warned_;
   world::WorldState world_;
+  std::string stop_reason_;
+  std::function<void(const std::string&)> on_stop_;
 };
 
 }  // namespace costar::component

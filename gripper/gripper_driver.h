@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include "core/clock.h"
+
 namespace costar::gripper {
 
 struct FingerReading {
@@ -11,6 +13,8 @@ struct FingerReading {
   double opening_speed = 0.0;  // m/s (negative while closing)
   double force = 0.0;          // squeezing force, N
   bool contact = false;        // the fingers touch something (tactile/current sensing)
+  /// When it was measured; TimePoint{} from a driver that does not stamp its readings.
+  TimePoint stamp{};
 };
 
 class GripperDriver {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 namespace costar::gripper {
 
@@ -17,12 +18,27 @@ std::string millimetres(double metres) {
   return text;
 }
 
+/// Why a finger reading cannot be trusted, or empty.
+std::string problemWith(const FingerReading& reading, TimePoint now, Duration timeout) {
+  if (!std::isfinite(reading.opening) || !std::isfinite(reading.opening_speed) || !std::isfinite(reading.force)) {
+    return "gripper driver: the finger reading is not a number";
+  }
+  if (reading.stamp != TimePoint{} && now - reading.stamp > timeout) {
+    char text[96];
+    std::snprintf(text, sizeof text, "gripper driver: the finger reading stopped updating (%.3f s old)",
+                  toSeconds(now - reading.stamp));
+    return text;
+  }
+  return {};
+}
+
 /// Moves the fingers and waits until they settle: at the target, or stopped on something.
 class FingerMotion final : public component::RunningOperation {
  public:
-  FingerMotion(GripperDriver& driver, const Clock& clock, double target, double speed, double force, Duration timeout,
-               bool closing)
-      : driver_(driver),
+  FingerMotion(const ParallelGripper& gripper, GripperDriver& driver, const Clock& clock, double target, double speed,
+               double force, Duration timeout, bool closing)
+      : gripper_(gripper),
+        driver_(driver),
         clock_(clock),
         target_(target),
         closing_(closing),
@@ -32,7 +48,13 @@ class FingerMotion final : public component::RunningOperation {
   }
 
   OperationResult poll() override {
-    const FingerReading reading = driver_.read();
+    FingerReading reading;
+    try {
+      reading = gripper_.checkedRead();
+    } catch (const std::exception& e) {
+      cancel();
+      return OperationResult::failure(e.what() + std::string("; the fingers were stopped"));
+    }
     const TimePoint now = clock_.now();
     const bool still = std::abs(reading.opening_speed) < 0.002;
     // Settled once still for 50 ms, and not before the fingers had time to start moving.
@@ -60,12 +82,18 @@ class FingerMotion final : public component::RunningOperation {
   }
 
   void cancel() override {
-    // Stop where the fingers are.
-    const FingerReading reading = driver_.read();
+    // Stop where the fingers are; without a reading to trust, keep the last command.
+    FingerReading reading;
+    try {
+      reading = gripper_.checkedRead();
+    } catch (const std::exception&) {
+      return;
+    }
     driver_.command(reading.opening, 0.1, reading.force > 0 ? reading.force : 10.0);
   }
 
  private:
+  const ParallelGripper& gripper_;
   GripperDriver& driver_;
   const Clock& clock_;
   double target_;
@@ -102,8 +130,17 @@ ParallelGripper::ParallelGripper(GripperDriver& driver, const Clock& clock, Para
                              {"gripper_mode", 1, "gripper_mode(m): the gripper is in mode m"}};
 }
 
-world::Report ParallelGripper::report() const {
+FingerReading ParallelGripper::checkedRead() const {
   const FingerReading reading = driver_.read();
+  if (const std::string problem = problemWith(reading, clock_.now(), options_.reading_timeout); !problem.empty()) {
+    throw std::runtime_error(problem);
+  }
+  return reading;
+}
+
+world::Report ParallelGripper::report() const {
+  // A reading that cannot be trusted makes the report throw: the registry then stops the cell.
+  const FingerReading reading = checkedRead();
   world::Report report;
   if (reading.opening >= driver_.maxOpening() - kOpenMargin) {
     report.predicates.push_back({"gripper_open", {}, true, ""});
@@ -122,11 +159,11 @@ world::Report ParallelGripper::report() const {
 std::unique_ptr<component::RunningOperation> ParallelGripper::begin(const std::string& operation,
                                                                     const component::ParamMap& params) {
   if (operation == "Open") {
-    return std::make_unique<FingerMotion>(driver_, clock_, driver_.maxOpening(), params.at("speed").asDouble(),
+    return std::make_unique<FingerMotion>(*this, driver_, clock_, driver_.maxOpening(), params.at("speed").asDouble(),
                                           options_.force, options_.timeout, false);
   }
   if (operation == "Close") {
-    return std::make_unique<FingerMotion>(driver_, clock_, 0.0, params.at("speed").asDouble(),
+    return std::make_unique<FingerMotion>(*this, driver_, clock_, 0.0, params.at("speed").asDouble(),
                                           params.at("force").asDouble(), options_.timeout, true);
   }
   if (operation == "PinchMode") {

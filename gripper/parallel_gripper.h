@@ -21,6 +21,8 @@ struct ParallelGripperOptions {
   double force = 40.0;  // N, default grip force
   /// Close and Open fail when the fingers have not settled after this long.
   Duration timeout = std::chrono::seconds(3);
+  /// A finger reading older than this (by the driver's stamp) means the driver stopped updating.
+  Duration reading_timeout = std::chrono::milliseconds(50);
 };
 
 class ParallelGripper final : public component::LocalComponent {
@@ -38,6 +40,10 @@ class ParallelGripper final : public component::LocalComponent {
   static constexpr double kClosedBelow = 0.002;
   static constexpr double kHoldingForce = 2.0;
   static constexpr double kHoldingSpeed = 0.02;
+
+  /// The driver's reading, checked: finite and fresh. @throws std::runtime_error naming the
+  /// problem (NaN readings, a reading that stopped updating, or the driver's own error).
+  FingerReading checkedRead() const;
 
  private:
   std::unique_ptr<component::RunningOperation> begin(const std::string& operation,

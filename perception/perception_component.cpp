@@ -72,7 +72,24 @@ class DetectObjectsOperation final : public component::RunningOperation {
   void capture() {
     // The pipeline takes colour from the last frame only (the median filter's output).
     const bool last = static_cast<int>(frames_.size()) + 1 >= wanted_;
-    frames_.push_back(last ? component_.camera_.capture() : component_.camera_.captureDepth());
+    camera::RgbdFrame frame = last ? component_.camera_.capture() : component_.camera_.captureDepth();
+    // Each frame is checked as it comes, so a broken camera fails the operation at once: a
+    // frame without its pixels, without any valid depth, or one the camera sent before (its
+    // stream stopped: the stamp does not advance).
+    if (!done_) {
+      const std::size_t pixels = static_cast<std::size_t>(frame.intrinsics.width) * frame.intrinsics.height;
+      if (frame.points.empty() || frame.points.size() != pixels) {
+        done_ = OperationResult::failure("DetectObjects: the camera sent an empty frame");
+      } else if (frame.validCount() == 0) {
+        done_ = OperationResult::failure(
+            "DetectObjects: the camera sent a frame without any valid depth (is it covered, broken, or not looking "
+            "at the table?)");
+      } else if (!frames_.empty() && frame.stamp <= frames_.back().stamp) {
+        done_ = OperationResult::failure(
+            "DetectObjects: the camera stopped sending new frames (the frame's stamp did not advance)");
+      }
+    }
+    frames_.push_back(std::move(frame));
     next_capture_ = component_.clock_.now() + component_.camera_.framePeriod();
   }
 

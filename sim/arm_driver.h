@@ -14,7 +14,9 @@ class SimArmDriver final : public arm::ArmDriver {
  public:
   explicit SimArmDriver(Simulation& simulation) : simulation_(simulation) {}
 
-  arm::ArmState read() const override { return {simulation_.armPositions(), simulation_.armVelocities()}; }
+  arm::ArmState read() const override {
+    return {simulation_.armPositions(), simulation_.armVelocities(), simulation_.time()};
+  }
 
   void execute(std::shared_ptr<const arm::JointTrajectory> trajectory, TimePoint start) override {
     simulation_.setArmSetpointSource([trajectory = std::move(trajectory), start](TimePoint t) {

@@ -31,7 +31,7 @@ class SimGripperDriver final : public gripper::GripperDriver {
   explicit SimGripperDriver(Simulation& simulation) : simulation_(simulation) {}
   gripper::FingerReading read() const override {
     const FingerState state = simulation_.fingers();
-    return {state.opening, state.opening_speed, state.force, state.pads_in_contact};
+    return {state.opening, state.opening_speed, state.force, state.pads_in_contact, simulation_.time()};
   }
   void command(double opening, double speed, double force) override {
     simulation_.commandFingers(opening, speed, force);

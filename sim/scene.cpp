@@ -38,7 +38,8 @@ std::string shown(const json& value) {
 }
 
 void onlyKnownFields(const json& object, const std::string& field, std::initializer_list<const char*> known) {
-  for (const auto& [key, value] : object.items()) {
+  for (const auto& item : object.items()) {
+    const std::string& key = item.key();  // not a structured binding: clang 14 cannot capture one
     if (std::none_of(known.begin(), known.end(), [&key](const char* name) { return key == name; })) {
       std::string list;
       for (const char* name : known) {

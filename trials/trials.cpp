@@ -18,6 +18,7 @@
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
 #include "core/files.h"
+#include "faults/injector.h"
 #include "sim/simulation.h"
 #include "trials/judge.h"
 #include "workcell/workcell.h"
@@ -32,11 +33,13 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
   result.seed = options.seed + static_cast<std::uint64_t>(index);
   const auto wall_start = std::chrono::steady_clock::now();
   try {
-    const auto cell = workcell::makeWorkcell({.name = "ur5-sim",
-                                              .scene = options.scene,
-                                              .seed = result.seed,
-                                              .waypoints = options.waypoints,
-                                              .memory_only = true});
+    const auto cell = workcell::makeWorkcell(
+        {.name = "ur5-sim",
+         .scene = options.scene,
+         .seed = result.seed,
+         .waypoints = options.waypoints,
+         .memory_only = true,
+         .faults = options.inject.empty() ? nullptr : faults::Injector::fromText(options.inject, result.seed)});
     sim::Simulation& simulation = *cell->simulation();
     const std::vector<sim::PartState> initial = simulation.parts();
     bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
@@ -149,12 +152,14 @@ Summary runTrials(const TrialOptions& options, const std::function<void(const Tr
   const Judge judge = trials::judge(options.judge);
   const bt::Plan plan = bt::loadPlan(options.plan);
   {
-    // Validate once, before any trial, against the workcell the trials use.
-    const auto cell = workcell::makeWorkcell({.name = "ur5-sim",
-                                              .scene = options.scene,
-                                              .seed = options.seed,
-                                              .waypoints = options.waypoints,
-                                              .memory_only = true});
+    // Validate once, before any trial, against the workcell the trials use (the faults too).
+    const auto cell = workcell::makeWorkcell(
+        {.name = "ur5-sim",
+         .scene = options.scene,
+         .seed = options.seed,
+         .waypoints = options.waypoints,
+         .memory_only = true,
+         .faults = options.inject.empty() ? nullptr : faults::Injector::fromText(options.inject, options.seed)});
     if (auto diagnostics = bt::validatePlan(plan, cell->nodes()); !diagnostics.empty()) {
       throw bt::PlanError(std::move(diagnostics));
     }

@@ -29,6 +29,9 @@ struct TrialOptions {
   /// i % shard_count == shard_index (trial i keeps seed + i whichever shard runs it).
   int shard_index = 0;
   int shard_count = 1;
+  /// Faults to inject in every trial (faults/fault.h grammar); random moments are drawn from
+  /// the trial's seed.
+  std::vector<std::string> inject;
 };
 
 struct TrialResult {

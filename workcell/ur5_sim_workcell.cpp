@@ -2,6 +2,7 @@
 
 #include "arm/arm_component.h"
 #include "core/paths.h"
+#include "faults/injector.h"
 #include "gripper/parallel_gripper.h"
 #include "perception/perception_component.h"
 #include "perception/pipeline.h"
@@ -108,8 +109,19 @@ class Ur5SimWorkcell final : public Workcell {
                        : (options.memory_only ? std::filesystem::path() : defaultWaypointFile("ur5-sim")),
                    /*persist=*/!options.memory_only),
         grasps_(dataRoot() / "data/grasps.json",
-                options.memory_only ? std::filesystem::path() : defaultGraspFile("ur5-sim")) {
+                options.memory_only ? std::filesystem::path() : defaultGraspFile("ur5-sim")),
+        faults_(options.faults) {
     simulation_->attach(static_cast<SimClock&>(clock()));
+    if (faults_) {
+      faults_->attach(clock());
+    }
+    // The drivers and components as the cell uses them: wrapped by the fault injector, if any.
+    arm::ArmDriver& arm_driver = faults_ ? faults_->wrap(arm_driver_) : arm_driver_;
+    gripper::GripperDriver& gripper_driver = faults_ ? faults_->wrap(gripper_driver_) : gripper_driver_;
+    camera::RgbdCamera& camera = faults_ ? faults_->wrap(camera_) : camera_;
+    const auto add = [this](std::shared_ptr<component::Component> component) {
+      components().add(faults_ ? faults_->wrap(std::move(component)) : std::move(component));
+    };
     collisions_.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
     collisions_.allow("base_link", "table");  // the robot stands on it
     // The tool stays above the table top, within the cell.
@@ -119,27 +131,38 @@ class Ur5SimWorkcell final : public Workcell {
     arm_config.base_in_world = kBaseInWorld;
     arm_config.home = sim::Simulation::homeConfiguration();
     auto arm = std::make_shared<arm::ArmComponent>(
-        arm_driver_, clock(), collisions_, waypoints_,
+        arm_driver, clock(), collisions_, waypoints_,
         [this](const std::string& frame) { return components().world().worldPose(frame); }, arm_config);
-    auto gripper = std::make_shared<gripper::ParallelGripper>(gripper_driver_, clock());
-    components().add(arm);
+    // SmartMove reaches the gripper through its operations, as the tree does: the same (possibly
+    // fault-injected) component the registry holds.
+    std::shared_ptr<component::Component> gripper = std::make_shared<gripper::ParallelGripper>(gripper_driver, clock());
+    if (faults_) {
+      gripper = faults_->wrap(std::move(gripper));
+    }
+    add(arm);
     components().add(gripper);
-    components().add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
-        {"table_center", tableCenter()}, {"robot_base", kBaseInWorld}}));
+    add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{{"table_center", tableCenter()},
+                                                                                       {"robot_base", kBaseInWorld}}));
     if (options.test_oracle_perception) {
-      components().add(std::make_shared<TestOraclePerception>(*simulation_));
+      add(std::make_shared<TestOraclePerception>(*simulation_));
     } else {
       // DetectObjects: the camera's frames only, never the simulator's true poses.
       perception::PerceptionConfig perception_config;
       perception_config.table_center = tableCenter();
-      components().add(std::make_shared<perception::PerceptionComponent>(
-          camera_, clock(), threadPipeline(perception_config), perception_config));
+      add(std::make_shared<perception::PerceptionComponent>(camera, clock(), threadPipeline(perception_config),
+                                                            perception_config));
     }
     smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(*arm, *gripper, components().world(), collisions_,
                                                                  simulation_->objectClasses(), grasps_);
-    components().add(smartmove_);
+    add(smartmove_);
     // Last: it derives its predicates from what the others report.
-    components().add(std::make_shared<predicator::Predicator>(components().world(), simulation_->objectClasses()));
+    add(std::make_shared<predicator::Predicator>(components().world(), simulation_->objectClasses()));
+    if (faults_) {
+      faults_->checkTargets();
+    }
+    // The safety stop (a component failed, a driver's readings cannot be trusted): the arm
+    // decelerates along its path and stops; the fingers keep their last command.
+    components().setOnStop([arm](const std::string&) { arm->stop(); });
     smartmove_->setPatternCheck([this](const predicator::Pattern& pattern) { return checkPattern(pattern); });
     registerNodes();
     smartmove_->syncObstacles();
@@ -187,6 +210,7 @@ class Ur5SimWorkcell final : public Workcell {
   arm::WaypointStore waypoints_;
   smartmove::GraspLibrary grasps_;
   std::shared_ptr<smartmove::SmartMoveComponent> smartmove_;
+  std::shared_ptr<faults::Injector> faults_;
 };
 
 }  // namespace

@@ -55,11 +55,18 @@ class BareWorkcell final : public Workcell {
 /// without a robot) on a simulated clock.
 class TestWorkcell final : public Workcell {
  public:
-  TestWorkcell() : Workcell(std::make_unique<SimClock>()) {
-    components().add(std::make_shared<testing::TestLogger>());
-    components().add(std::make_shared<testing::TestActions>());
-    components().add(std::make_shared<testing::TestCounter>());
-    components().add(std::make_shared<testing::TestArm>());
+  TestWorkcell(const ComponentWrapper& wrap, const std::function<void(const Clock&)>& attach)
+      : Workcell(std::make_unique<SimClock>()) {
+    if (attach) {
+      attach(clock());
+    }
+    const auto add = [this, &wrap](std::shared_ptr<component::Component> component) {
+      components().add(wrap ? wrap(std::move(component)) : std::move(component));
+    };
+    add(std::make_shared<testing::TestLogger>());
+    add(std::make_shared<testing::TestActions>());
+    add(std::make_shared<testing::TestCounter>());
+    add(std::make_shared<testing::TestArm>());
     registerNodes();
   }
   std::string name() const override { return "test"; }
@@ -72,10 +79,20 @@ std::vector<WorkcellInfo> knownWorkcells() {
   return {{"ur5-sim", kUr5SimSummary}, {"test", kTestSummary}, {"none", kNoneSummary}};
 }
 
+std::unique_ptr<Workcell> makeTestWorkcell(const ComponentWrapper& wrap,
+                                           const std::function<void(const Clock&)>& attach) {
+  return std::make_unique<TestWorkcell>(wrap, attach);
+}
+
+std::unique_ptr<Workcell> makeBareWorkcell() { return std::make_unique<BareWorkcell>(); }
+
 std::unique_ptr<Workcell> makeLightWorkcell(const WorkcellOptions& options) {
   const std::string& name = options.name;
+  if (options.faults || !options.inject.empty()) {
+    return nullptr;  // faults are injected by makeWorkcell (costar_workcell links the injector)
+  }
   if (name == "test") {
-    return std::make_unique<TestWorkcell>();
+    return std::make_unique<TestWorkcell>(ComponentWrapper{}, nullptr);
   }
   if (name == "none") {
     return std::make_unique<BareWorkcell>();

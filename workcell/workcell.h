@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,6 +17,9 @@
 
 namespace costar::sim {
 class Simulation;
+}
+namespace costar::faults {
+class Injector;
 }
 
 namespace costar::workcell {
@@ -35,6 +39,12 @@ struct WorkcellOptions {
   /// TEST ONLY: report the simulator's true part poses as object symbols in place of
   /// perception, to test SmartMove apart from perception. Never set by the CLI.
   bool test_oracle_perception = false;
+  /// Faults to inject (faults/injector.h): the cell wraps its drivers and components with
+  /// it. Keep the pointer to read what happened. Null: nothing is broken on purpose.
+  std::shared_ptr<faults::Injector> faults;
+  /// The same as fault specs (faults/fault.h grammar), for the CLI: the executable that builds
+  /// the cell makes the injector from them (seeded with `seed`, else 1) when `faults` is null.
+  std::vector<std::string> inject;
 };
 
 class Workcell {
@@ -82,10 +92,20 @@ std::vector<WorkcellInfo> knownWorkcells();
 std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& options);
 
 /// Creates a workcell that needs none of the robot libraries ("test", "none"), or returns
-/// nullptr for a known robot cell ("ur5-sim"), which only makeWorkcell() builds. In
+/// nullptr for a known robot cell ("ur5-sim") and for any cell with faults to inject, which
+/// only makeWorkcell() builds. In
 /// costar_workcell_base, with the light `costar` executable.
 /// @throws std::invalid_argument naming the known ones for an unknown name.
 std::unique_ptr<Workcell> makeLightWorkcell(const WorkcellOptions& options);
+
+/// Wraps a component (fault injection: faults::Injector::wrap).
+using ComponentWrapper = std::function<std::shared_ptr<component::Component>(std::shared_ptr<component::Component>)>;
+
+/// The TEST ONLY cell ("test"); each component goes through `wrap` when given, and `attach`
+/// (if given) first sees the cell's clock. The "none" cell: built-in nodes only.
+std::unique_ptr<Workcell> makeTestWorkcell(const ComponentWrapper& wrap,
+                                           const std::function<void(const Clock&)>& attach);
+std::unique_ptr<Workcell> makeBareWorkcell();
 
 /// Where waypoints of `workcell` are kept by default.
 std::filesystem::path defaultWaypointFile(const std::string& workcell);

@@ -191,7 +191,10 @@ TEST(PointToPoint, RandomMovesRespectTheLimitsAndStartAndEndAtRest) {
   std::uniform_real_distribution<double> scale_distribution(0.3, 1.0);
   for (int trial = 0; trial < 10000; ++trial) {
     const JointLimits limits = trial % 2 == 0 ? JointLimits::ur5() : unevenLimits();
-    const auto [from, to] = randomMove(random, limits);
+    // Not a structured binding: the lambda below uses `from` (clang before 16 cannot capture one).
+    const auto move = randomMove(random, limits);
+    const JointVector& from = move.first;
+    const JointVector& to = move.second;
     const double scale = trial % 10 == 0 ? 1.0 : scale_distribution(random);
     const JointTrajectory trajectory = JointTrajectory::pointToPoint(from, to, limits, scale);
     SCOPED_TRACE("trial " + std::to_string(trial));

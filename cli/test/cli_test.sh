@@ -35,6 +35,14 @@ check "nodes model"         0 '<Action ID="Move">' -- "$costar" nodes -w test
 check "nodes json"          0 '"category": "knowledge"' -- "$costar" nodes -w test --format json
 check "help"                0 'Exit code: 0 SUCCESS' -- "$costar" run --help
 check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit 0.1
+check "inject: bad spec"    2 "fault 'melt:arm@t=1': unknown kind 'melt'" \
+  -- "$costar" run examples/test_workcell/demo.xml -w test --inject melt:arm@t=1
+check "inject: no target"   2 "this workcell has no 'arm-driver'" \
+  -- "$costar" run examples/test_workcell/demo.xml -w test --inject nan:arm-driver@t=1
+check "inject: dies"        1 "FAILURE at .*: the cell stopped: component 'test_counter' failed: .*is gone" \
+  -- "$costar" run examples/test_workcell/demo.xml -w test --inject die:test_counter@t=0.1s
+check "inject: throws"      1 'FAILURE at .*"go home": could not start: the operation threw' \
+  -- "$costar" run examples/test_workcell/demo.xml -w test --inject throw:test_arm@op=1
 
 # Trials spread over machines: shards' JSON results merge into one summary (no simulation here:
 # two hand-written shard files of a 3-trial batch).

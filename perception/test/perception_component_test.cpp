@@ -198,11 +198,13 @@ class BlindCamera final : public camera::RgbdCamera {
     frame.points.assign(static_cast<std::size_t>(intrinsics_.width) * intrinsics_.height,
                         Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
     frame.rgb = RgbImage(intrinsics_.width, intrinsics_.height);
+    frame.stamp = TimePoint(std::chrono::milliseconds(33 * ++frames_));  // a new frame each time
     return frame;
   }
 
  private:
   camera::Intrinsics intrinsics_ = camera::Intrinsics::fromHorizontalFov(64, 48, 1.0);
+  int frames_ = 0;
 };
 
 TEST(PerceptionComponent, FailsWithAReasonWhenTheTableIsNotInView) {

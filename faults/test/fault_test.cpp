@@ -1,0 +1,58 @@
+#include "faults/fault.h"
+
+#include <gtest/gtest.h>
+
+namespace costar::faults {
+namespace {
+
+TEST(FaultSpec, ParsesEveryMoment) {
+  const FaultSpec timed = parseFault("nan:arm-driver@t=2.5s");
+  EXPECT_EQ(timed.kind, FaultKind::kNan);
+  EXPECT_EQ(timed.target, "arm-driver");
+  EXPECT_EQ(timed.when.type, FaultWhen::Type::kTime);
+  EXPECT_DOUBLE_EQ(timed.when.seconds, 2.5);
+  EXPECT_EQ(timed.text, "nan:arm-driver@t=2.5s");
+
+  const FaultSpec op = parseFault("hang:perception@op=3");
+  EXPECT_EQ(op.kind, FaultKind::kHang);
+  EXPECT_EQ(op.target, "perception");
+  EXPECT_EQ(op.when.type, FaultWhen::Type::kOperation);
+  EXPECT_EQ(op.when.operation, 3);
+
+  const FaultSpec random = parseFault("empty-frame:camera@random");
+  EXPECT_EQ(random.kind, FaultKind::kEmptyFrame);
+  EXPECT_EQ(random.when.type, FaultWhen::Type::kRandom);
+  EXPECT_DOUBLE_EQ(random.when.seconds, 10.0);
+  EXPECT_DOUBLE_EQ(parseFault("die:smartmove@random=4s").when.seconds, 4.0);
+  EXPECT_DOUBLE_EQ(parseFault("throw:gripper@t=0").when.seconds, 0.0);
+}
+
+void expectError(const std::string& spec, const std::string& words) {
+  try {
+    parseFault(spec);
+    ADD_FAILURE() << spec << " was accepted";
+  } catch (const FaultSpecError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("'" + spec + "'"), std::string::npos) << message;
+    EXPECT_NE(message.find(words), std::string::npos) << message;
+  }
+}
+
+TEST(FaultSpec, RefusesBadSpecsNamingThePart) {
+  expectError("nan:arm-driver", "KIND:TARGET@WHEN");
+  expectError("arm-driver@t=1", "KIND:TARGET@WHEN");
+  expectError("melt:arm@t=1", "unknown kind 'melt'");
+  expectError("nan:@t=1", "no target");
+  expectError("nan:perception@t=1", "cannot have a 'nan' fault");
+  expectError("die:camera@t=1", "cannot have a 'die' fault");
+  expectError("empty-frame:arm-driver@t=1", "cannot have a 'empty-frame' fault");
+  expectError("throw:arm@t=-1", "t= needs a time");
+  expectError("throw:arm@t=abc", "t= needs a time");
+  expectError("throw:arm@op=0", "op= needs a whole number");
+  expectError("throw:arm@op=1.5", "op= needs a whole number");
+  expectError("throw:arm@random=0s", "random= needs a window");
+  expectError("throw:arm@soon", "unknown moment 'soon'");
+}
+
+}  // namespace
+}  // namespace costar::faults
