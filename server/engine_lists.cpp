@@ -1,7 +1,7 @@
 // What the editor offers: the palette of node types with their ports (where each parameter's
 // choices come from, extra choices, exclusions, ranges), the workcell's info, and the choice
 // lists read from what the cell knows now (waypoints, frames, object classes, predicates, the
-// grasps taught per class).
+// grasps taught per class), and each object class's shape and colours (for drawing the parts).
 
 #include "server/engine_parts.h"
 
@@ -10,8 +10,28 @@
 #include "sim/simulation.h"
 #include "smartmove/grasps.h"
 #include "workcell/workcell.h"
+#include "world/object_class.h"
 
 namespace costar::server {
+
+namespace {
+
+/// A class as the 3D view draws it: its boxes (object frame, metres) and its named colours
+/// (RGB in [0, 1], ordered by name as the simulator numbers them).
+json classShape(const world::ObjectClass& object_class) {
+  json boxes = json::array();
+  for (const world::Box& box : object_class.boxes) {
+    boxes.push_back({{"center", {box.center.x(), box.center.y(), box.center.z()}},
+                     {"half_size", {box.half_size.x(), box.half_size.y(), box.half_size.z()}}});
+  }
+  json colors = json::array();
+  for (const auto& [name, rgb] : object_class.colors) {
+    colors.push_back({{"name", name}, {"rgb", {rgb.x(), rgb.y(), rgb.z()}}});
+  }
+  return {{"boxes", std::move(boxes)}, {"colors", std::move(colors)}};
+}
+
+}  // namespace
 
 void Engine::describeNodes() {
   // The palette: every node type with its ports; operation parameters add where their
@@ -102,6 +122,7 @@ json Engine::choices() {
     std::set<std::string> classes;
     std::set<std::string> arm_sources;
     std::set<std::string> declared;
+    json shapes = json::object();
     for (const auto& component : cell_.components().components()) {
       const auto& description = component->description();
       if (std::find(description.implements.begin(), description.implements.end(), "Arm") !=
@@ -128,6 +149,7 @@ json Engine::choices() {
     if (sim::Simulation* simulation = cell_.simulation()) {
       for (const auto& object_class : simulation->objectClasses()) {
         classes.insert(object_class.name);
+        shapes[object_class.name] = classShape(object_class);
       }
     }
     json predicates = json::array();
@@ -149,11 +171,9 @@ json Engine::choices() {
     } catch (const std::exception&) {
       // An unreadable grasp file: SmartMove reports it when it runs; offer no list.
     }
-    return json{{"waypoint", waypoints},
-                {"frame", frames},
-                {"object_class", classes},
-                {"predicate", std::move(predicates)},
-                {"grasp", std::move(grasps)}};
+    return json{{"waypoint", waypoints},      {"frame", frames},
+                {"object_class", classes},    {"predicate", std::move(predicates)},
+                {"grasp", std::move(grasps)}, {"object_shape", std::move(shapes)}};
   });
 }
 

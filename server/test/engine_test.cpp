@@ -369,6 +369,16 @@ TEST(Ur5Cell, ChoicesComeFromWhatTheCellKnows) {
   EXPECT_TRUE(has(choices["frame"], "table_center"));
   EXPECT_TRUE(has(choices["object_class"], "node"));
   EXPECT_TRUE(has(choices["grasp"]["node"], "top"));
+  // The classes' shapes and colours, as the class files give them, for drawing the parts.
+  const json& node_shape = choices["object_shape"]["node"];
+  ASSERT_EQ(node_shape["boxes"].size(), 19u);
+  EXPECT_DOUBLE_EQ(node_shape["boxes"][8]["half_size"][0].get<double>(), 0.025);
+  ASSERT_EQ(node_shape["colors"].size(), 4u);
+  bool red = false;
+  for (const json& color : node_shape["colors"]) {
+    red = red || (color["name"] == "red" && color["rgb"] == json::array({0.8, 0.1, 0.1}));
+  }
+  EXPECT_TRUE(red) << node_shape["colors"];
   bool holding = false;
   for (const auto& predicate : choices["predicate"]) {
     holding = holding || (predicate["name"] == "gripper_holding" && predicate["arity"] == 0);

@@ -10,6 +10,8 @@
 //
 //   node web/e2e/assemble_by_clicks.mjs [--costar build/cli/costar] [--artifacts build/test-artifacts]
 //                                       [--chromium /usr/bin/chromium] [--docs-screenshot docs/editor.png]
+// (--docs-screenshot: the finished run at 1600x1000 there, and at 1280x800 beside it as
+// NAME_1280x800.png)
 
 import { spawn, spawnSync } from 'node:child_process';
 import fs from 'node:fs';
@@ -85,6 +87,15 @@ function judgeAssembly(parts, still) {
     }
   }
   return null;
+}
+
+// How many of these boxes the tree pane shows whole (run in the page).
+function wholeInPane(nodes) {
+  const pane = document.querySelector('.tree-canvas').getBoundingClientRect();
+  return nodes.filter((n) => {
+    const b = n.getBoundingClientRect();
+    return b.top >= pane.top && b.bottom <= pane.bottom && b.left >= pane.left && b.right <= pane.right;
+  }).length;
 }
 
 async function main() {
@@ -200,6 +211,14 @@ async function main() {
   const structure = judgeAssembly(second.parts, still);
   check(structure !== null, `the simulator's true state holds the structure (base / link / top): ${structure ?? second.parts.map((p) => `${p.name} ${p.p.map((v) => v.toFixed(3))}`).join('; ')}`);
 
+  // The world the page believes: the top part was put down after the last detection, so only
+  // the page's belief (it moved with the tool while held) has it on the structure.
+  const top = second.parts.find((p) => p.name === structure.split(' / ')[2]);
+  const putDown = await page.$$eval('.objects-table tbody tr', (rows) => rows.map((r) => r.textContent).filter((t) => t.includes('(put down)')));
+  const believedAt = putDown.map((t) => /(-?\d+\.\d+), (-?\d+\.\d+), (-?\d+\.\d+)/.exec(t).slice(1).map(Number));
+  const off = Math.min(...believedAt.map((p) => Math.hypot(...p.map((v, i) => v - top.p[i]))));
+  check(putDown.length === 1 && off < 0.05, `the Objects pane shows the top part where it was put down, ${(off * 100).toFixed(1)} cm from where it is: ${putDown.join('; ')}`);
+
   // Screenshots of the finished run at both sizes: select a SmartRelease to show its candidates.
   await node('SmartRelease', 1).click();
   await page.waitForTimeout(600);
@@ -208,14 +227,9 @@ async function main() {
   await page.setViewportSize({ width: 1280, height: 800 });
   await page.waitForTimeout(600);
   await page.screenshot({ path: path.join(artifacts, 'editor_run_1280x800.png') });
-  const visible = await page.$$eval('.tree-node', (nodes) => {
-    const pane = document.querySelector('.tree-canvas').getBoundingClientRect();
-    return nodes.filter((n) => {
-      const b = n.getBoundingClientRect();
-      return b.top >= pane.top && b.bottom <= pane.bottom && b.left >= pane.left && b.right <= pane.right;
-    }).length;
-  });
-  check(visible >= 8, `at 1280x800 the tree shows ${visible} of 15 nodes whole`);
+  if (args['docs-screenshot']) fs.copyFileSync(path.join(artifacts, 'editor_run_1280x800.png'), path.resolve(args['docs-screenshot']).replace(/\.png$/, '_1280x800.png'));
+  const visible = await page.$$eval('.tree-node', wholeInPane);
+  check(visible >= 12, `at 1280x800 the tree shows ${visible} of 15 nodes whole`);
 
   // Undo, redo, keyboard help.
   await page.keyboard.press('?');
@@ -223,11 +237,20 @@ async function main() {
   await page.screenshot({ path: path.join(artifacts, 'editor_help_1280x800.png') });
   await page.keyboard.press('Escape');
   check((await page.$('[role="dialog"][aria-label="Keyboard shortcuts"]')) === null, 'the help overlay lists the keys and closes with Escape');
+  // The larger tree (M): the cell, the waypoints and the runs fold away; the whole tree shows.
+  await page.keyboard.press('m');
+  await page.waitForTimeout(600);
+  await page.screenshot({ path: path.join(artifacts, 'editor_run_1280x800_larger_tree.png') });
+  const whole = await page.$$eval('.tree-node', wholeInPane);
+  const zoom = await page.$eval('.react-flow__viewport', (v) => Number(/scale\(([\d.]+)\)/.exec(v.style.transform)?.[1]));
+  check(whole === 15 && zoom >= 0.75, `with the larger tree (M) at 1280x800 all ${whole} of 15 nodes show whole, at zoom ${zoom.toFixed(2)}`);
   await node('Home', 3).click();
   await page.keyboard.press('Delete');
   check((await page.$$('.tree-node')).length === 14, 'Delete removes the selected node');
   await page.keyboard.press('Control+z');
   check((await page.$$('.tree-node')).length === 15, 'Ctrl+Z brings it back');
+  await page.keyboard.press('m');
+  check(await page.isVisible('.view3d'), 'M again brings the cell back');
 
   // Replay: pick the run from the run log and scrub through its transitions.
   await page.setViewportSize({ width: 1600, height: 1000 });

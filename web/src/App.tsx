@@ -19,6 +19,7 @@ import { candidatesOf, ObjectsPane } from './components/ObjectsPane';
 import { Waypoints } from './components/Waypoints';
 import { View3D } from './components/View3D';
 import { Replay } from './components/Replay';
+import { Believed, believe, emptyBelief } from './model/belief';
 
 interface LiveRun {
   run: RunInfo;
@@ -83,6 +84,9 @@ export function App() {
   const [clipboard, setClipboard] = useState<T.EditorNode[]>([]);
   const [orientation, setOrientation] = useState<Orientation>('LR');
   const [help, setHelp] = useState(false);
+  // The larger tree (M): the cell, the waypoints and the runs fold away.
+  const [large, setLarge] = useState(false);
+  const [fitRequest, setFitRequest] = useState(0);
   // Sign-in: 'missing' without a token, 'wrong' when the server refused it.
   const [signIn, setSignIn] = useState<'missing' | 'wrong' | null>(() => (readToken() ? null : 'missing'));
   // Plan runs started from this page: their statuses are painted on this plan.
@@ -104,6 +108,18 @@ export function App() {
   const [operation, setOperation] = useState<OperationState | null>(null);
   const [replay, setReplay] = useState<ReplayState | null>(null);
   const [runsRefresh, setRunsRefresh] = useState(0);
+
+  // The world the system believes (pane 1 lists it, pane 2 draws it): one step for every
+  // snapshot as it arrives, not per render, so that a grasp or a release between two renders
+  // is not missed.
+  const beliefRef = useRef(emptyBelief());
+  const [believed, setBelieved] = useState<Believed | undefined>(undefined);
+  const showCell = (state: CellState) => {
+    const next = believe(beliefRef.current, state);
+    beliefRef.current = next.belief;
+    setBelieved(next);
+    setCell(state);
+  };
 
   const planRef = useRef(plan);
   planRef.current = plan;
@@ -134,7 +150,7 @@ export function App() {
         switch (m.type) {
           case 'hello':
             setInfo(m.info);
-            setCell(m.state);
+            if (m.state) showCell(m.state);
             // The last run paints this plan only if it is a run of this plan (a reload starts
             // a new plan: another plan's old FAILURE must not show on it).
             if (m.run && m.run.kind === 'plan' && m.run.nodes && m.run.plan && m.run.plan === planNameRef.current) {
@@ -146,7 +162,7 @@ export function App() {
             }
             break;
           case 'state':
-            setCell(m as CellState);
+            showCell(m as CellState);
             break;
           case 'run_started':
             if (m.run.kind === 'plan') {
@@ -330,6 +346,8 @@ export function App() {
       else if (ctrl && key === 'v' && !replay) paste();
       else if (ctrl && key === 'd' && !replay) duplicate();
       else if (ctrl && key === 's') void save();
+      else if (!ctrl && !e.altKey && key === 'f') setFitRequest((n) => n + 1);
+      else if (!ctrl && !e.altKey && key === 'm') setLarge((l) => !l);
       else if ((e.key === 'Delete' || e.key === 'Backspace') && selectedKey && !replay) removeSelected();
       else if (e.altKey && selectedKey && !replay && (key === (lr ? 'arrowup' : 'arrowleft') || key === (lr ? 'arrowdown' : 'arrowright')))
         edit((p) => T.shiftNode(p, treeId, selectedKey, key === (lr ? 'arrowup' : 'arrowleft') ? -1 : 1));
@@ -520,7 +538,7 @@ export function App() {
     : 'Nothing has run yet.';
 
   return (
-    <div className="app">
+    <div className={`app ${large ? 'tree-large' : ''}`}>
       {/* 8: the menu, with plan files and the run controls (7) */}
       <header className="menu" aria-label="Menu">
         <span className="brand">costar</span>
@@ -687,17 +705,36 @@ export function App() {
           <button type="button" disabled={!!replay || !selectedKey} onClick={removeSelected} title="Delete the selected nodes (Delete)">
             Delete
           </button>
-          <button type="button" disabled={!canUndo(history) || !!replay} onClick={() => setHistory(undo(history))} title="Ctrl+Z">
-            Undo
+          <button type="button" className="icon" aria-label="Undo" disabled={!canUndo(history) || !!replay} onClick={() => setHistory(undo(history))} title="Undo (Ctrl+Z)">
+            ↶
           </button>
-          <button type="button" disabled={!canRedo(history) || !!replay} onClick={() => setHistory(redo(history))} title="Ctrl+Y">
-            Redo
+          <button type="button" className="icon" aria-label="Redo" disabled={!canRedo(history) || !!replay} onClick={() => setHistory(redo(history))} title="Redo (Ctrl+Y)">
+            ↷
           </button>
-          <button type="button" onClick={() => setOrientation((o) => (o === 'LR' ? 'TB' : 'LR'))} title="Lay the tree out left to right or top down">
-            {orientation === 'LR' ? '→ layout' : '↓ layout'}
+          <button
+            type="button"
+            className="icon"
+            aria-label="Layout"
+            onClick={() => setOrientation((o) => (o === 'LR' ? 'TB' : 'LR'))}
+            title={orientation === 'LR' ? 'Laid out left to right: click for top down' : 'Laid out top down: click for left to right'}
+          >
+            {orientation === 'LR' ? '→' : '↓'}
           </button>
-          <button type="button" onClick={() => setHelp(true)} title="Keyboard shortcuts (?)">
-            ? Keys
+          <button type="button" aria-label="Fit the tree" onClick={() => setFitRequest((n) => n + 1)} title="Fit the whole tree into the pane (F)">
+            Fit
+          </button>
+          <button
+            type="button"
+            className={`icon ${large ? 'on' : ''}`}
+            aria-label="Larger tree"
+            aria-pressed={large}
+            onClick={() => setLarge((l) => !l)}
+            title={large ? 'Show the cell, the waypoints and the runs again (M)' : 'Larger tree: fold away the cell, the waypoints and the runs (M)'}
+          >
+            ⤢
+          </button>
+          <button type="button" className="icon" aria-label="Keys" onClick={() => setHelp(true)} title="Keyboard shortcuts (?)">
+            ?
           </button>
           <span className="separator" />
           <button type="button" disabled={!selected || !!replay} onClick={saveSubtree}>
@@ -711,12 +748,16 @@ export function App() {
               </option>
             ))}
           </select>
-          <button type="button" disabled={!subtreeChoice || !!replay} onClick={() => insertSubtree(false)} title="Insert a copy of the saved subtree">
-            Insert
-          </button>
-          <button type="button" disabled={!subtreeChoice || !!replay} onClick={() => insertSubtree(true)} title="Insert a SubTree node that names it (and add its BehaviorTree to the file)">
-            As SubTree
-          </button>
+          {subtreeChoice && (
+            <>
+              <button type="button" disabled={!!replay} onClick={() => insertSubtree(false)} title="Insert a copy of the saved subtree">
+                Insert
+              </button>
+              <button type="button" disabled={!!replay} onClick={() => insertSubtree(true)} title="Insert a SubTree node that names it (and add its BehaviorTree to the file)">
+                As SubTree
+              </button>
+            </>
+          )}
         </div>
         {(replay ? replay.plan : plan).trees.length > 1 && (
         <div className="tabs">
@@ -746,6 +787,7 @@ export function App() {
             problems={problems}
             readOnly={!!replay}
             orientation={orientation}
+            fitRequest={fitRequest}
             onSelect={select}
             onToggle={(key) => setHistory(replace(history, T.toggleCollapsed(plan, treeId, key)))}
             onMove={(key, target, position) => edit((p) => T.moveNode(p, treeId, key, target, position, kindOf))}
@@ -777,13 +819,15 @@ export function App() {
           edit((p) => (clear ?? []).reduce((q, other) => T.setAttribute(q, treeId, selectedKey, other, undefined), T.setAttribute(p, treeId, selectedKey, name, value)))
         }
       />
-      <ObjectsPane state={cell} selectedType={selected?.id ?? null} data={selectedData} />
+      <ObjectsPane state={cell} selectedType={selected?.id ?? null} data={selectedData} shapes={choices?.object_shape} believed={believed} />
       <View3D
         state={cell}
         candidates={selectedData?.candidates ?? []}
         selectedWaypoint={selected ? T.attribute(selected, 'waypoint') ?? null : null}
         api={api}
         pointCloudAvailable={info?.features.pointcloud ?? false}
+        shapes={choices?.object_shape}
+        believed={believed}
       />
       <Waypoints state={cell} choices={choices} busy={running} run={runOperation} />
       <Replay

@@ -34,6 +34,13 @@ export interface Choices {
   object_class: string[];
   predicate: { name: string; arity: number; description: string }[];
   grasp: Record<string, string[]>;
+  /** Each object class's shape (boxes in its frame, metres) and named colours (RGB in [0, 1]). */
+  object_shape?: Record<string, ObjectShape>;
+}
+
+export interface ObjectShape {
+  boxes: { center: [number, number, number]; half_size: [number, number, number] }[];
+  colors: { name: string; rgb: [number, number, number] }[];
 }
 
 export interface Info {

@@ -1,6 +1,6 @@
 import { describe, expect, it } from 'vitest';
 import type { CellState } from '../src/api';
-import { believe, emptyBelief } from '../src/model/belief';
+import { believe, emptyBelief, whereFrom } from '../src/model/belief';
 
 const I: [number, number, number, number] = [0, 0, 0, 1];
 function snapshot(tool: [number, number, number], holding: boolean, part: [number, number, number] = [0.5, 0.2, 0.02]): CellState {
@@ -18,8 +18,10 @@ describe('the world the system believes', () => {
   it('moves a held part with the tool and leaves it where it was put', () => {
     let belief = emptyBelief();
     // Grasped: the tool is 2 cm above the part's centre.
+    expect(whereFrom(believe(belief, snapshot([0.5, 0.2, 0.3], false)), 'node_1')).toBe('detected');
     let step = believe(belief, snapshot([0.5, 0.2, 0.04], true));
     expect(step.poses.get('node_1')!.p).toEqual([0.5, 0.2, 0.02]);
+    expect(whereFrom(step, 'node_1')).toBe('held');
     belief = step.belief;
     step = believe(belief, snapshot([0.3, -0.1, 0.2], true));
     step.poses.get('node_1')!.p.forEach((v, i) => expect(v).toBeCloseTo([0.3, -0.1, 0.18][i], 9));
@@ -29,8 +31,10 @@ describe('the world the system believes', () => {
     step.poses.get('node_1')!.p.forEach((v, i) => expect(v).toBeCloseTo([0.3, -0.1, 0.18][i], 9));
     step = believe(step.belief, snapshot([0.4, 0, 0.3], false));
     step.poses.get('node_1')!.p.forEach((v, i) => expect(v).toBeCloseTo([0.3, -0.1, 0.18][i], 9));
+    expect(whereFrom(step, 'node_1')).toBe('put down');
     // A new detection wins.
     step = believe(step.belief, snapshot([0.4, 0, 0.3], false, [0.3, -0.1, 0.02]));
     expect(step.poses.get('node_1')!.p).toEqual([0.3, -0.1, 0.02]);
+    expect(whereFrom(step, 'node_1')).toBe('detected');
   });
 });

@@ -1,4 +1,4 @@
-// The keyboard shortcuts, listed over the page (the ? key, or the "? Keys" button).
+// The keyboard shortcuts, listed over the page (the ? key, or the "?" button).
 
 export const HELP_SHORTCUTS: [string, string][] = [
   ['click an operation (6)', 'insert it after the selected node, or inside it if it takes children'],
@@ -11,7 +11,9 @@ export const HELP_SHORTCUTS: [string, string][] = [
   ['Space', 'fold or unfold the selected node'],
   ['Ctrl+Z · Ctrl+Y (Ctrl+Shift+Z)', 'undo · redo'],
   ['Ctrl+S', 'save the plan'],
-  ['wheel · Ctrl+wheel or pinch · drag', 'scroll · zoom · pan the tree; the ⛶ button fits it'],
+  ['wheel · Ctrl+wheel or pinch · drag', 'scroll · zoom · pan the tree'],
+  ['F', 'fit the whole tree into the pane (the Fit button)'],
+  ['M', 'larger tree: fold away the cell, the waypoints and the runs, and back (the ⤢ button)'],
   ['drag a node onto another', 'its leading or trailing edge: before or after it; its middle: inside it'],
   ['? or F1 · Escape', 'this list · close it'],
 ];

@@ -1,7 +1,9 @@
 // Pane 1: the objects the system knows (detected parts), and for a selected SmartMove node the
 // candidates it considered: each part x symmetry with its cost, or why it was rejected.
 
-import type { CellState } from '../api';
+import type { CellState, ObjectShape } from '../api';
+import { cssColour, PartLook, partLook } from '../model/parts';
+import { Believed, whereFrom } from '../model/belief';
 
 export interface Candidate {
   object: string;
@@ -29,6 +31,8 @@ interface Props {
   state: CellState | null;
   selectedType: string | null;
   data: SmartMoveData | null;
+  shapes?: Record<string, ObjectShape>;
+  believed?: Believed;
 }
 
 /** Feasible candidates by cost, the chosen one first; rejected ones grouped by their reason. */
@@ -88,7 +92,15 @@ function CandidateTable({ data, known }: { data: SmartMoveData; known: Set<strin
   );
 }
 
-export function ObjectsPane({ state, selectedType, data }: Props) {
+/** The colour a part is drawn in (pane 2): its class's, as perception reports no part's own. */
+function Swatch({ look }: { look: PartLook }) {
+  const title = look.colorName
+    ? `drawn in the class's colour ${look.colorName} (the class comes in ${look.colorNames.join(', ')}; perception reports a part's class, not its colour)`
+    : 'the server did not describe this class: drawn grey';
+  return <span className="swatch" style={{ background: cssColour(look.rgb) }} title={title} />;
+}
+
+export function ObjectsPane({ state, selectedType, data, shapes, believed }: Props) {
   const objects = state?.objects ?? [];
   const smart = selectedType !== null && selectedType.startsWith('Smart');
   return (
@@ -111,8 +123,19 @@ export function ObjectsPane({ state, selectedType, data }: Props) {
             {objects.map((o) => (
               <tr key={o.name}>
                 <td>{o.name}</td>
-                <td>{o.class}</td>
-                <td>{o.p.map((v) => v.toFixed(3)).join(', ')}</td>
+                <td>
+                  <Swatch look={partLook(o.class, shapes)} />
+                  {o.class}
+                </td>
+                <td>
+                  {(believed?.poses.get(o.name) ?? o).p.map((v) => v.toFixed(3)).join(', ')}
+                  {believed && whereFrom(believed, o.name) !== 'detected' && (
+                    <span className="dim" title="where the system believes it is: it moves with the tool while held, and stays where it was put until a detection sees it again">
+                      {' '}
+                      ({whereFrom(believed, o.name)})
+                    </span>
+                  )}
+                </td>
               </tr>
             ))}
           </tbody>

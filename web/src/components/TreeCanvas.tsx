@@ -21,12 +21,12 @@ import {
   useStore,
 } from '@xyflow/react';
 import '@xyflow/react/dist/style.css';
-import { hierarchy, tree as tidyTree } from 'd3-hierarchy';
 import type { NodeInfo } from '../api';
 import type { DropPosition, EditorNode } from '../model/tree';
+import { BOX, fitViewport, layout, Orientation } from '../model/layout';
 import type { NodeStatus } from '../model/status';
 
-export type Orientation = 'LR' | 'TB';
+export type { Orientation };
 export type SelectMode = 'single' | 'range' | 'toggle';
 
 interface Props {
@@ -42,10 +42,11 @@ interface Props {
   onToggle: (key: string) => void;
   onMove: (key: string, target: string, position: DropPosition) => void;
   onDropNew: (id: string, target: string, position: DropPosition) => void;
+  /** Changes when the whole tree should be fitted into the pane (the F key). */
+  fitRequest?: number;
 }
 
-export const BOX = { width: 236, height: 56 };
-const GAP = { sibling: 12, level: 56 };
+
 
 // The parameters that tell nodes of one type apart, in the order they are shown.
 const SUMMARY_PORTS = ['waypoint', 'object_class', 'target_class', 'target', 'predicates', 'grasp', 'predicate', 'args',
@@ -142,10 +143,10 @@ const TreeBox = memo(function TreeBox({ data }: NodeProps<Node<BoxData>>) {
           </button>
         )}
         <span className="node-type">{node.id}</span>
+        {name && <span className="node-name">“{name}”</span>}
         {node.collapsed && <span className="folded">+{node.children.length}</span>}
         {last !== 'IDLE' && <span className={`badge badge-${running ? 'running' : last.toLowerCase()}`}>{running ? 'RUNNING' : last}</span>}
       </div>
-      {name && <div className="node-name">“{name}”</div>}
       {reason ? (
         <div className="reason node-line">{reason}</div>
       ) : problem ? (
@@ -161,20 +162,6 @@ const TreeBox = memo(function TreeBox({ data }: NodeProps<Node<BoxData>>) {
 });
 
 const NODE_TYPES = { bt: TreeBox };
-
-/** Positions from d3-hierarchy's tidy tree: depth along the main axis, siblings across it. */
-export function layout(root: EditorNode, orientation: Orientation) {
-  const h = hierarchy(root, (n) => (n.collapsed ? [] : n.children));
-  const across = orientation === 'LR' ? BOX.height + GAP.sibling : BOX.width + GAP.sibling;
-  const along = orientation === 'LR' ? BOX.width + GAP.level : BOX.height + GAP.level;
-  tidyTree<EditorNode>().nodeSize([across, along]).separation((a, b) => (a.parent === b.parent ? 1 : 1.15))(h);
-  return h.descendants().map((d) => ({
-    node: d.data,
-    parent: d.parent?.data.key ?? null,
-    x: orientation === 'LR' ? (d.y ?? 0) : (d.x ?? 0),
-    y: orientation === 'LR' ? (d.x ?? 0) : (d.y ?? 0),
-  }));
-}
 
 function Canvas(props: Props) {
   const flow = useReactFlow();
@@ -223,8 +210,9 @@ function Canvas(props: Props) {
     [placed, props.statuses],
   );
 
-  // Fit the tree when it is shown, its shape or the pane's size changes, never below 75% (the
-  // rest is a wheel away); then bring the selected node into view (new nodes, keyboard).
+  // Fit the tree when it is shown, its shape or the pane's size changes, never below
+  // MIN_FIT_ZOOM (the rest is a wheel away); then bring the selected node into view (new
+  // nodes, keyboard).
   const rootKey = props.root?.key;
   const fitted = useRef<string>('');
   useEffect(() => {
@@ -232,22 +220,13 @@ function Canvas(props: Props) {
     const id = `${rootKey}/${props.orientation}/${placed.length}/${width}x${height}`;
     if (fitted.current === id) return;
     fitted.current = id;
-    // Readable first: never below 70% for the first view; the rest is a scroll (wheel) away.
-    const xs = placed.map((p) => p.x);
-    const ys = placed.map((p) => p.y);
-    const w = Math.max(...xs) - Math.min(...xs) + BOX.width + 40;
-    const h = Math.max(...ys) - Math.min(...ys) + BOX.height + 40;
-    const zoom = Math.max(0.75, Math.min(1, width / w, height / h));
-    const left = Math.min(...xs) - 20;
-    const top = Math.min(...ys) - 20;
-    const fitsAcross = w * zoom <= width;
-    const fitsDown = h * zoom <= height;
-    void flow.setViewport({
-      x: fitsAcross ? (width - w * zoom) / 2 - left * zoom : -left * zoom,
-      y: fitsDown ? (height - h * zoom) / 2 - top * zoom : -top * zoom,
-      zoom,
-    });
+    void flow.setViewport(fitViewport(placed, width, height));
   }, [width, height, placed, rootKey, props.orientation, flow]);
+
+  // The F key: the whole tree, however small.
+  useEffect(() => {
+    if (props.fitRequest) void flow.fitView({ padding: 0.04, duration: 150 });
+  }, [props.fitRequest, flow]);
 
   useEffect(() => {
     if (!props.selectedKey || !width || !height) return;

@@ -1,13 +1,15 @@
 // Pane 2: the cell in 3D (three.js): the robot drawn along the UR5's Denavit-Hartenberg
 // frames from the joint angles the stream carries, its gripper, the table, the parts the
-// system knows (object symbols), the waypoints, SmartMove's candidates, and on request the
-// RGB-D camera's point cloud. Drag to orbit, wheel to zoom.
+// system believes are there (object symbols; a held part moves with the tool), each drawn as
+// its class's boxes in its class's colour, the waypoints, SmartMove's candidates, and on
+// request the RGB-D camera's point cloud. Drag to orbit, wheel to zoom.
 
 import { useEffect, useRef, useState } from 'react';
 import * as THREE from 'three';
-import { believe, Belief, emptyBelief } from '../model/belief';
+import type { Believed } from '../model/belief';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
-import type { Api, CellState } from '../api';
+import type { Api, CellState, ObjectShape } from '../api';
+import { partLook } from '../model/parts';
 import { position, ur5Frames } from '../model/kinematics';
 import type { Candidate } from './ObjectsPane';
 
@@ -17,6 +19,10 @@ interface Props {
   selectedWaypoint: string | null;
   api: Api;
   pointCloudAvailable: boolean;
+  /** Each object class's boxes and colours (GET /api/choices). */
+  shapes?: Record<string, ObjectShape>;
+  /** Where the system believes each part is (a held part moves with the tool). */
+  believed?: Believed;
 }
 
 interface Scene {
@@ -31,11 +37,6 @@ interface Scene {
   cloud: THREE.Group;
   render: () => void;
 }
-
-const CLASS_SIZES: Record<string, [number, number, number]> = {
-  node: [0.04, 0.04, 0.04],
-  link: [0.12, 0.03, 0.03],
-};
 
 function cylinderBetween(a: THREE.Vector3, b: THREE.Vector3, radius: number, material: THREE.Material) {
   const length = a.distanceTo(b);
@@ -62,17 +63,35 @@ function clear(group: THREE.Group) {
     child.traverse((o) => {
       const mesh = o as THREE.Mesh;
       mesh.geometry?.dispose?.();
+      const material = mesh.material as THREE.Material | THREE.Material[] | undefined;
+      if (Array.isArray(material)) material.forEach((m) => m.dispose());
+      else material?.dispose?.();
     });
   }
 }
 
-export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAvailable }: Props) {
+/** Where the 3D view looks from: close enough to tell the parts apart, the arm in view. */
+const HOME_VIEW: [number, number, number] = [1.05, -0.95, 0.7];
+
+/** A part: its class's boxes in the object frame, in the class's colour. */
+function partMesh(objectClass: string, shapes: Record<string, ObjectShape> | undefined) {
+  const look = partLook(objectClass, shapes);
+  const material = new THREE.MeshLambertMaterial({ color: new THREE.Color(...look.rgb) });
+  const group = new THREE.Group();
+  for (const box of look.boxes) {
+    const mesh = new THREE.Mesh(new THREE.BoxGeometry(...box.size), material);
+    mesh.position.set(...box.center);
+    group.add(mesh);
+  }
+  return group;
+}
+
+export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAvailable, shapes, believed }: Props) {
   const mount = useRef<HTMLDivElement>(null);
   const sceneRef = useRef<Scene | null>(null);
   const [error, setError] = useState<string | null>(null);
   const [cloudInfo, setCloudInfo] = useState<string>('');
   const [cloudTime, setCloudTime] = useState<number | null>(null);
-  const beliefRef = useRef<Belief>(emptyBelief());
 
   useEffect(() => {
     const element = mount.current;
@@ -90,9 +109,9 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     scene.background = new THREE.Color(0xf4f6fa);
     const camera = new THREE.PerspectiveCamera(45, 1, 0.01, 20);
     camera.up.set(0, 0, 1);
-    camera.position.set(1.35, -1.05, 0.85);
+    camera.position.set(...HOME_VIEW);
     const controls = new OrbitControls(camera, renderer.domElement);
-    controls.target.set(0.3, 0, 0.15);
+    controls.target.set(0.35, -0.05, 0.12);
     scene.add(new THREE.HemisphereLight(0xffffff, 0x8899aa, 1.6));
     const sun = new THREE.DirectionalLight(0xffffff, 1.5);
     sun.position.set(1, -1, 2);
@@ -170,15 +189,9 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       s.robot.add(gripper);
     }
     clear(s.parts);
-    const believed = believe(beliefRef.current, state);
-    beliefRef.current = believed.belief;
     for (const object of state.objects) {
-      const pose = believed.poses.get(object.name) ?? object;
-      const size = CLASS_SIZES[object.class] ?? [0.04, 0.04, 0.04];
-      const mesh = new THREE.Mesh(
-        new THREE.BoxGeometry(...size),
-        new THREE.MeshLambertMaterial({ color: object.class === 'link' ? 0x3fa34d : 0xd9534f }),
-      );
+      const pose = believed?.poses.get(object.name) ?? object;
+      const mesh = partMesh(object.class, shapes);
       mesh.position.set(...pose.p);
       mesh.quaternion.set(...pose.q);
       s.parts.add(mesh);
@@ -199,7 +212,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       }
     }
     s.render();
-  }, [state, selectedWaypoint]);
+  }, [state, selectedWaypoint, shapes, believed]);
 
   useEffect(() => {
     const s = sceneRef.current;
@@ -220,7 +233,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     const s = sceneRef.current;
     if (!s) return;
     s.camera.position.set(...from);
-    s.controls.target.set(0.35, 0, 0.1);
+    s.controls.target.set(0.35, -0.05, 0.12);
     s.controls.update();
     s.render();
   };
@@ -250,7 +263,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     <section className="pane view3d" aria-label="3D view">
       <h2>
         <span className="pane-number">2</span> Cell
-        <button type="button" className="small" onClick={() => look([1.35, -1.05, 0.85])}>
+        <button type="button" className="small" onClick={() => look(HOME_VIEW)}>
           3D
         </button>
         <button type="button" className="small" onClick={() => look([0.35, -0.25, 2.2])}>

@@ -53,8 +53,20 @@ export function heldPart(state: CellState): string | undefined {
   return undefined;
 }
 
+export interface Believed {
+  belief: Belief;
+  /** Each part's pose to draw. */
+  poses: Map<string, Pose>;
+}
+
+/** What a part's believed pose rests on: the last detection, the tool, or where it was put. */
+export function whereFrom(believed: Believed, name: string): 'detected' | 'held' | 'put down' {
+  if (believed.belief.held?.name === name) return 'held';
+  return believed.belief.placed.has(name) ? 'put down' : 'detected';
+}
+
 /** The next belief after a snapshot, and each part's pose to draw. */
-export function believe(previous: Belief, state: CellState): { belief: Belief; poses: Map<string, Pose> } {
+export function believe(previous: Belief, state: CellState): Believed {
   const tool = state.arm.endpoint;
   const held = heldPart(state);
   const belief: Belief = { held: undefined, placed: new Map(previous.placed) };
