@@ -354,7 +354,7 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->mountCamera(options.camera_offset.value_or(
       scene.camera_offset ? cameraOffsetPose(*scene.camera_offset, options.placement_seed.value_or(scene.seed))
                           : world::Pose::Identity()));
-  impl->tool_body = impl->id(mjOBJ_BODY, robot.urdf_tool_link.c_str());  // the flange (tool0 on a UR)
+  impl->tool_body = impl->id(mjOBJ_BODY, "tool0");  // the flange (the workcell model names it, like the gripper)
   for (const auto& part : impl->placements) {
     impl->part_bodies.push_back(impl->id(mjOBJ_BODY, part.name.c_str()));
   }

@@ -48,7 +48,7 @@ TEST(SimMarker, CornersAreSeenWhereTheSimulatorPutsThem) {
           best = s;
         }
       }
-      sim::ArmJoints q{};
+      sim::ArmJoints q = home;
       for (int j = 0; j < 6; ++j) {
         q[j] = home[j] + std::remainder(solutions[best][j] - home[j], 2 * M_PI);
       }
