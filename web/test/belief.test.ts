@@ -37,4 +37,23 @@ describe('the world the system believes', () => {
     expect(step.poses.get('node_1')!.p).toEqual([0.3, -0.1, 0.02]);
     expect(whereFrom(step, 'node_1')).toBe('detected');
   });
+
+  it('puts a part down where it was last held, though the first snapshot without the hold comes after the tool retreated', () => {
+    let belief = believe(emptyBelief(), snapshot([0.5, 0.2, 0.04], true)).belief;
+    belief = believe(belief, snapshot([0.3, -0.1, 0.2], true)).belief; // held above the place, at rest
+    // Sparse snapshots (a loaded machine): the next one is after the fingers opened and the tool
+    // rose 8 cm; the part stays where the tool let it go.
+    const step = believe(belief, snapshot([0.3, -0.1, 0.28], false));
+    step.poses.get('node_1')!.p.forEach((v, i) => expect(v).toBeCloseTo([0.3, -0.1, 0.18][i], 9));
+    expect(whereFrom(step, 'node_1')).toBe('put down');
+  });
+
+  it('takes the grasp where the tool was nearest the part, though the first snapshot with the hold comes after the lift began', () => {
+    let belief = believe(emptyBelief(), snapshot([0.5, 0.2, 0.04], false)).belief; // closing on the part
+    // Sparse snapshots: the next one is held, with the tool already 10 cm up.
+    const step = believe(belief, snapshot([0.5, 0.2, 0.14], true));
+    step.poses.get('node_1')!.p.forEach((v, i) => expect(v).toBeCloseTo([0.5, 0.2, 0.12][i], 9));
+    belief = step.belief;
+    expect(whereFrom(step, 'node_1')).toBe('held');
+  });
 });

@@ -38,7 +38,9 @@ const same = (a: Pose, b: Pose) => a.p.every((v, i) => Math.abs(v - b.p[i]) < 1e
 
 export interface Belief {
   /** The part held and its pose in the tool frame (taken when the hold began). */
-  held?: { name: string; inTool: Pose };
+  held?: { name: string; inTool: Pose; at: Pose };
+  /** The tool's pose in the previous snapshot (snapshots are sparse on a loaded machine). */
+  tool?: Pose;
   /** Parts put down since their last detection: where they were put, and the detected pose then. */
   placed: Map<string, { pose: Pose; detected: Pose }>;
 }
@@ -69,7 +71,7 @@ export function whereFrom(believed: Believed, name: string): 'detected' | 'held'
 export function believe(previous: Belief, state: CellState): Believed {
   const tool = state.arm.endpoint;
   const held = heldPart(state);
-  const belief: Belief = { held: undefined, placed: new Map(previous.placed) };
+  const belief: Belief = { held: undefined, placed: new Map(previous.placed), tool: tool ?? previous.tool };
   const poses = new Map<string, Pose>();
   for (const o of state.objects) {
     const detected: Pose = { p: o.p, q: o.q };
@@ -80,17 +82,25 @@ export function believe(previous: Belief, state: CellState): Believed {
   if (held && tool) {
     const before = previous.held?.name === held ? previous.held.inTool : undefined;
     const where = poses.get(held);
-    const inTool = before ?? (where ? relative(tool, where) : undefined);
+    // The grasp: the part where it was seen, the tool where it closed. By the first snapshot with
+    // the hold the arm may be lifting already; of this tool pose and the previous one, the one
+    // nearer the part is nearer the grasp.
+    const near = (t: Pose) => (where ? Math.hypot(...t.p.map((v, i) => v - where.p[i])) : 0);
+    const grasping = previous.tool && near(previous.tool) < near(tool) ? previous.tool : tool;
+    const inTool = before ?? (where ? relative(grasping, where) : undefined);
     if (inTool) {
-      belief.held = { name: held, inTool };
-      poses.set(held, compose(tool, inTool));
+      const at = compose(tool, inTool);
+      belief.held = { name: held, inTool, at };
+      poses.set(held, at);
     }
   }
   if (previous.held && previous.held.name !== held && tool) {
     // Let go: the part stays where the tool left it until a detection sees it.
     const detected = state.objects.find((o) => o.name === previous.held!.name);
     if (detected) {
-      const pose = compose(tool, previous.held.inTool);
+      // Where it was last drawn held: the fingers open with the arm at rest, and by the first
+      // snapshot without the hold the tool may already be retreating (sparse snapshots under load).
+      const pose = previous.held.at;
       belief.placed.set(detected.name, { pose, detected: { p: detected.p, q: detected.q } });
       poses.set(detected.name, pose);
     }
