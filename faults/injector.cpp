@@ -256,34 +256,27 @@ std::vector<std::size_t> Injector::faultsOn(std::string_view target) const {
   return found;
 }
 
-arm::ArmDriver& Injector::wrap(arm::ArmDriver& driver) {
-  wrapped_targets_.push_back("arm-driver");
-  arm::ArmDriver* outer = &driver;
-  for (const std::size_t fault : faultsOn("arm-driver")) {
-    arm_wrappers_.push_back(std::make_unique<FaultyArmDriver>(*outer, *this, fault));
-    outer = arm_wrappers_.back().get();
+template <class Faulty, class Interface>
+Interface& Injector::chain(Interface& inner, const char* target, std::vector<std::unique_ptr<Interface>>& wrappers) {
+  wrapped_targets_.push_back(target);
+  Interface* outer = &inner;
+  for (const std::size_t fault : faultsOn(target)) {
+    wrappers.push_back(std::make_unique<Faulty>(*outer, *this, fault));
+    outer = wrappers.back().get();
   }
   return *outer;
+}
+
+arm::ArmDriver& Injector::wrap(arm::ArmDriver& driver) {
+  return chain<FaultyArmDriver>(driver, "arm-driver", arm_wrappers_);
 }
 
 gripper::GripperDriver& Injector::wrap(gripper::GripperDriver& driver) {
-  wrapped_targets_.push_back("gripper-driver");
-  gripper::GripperDriver* outer = &driver;
-  for (const std::size_t fault : faultsOn("gripper-driver")) {
-    gripper_wrappers_.push_back(std::make_unique<FaultyGripperDriver>(*outer, *this, fault));
-    outer = gripper_wrappers_.back().get();
-  }
-  return *outer;
+  return chain<FaultyGripperDriver>(driver, "gripper-driver", gripper_wrappers_);
 }
 
 camera::RgbdCamera& Injector::wrap(camera::RgbdCamera& camera) {
-  wrapped_targets_.push_back("camera");
-  camera::RgbdCamera* outer = &camera;
-  for (const std::size_t fault : faultsOn("camera")) {
-    camera_wrappers_.push_back(std::make_unique<FaultyCamera>(*outer, *this, fault));
-    outer = camera_wrappers_.back().get();
-  }
-  return *outer;
+  return chain<FaultyCamera>(camera, "camera", camera_wrappers_);
 }
 
 std::shared_ptr<component::Component> Injector::wrap(std::shared_ptr<component::Component> component) {

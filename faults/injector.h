@@ -79,6 +79,9 @@ class Injector {
  private:
   TimePoint now() const;
   std::vector<std::size_t> faultsOn(std::string_view target) const;
+  /// `inner` wrapped once per fault on `target`, innermost first; the wrappers kept in `wrappers`.
+  template <class Faulty, class Interface>
+  Interface& chain(Interface& inner, const char* target, std::vector<std::unique_ptr<Interface>>& wrappers);
 
   std::vector<FaultRecord> records_;
   const Clock* clock_ = nullptr;
