@@ -63,12 +63,16 @@ if [[ "$FUZZ_RUNS" -gt 0 ]]; then
   rm -rf "$api_corpus"
 
   echo
-  echo "test: fuzzing the server end to end (raw bytes over loopback: HTTP parser, router, handlers, WebSocket), $FUZZ_RUNS runs (smoke mode)"
-  cmake --build "$BUILD_DIR-fuzz" --target http_fuzz -j "$(nproc)"
+  echo "test: fuzzing the server end to end (raw bytes as a connection, in memory: HTTP parser, router, handlers, WebSocket), $FUZZ_RUNS runs (smoke mode)"
+  cmake --build "$BUILD_DIR-fuzz" --target http_fuzz http_socket_fuzz -j "$(nproc)"
   http_corpus=$(mktemp -d)
   cp server/fuzz/http_corpus/* "$http_corpus/"
   "$BUILD_DIR-fuzz/server/http_fuzz" -dict=server/fuzz/http.dict -max_len=4096 -seed=1 \
     -runs="$FUZZ_RUNS" -artifact_prefix="$http_corpus/" "$http_corpus" 2>&1 | tail -n 3
+  # The same over loopback TCP (a socket per run: a tenth of the runs).
+  echo "test: fuzzing the server end to end over loopback TCP, $((FUZZ_RUNS / 10)) runs (smoke mode)"
+  "$BUILD_DIR-fuzz/server/http_socket_fuzz" -dict=server/fuzz/http.dict -max_len=4096 -seed=1 \
+    -runs="$((FUZZ_RUNS / 10))" -artifact_prefix="$http_corpus/" "$http_corpus" 2>&1 | tail -n 3
   rm -rf "$http_corpus"
 fi
 
