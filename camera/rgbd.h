@@ -4,6 +4,8 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +45,15 @@ struct RgbdFrame {
   std::size_t validCount() const;
 };
 
+/// What a camera's stream says about its newest frame, without the frame itself.
+struct StreamStatus {
+  /// When the newest frame was taken.
+  TimePoint stamp{};
+  /// Its pixels (0: an empty frame), and how many of them hold a valid depth reading.
+  std::size_t points = 0;
+  std::size_t valid = 0;
+};
+
 class RgbdCamera {
  public:
   virtual ~RgbdCamera() = default;
@@ -55,6 +66,12 @@ class RgbdCamera {
   /// The current frame for a user that needs its points only: the colour image may be left
   /// empty (a simulated camera then skips rendering colour). The points are as capture()'s.
   virtual RgbdFrame captureDepth() { return capture(); }
+  /// The stream's health between the frames taken, for a monitor that asks often (the
+  /// perception component, every tick): a camera streams whether or not anyone takes its
+  /// frames (30 a second for a Carmine), and its driver knows the newest one's stamp and
+  /// validity. Must be cheap. Empty: this camera cannot tell; it is then judged only by the
+  /// frames taken. @throws std::exception when the camera cannot be reached.
+  virtual std::optional<StreamStatus> streamStatus() { return std::nullopt; }
 };
 
 }  // namespace costar::camera

@@ -51,9 +51,13 @@ double percentile(std::vector<double> values, double p) {
   return values[low] + (values[high] - values[low]) * (position - low);
 }
 
-/// The spec with its moment: camera faults at a frame the plan captures, others at a time.
+/// The spec with its moment: camera faults at a frame the plan captures, others at a time; a
+/// spec that names its moment (KIND:TARGET@WHEN) keeps it.
 std::string withMoment(const std::string& fault, const CampaignOptions& options, const CampaignTask& task,
                        std::uint64_t seed) {
+  if (fault.find('@') != std::string::npos) {
+    return fault;
+  }
   if (fault.find(":camera") != std::string::npos) {
     std::mt19937_64 random(seed ^ 0x9e3779b97f4a7c15ULL);
     const int frames = std::max(1, options.frames_per_detection * task.detections);
@@ -196,7 +200,8 @@ CampaignSummary runCampaign(const CampaignOptions& options,
                                           : options.workcell == "test" ? testCellFaults()
                                                                        : allFaults();
   for (const std::string& fault : faults) {
-    parseFault(fault + "@t=0");  // @throws FaultSpecError for a bad one, before any run
+    parseFault(fault.find('@') != std::string::npos ? fault
+                                                    : fault + "@t=0");  // @throws FaultSpecError, before any run
   }
   std::vector<bt::Plan> plans;
   for (const CampaignTask& task : options.tasks) {

@@ -33,8 +33,8 @@ struct CampaignOptions {
   /// "ur5-sim", or "test" (components only, no robot: the arm checks are skipped).
   std::string workcell = "ur5-sim";
   std::vector<CampaignTask> tasks = paperTasks();
-  /// Fault specs to cycle through, "KIND:TARGET" (the moment is drawn); default: every kind on
-  /// every target of the UR5 cell.
+  /// Fault specs to cycle through, "KIND:TARGET" (the moment is drawn) or "KIND:TARGET@WHEN"
+  /// (as given); default: every kind on every target of the UR5 cell.
   std::vector<std::string> faults;
   int count = 30;
   std::uint64_t seed = 1;           // trial i: seed + i (placement, noise, the moment)

@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
   app.add_option("-w,--workcell", options.workcell, "ur5-sim, or test (components only)")->capture_default_str();
   std::vector<std::string> plans;
   app.add_option("--plan", plans, "plan(s) to run in place of the paper's three tasks");
-  app.add_option("--fault", options.faults, "KIND:TARGET to cycle through (default: all)");
+  app.add_option("--fault", options.faults, "KIND:TARGET to cycle through, or KIND:TARGET@WHEN (default: all)");
   app.add_option("--waypoints", options.waypoints, "the cell's waypoint file (checked unchanged)")
       ->check(CLI::ExistingFile);
   app.add_option("--json", json, "write every run as JSON");

@@ -91,7 +91,8 @@ class FaultyGripperDriver final : public gripper::GripperDriver {
   mutable gripper::FingerReading last_;
 };
 
-/// The RGB-D camera: its frames fail, repeat, come empty or all NaN.
+/// The RGB-D camera: its frames fail, repeat, come empty or all NaN, and its stream's status
+/// (what a health monitor sees between frames) says so too.
 class FaultyCamera final : public camera::RgbdCamera {
  public:
   FaultyCamera(camera::RgbdCamera& inner, Injector& injector, std::size_t fault)
@@ -103,6 +104,7 @@ class FaultyCamera final : public camera::RgbdCamera {
   camera::RgbdFrame capture() override {
     if (!injector_.active(fault_, true)) {
       last_ = inner_.capture();
+      newest_ = std::max(newest_, last_.stamp);
       return last_;
     }
     injector_.effect(fault_);
@@ -127,11 +129,40 @@ class FaultyCamera final : public camera::RgbdCamera {
     }
   }
 
+  /// Not counted for op=N (the frames are). A camera that cannot tell stays silent.
+  std::optional<camera::StreamStatus> streamStatus() override {
+    std::optional<camera::StreamStatus> status = inner_.streamStatus();
+    if (!status || !injector_.active(fault_, false)) {
+      if (status) {
+        newest_ = std::max(newest_, status->stamp);
+      }
+      return status;
+    }
+    injector_.effect(fault_);
+    const FaultRecord& record = injector_.record(fault_);
+    switch (record.spec.kind) {
+      case FaultKind::kThrow:
+        throw std::runtime_error("camera: its stream does not answer" + injected(record));
+      case FaultKind::kHang:
+        status->stamp = newest_;  // no frame since the fault
+        break;
+      case FaultKind::kEmptyFrame:
+        status->points = status->valid = 0;
+        break;
+      default:
+        status->valid = 0;
+        break;
+    }
+    return status;
+  }
+
  private:
   camera::RgbdCamera& inner_;
   Injector& injector_;
   std::size_t fault_;
   camera::RgbdFrame last_;
+  /// The newest stamp seen before the fault (frames and status).
+  TimePoint newest_{};
 };
 
 /// A component that throws once, stops answering, or dies.

@@ -196,7 +196,37 @@ OperationResult PerceptionComponent::process(const std::vector<camera::RgbdFrame
   return OperationResult::success(std::move(data));
 }
 
+void PerceptionComponent::checkCamera() const {
+  if (config_.camera_max_age <= Duration::zero()) {
+    return;
+  }
+  std::optional<camera::StreamStatus> status;
+  try {
+    status = camera_.streamStatus();
+  } catch (const std::exception& e) {
+    throw std::runtime_error(std::string("the camera's stream failed: ") + e.what());
+  }
+  if (!status) {
+    return;  // this camera cannot tell: its frames are checked as they are taken
+  }
+  if (status->points == 0) {
+    throw std::runtime_error("the camera sends empty frames (no pixels)");
+  }
+  if (status->valid == 0) {
+    throw std::runtime_error(
+        "the camera sends frames without any valid depth (is it covered, broken, or not looking at the table?)");
+  }
+  const Duration age = clock_.now() - status->stamp;
+  if (age > config_.camera_max_age) {
+    char text[160];
+    std::snprintf(text, sizeof text, "the camera stopped sending frames: the newest is %.3f s old (limit %.3f s)",
+                  toSeconds(age), toSeconds(config_.camera_max_age));
+    throw std::runtime_error(text);
+  }
+}
+
 world::Report PerceptionComponent::report() const {
+  checkCamera();
   std::lock_guard lock(mutex_);
   world::Report report;
   for (const auto& model : pipeline_->models()) {

@@ -14,6 +14,12 @@
 // The class symbol names the data file (data/objects/<class>.json) that gives SmartMove the
 // class's symmetries and axis priority. It reads camera frames only, never simulator ground
 // truth.
+//
+// Between detections it watches the camera: every report (every tick of a run) reads the
+// stream's status (RgbdCamera::streamStatus, cheap) and throws when the stream stopped (its
+// newest frame older than camera_max_age), sends empty frames or frames without any valid
+// depth, or does not answer; a report that throws stops the cell (ComponentRegistry), so a
+// camera that breaks after the last frame a DetectObjects used is not left unnoticed.
 
 #include <functional>
 #include <memory>
@@ -46,6 +52,9 @@ struct PerceptionConfig {
   /// seen from this pose instead of the one it carries, so a new calibration takes effect at
   /// the next frame.
   std::function<world::Pose()> camera_pose;
+  /// The camera's health between detections: the oldest its newest frame may be (a 30 Hz
+  /// stream that missed 6 frames). Zero: not watched (frames are still checked as taken).
+  Duration camera_max_age = std::chrono::milliseconds(200);
 };
 
 /// Loads the pipeline `config` describes: its files and options, the workspace centre from
@@ -76,6 +85,8 @@ class PerceptionComponent final : public component::LocalComponent {
   friend class DetectObjectsOperation;
   std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
                                                      const component::ParamMap& params) override;
+  /// @throws std::runtime_error naming what is wrong when the camera's stream is not healthy.
+  void checkCamera() const;
   /// Runs the pipeline on `frames` and updates the state; returns the operation's result.
   component::OperationResult process(const std::vector<camera::RgbdFrame>& frames);
 

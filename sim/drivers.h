@@ -17,12 +17,26 @@ class SimRgbdCamera final : public camera::RgbdCamera {
   std::string name() const override { return "rgbd (simulated PrimeSense Carmine)"; }
   const camera::Intrinsics& intrinsics() const override { return simulation_.rgbdIntrinsics(); }
   Duration framePeriod() const override { return std::chrono::nanoseconds(33'333'333); }
-  camera::RgbdFrame capture() override { return simulation_.captureRgbd(next_seed_++); }
-  camera::RgbdFrame captureDepth() override { return simulation_.captureRgbd(next_seed_++, false); }
+  camera::RgbdFrame capture() override { return taken(simulation_.captureRgbd(next_seed_++)); }
+  camera::RgbdFrame captureDepth() override { return taken(simulation_.captureRgbd(next_seed_++, false)); }
+  /// Frames are rendered only when taken (rendering costs), so the simulated stream never
+  /// stalls: its newest frame is the present instant, with the valid depth of the last frame
+  /// taken (all pixels before the first).
+  std::optional<camera::StreamStatus> streamStatus() override {
+    const camera::Intrinsics& intrinsics = simulation_.rgbdIntrinsics();
+    const std::size_t pixels = static_cast<std::size_t>(intrinsics.width) * intrinsics.height;
+    return camera::StreamStatus{simulation_.time(), pixels, last_valid_.value_or(pixels)};
+  }
 
  private:
+  camera::RgbdFrame taken(camera::RgbdFrame frame) {
+    last_valid_ = frame.validCount();
+    return frame;
+  }
+
   Simulation& simulation_;
   std::uint64_t next_seed_;
+  std::optional<std::size_t> last_valid_;
 };
 
 /// The gripper's fingers.

@@ -37,5 +37,29 @@ TEST(FaultCampaign, EveryFaultStopsTheTaskInTimeWithTheArmAtRest) {
   EXPECT_NE(summary.text().find("all"), std::string::npos);
 }
 
+TEST(FaultCampaign, ACameraThatBreaksBetweenDetectionsStopsTheTask) {
+  // Task 1 detects once, at its start (done at 0.56 s). A camera broken at 3 s, while the arm
+  // works, used to go unnoticed (no frame was taken again: the run ended in SUCCESS with a
+  // broken camera); the perception component watches the camera's stream between detections.
+  CampaignOptions options;
+  options.tasks = {paperTasks().front()};
+  options.faults = {"hang:camera@t=3s", "empty-frame:camera@t=3s", "nan-frame:camera@t=3s", "throw:camera@t=3s"};
+  options.count = static_cast<int>(options.faults.size());
+  options.seed = 5;
+  options.waypoints = dataRoot() / "examples/ur5/blind_waypoints.json";
+  const CampaignSummary summary = runCampaign(options);
+  ASSERT_EQ(summary.trials.size(), options.faults.size());
+  for (const FaultTrial& trial : summary.trials) {
+    SCOPED_TRACE(trial.fault + ": " + trial.outcome + " at " + trial.failure_path + ": " + trial.reason);
+    EXPECT_EQ(trial.outcome, "stopped");
+    EXPECT_NE(trial.reason.find("perception"), std::string::npos);
+    EXPECT_NE(trial.reason.find("camera"), std::string::npos);
+    EXPECT_GE(trial.end_s, 3.0);
+    EXPECT_LE(trial.end_s - 3.0, 0.25) << "within the stream's 0.2 s limit and a tick";
+    EXPECT_LT(trial.final_speed, 0.01);
+    EXPECT_TRUE(trial.waypoints_intact);
+  }
+}
+
 }  // namespace
 }  // namespace costar::faults

@@ -60,6 +60,11 @@ class GoodCamera final : public camera::RgbdCamera {
     frame.stamp = clock_.now();
     return frame;
   }
+  /// A live stream: its newest frame is now, every pixel valid.
+  std::optional<camera::StreamStatus> streamStatus() override {
+    const std::size_t pixels = static_cast<std::size_t>(intrinsics_.width) * intrinsics_.height;
+    return camera::StreamStatus{clock_.now(), pixels, pixels};
+  }
 
  private:
   const Clock& clock_;

@@ -97,6 +97,33 @@ TEST(Injector, BreaksCameraFramesAtTheChosenFrame) {
   EXPECT_EQ(nan->wrap(good2).capture().validCount(), 0u);
 }
 
+TEST(Injector, TheCameraStreamsStatusShowsTheFaultBetweenFrames) {
+  // What a health monitor sees without taking a frame; asking does not count for op=N.
+  SimClock clock;
+  GoodCamera good(clock);
+  auto hang = injector({"hang:camera@t=1s"}, clock);
+  camera::RgbdCamera& hung = hang->wrap(good);
+  clock.advanceTo(TimePoint(fromSeconds(0.9)));
+  ASSERT_TRUE(hung.streamStatus());
+  EXPECT_DOUBLE_EQ(toSeconds(hung.streamStatus()->stamp), 0.9);
+  EXPECT_FALSE(hang->records()[0].first_effect);
+  clock.advanceTo(TimePoint(fromSeconds(1.5)));
+  EXPECT_DOUBLE_EQ(toSeconds(hung.streamStatus()->stamp), 0.9) << "no frame since the fault";
+  ASSERT_TRUE(hang->records()[0].first_effect);
+  EXPECT_DOUBLE_EQ(toSeconds(*hang->records()[0].first_effect), 1.5);
+
+  SimClock clock2;
+  GoodCamera good2(clock2);
+  auto broken = injector({"empty-frame:camera@op=1", "nan-frame:camera@op=1", "throw:camera@op=2"}, clock2);
+  camera::RgbdCamera& camera = broken->wrap(good2);
+  EXPECT_EQ(camera.streamStatus()->valid, 48u) << "no frame taken yet: op=1 is not due";
+  camera.capture();  // the first frame: empty and NaN from here on; the throw counts 1 frame
+  EXPECT_EQ(camera.streamStatus()->points, 0u);
+  EXPECT_EQ(camera.streamStatus()->valid, 0u);
+  EXPECT_THROW(camera.capture(), std::runtime_error);
+  EXPECT_THROW(camera.streamStatus(), std::runtime_error);
+}
+
 component::OperationResult runToEnd(component::Component& component) {
   const component::OperationId id = component.start("Work", {});
   for (int i = 0; i < 10; ++i) {

@@ -341,5 +341,82 @@ TEST(PerceptionComponent, RefusesACorruptSvmOrAnUnknownClassNamingTheFile) {
   std::filesystem::remove_all(dir);
 }
 
+/// A camera whose stream's status the test sets (its frames are BlindCamera's).
+class StreamingCamera final : public camera::RgbdCamera {
+ public:
+  std::string name() const override { return "streaming"; }
+  const camera::Intrinsics& intrinsics() const override { return frames_.intrinsics(); }
+  Duration framePeriod() const override { return frames_.framePeriod(); }
+  camera::RgbdFrame capture() override { return frames_.capture(); }
+  std::optional<camera::StreamStatus> streamStatus() override {
+    if (unreachable) {
+      throw std::runtime_error("USB device disconnected");
+    }
+    return status;
+  }
+  std::optional<camera::StreamStatus> status;
+  bool unreachable = false;
+
+ private:
+  BlindCamera frames_;
+};
+
+/// The report's exception (what stops the cell), or "" when it did not throw.
+std::string reportError(const PerceptionComponent& component) {
+  try {
+    component.report();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(PerceptionComponent, WatchesTheCameraBetweenDetections) {
+  SimClock clock;
+  StreamingCamera camera;
+  PerceptionConfig config;
+  config.frames = 2;
+  PerceptionComponent component(camera, clock, config);
+  EXPECT_EQ(reportError(component), "") << "a camera that cannot tell is judged by its frames only";
+  clock.advanceTo(TimePoint(fromSeconds(5.0)));
+  camera.status = camera::StreamStatus{TimePoint(fromSeconds(4.9)), 3072, 3000};
+  EXPECT_EQ(reportError(component), "");
+  // The stream stopped: its newest frame grows old.
+  clock.advanceTo(TimePoint(fromSeconds(5.1)));
+  EXPECT_EQ(reportError(component), "");  // 0.2 s: the limit
+  clock.advanceTo(TimePoint(fromSeconds(5.2)));
+  EXPECT_EQ(reportError(component), "the camera stopped sending frames: the newest is 0.300 s old (limit 0.200 s)");
+  camera.status->stamp = clock.now();
+  camera.status->valid = 0;
+  EXPECT_NE(reportError(component).find("without any valid depth"), std::string::npos);
+  camera.status->points = 0;
+  EXPECT_EQ(reportError(component), "the camera sends empty frames (no pixels)");
+  camera.unreachable = true;
+  EXPECT_EQ(reportError(component), "the camera's stream failed: USB device disconnected");
+  // Healthy again: the report is the component's.
+  camera.unreachable = false;
+  camera.status = camera::StreamStatus{clock.now(), 3072, 3072};
+  EXPECT_EQ(reportError(component), "");
+  EXPECT_EQ(component.report().symbols.size(), 2u) << "the two classes";
+
+  // Not watched when asked not to.
+  PerceptionConfig unwatched = config;
+  unwatched.camera_max_age = Duration::zero();
+  PerceptionComponent blind_eye(camera, clock, unwatched);
+  camera.status->points = 0;
+  EXPECT_EQ(reportError(blind_eye), "");
+}
+
+TEST_F(PerceptionComponentTest, TheSimulatedCameraStreamsBetweenDetections) {
+  ASSERT_EQ(detect().state, OperationState::kSuccess);
+  clock_.advanceBy(std::chrono::seconds(3));
+  const std::optional<camera::StreamStatus> status = camera_->streamStatus();
+  ASSERT_TRUE(status);
+  EXPECT_EQ(status->stamp, clock_.now()) << "rendered on demand, the simulated stream never stalls";
+  EXPECT_EQ(status->points, 640u * 480u);
+  EXPECT_GT(status->valid, status->points / 2) << "the last frame's valid depth";
+  EXPECT_EQ(reportError(*component_), "");
+}
+
 }  // namespace
 }  // namespace costar::perception
