@@ -35,9 +35,9 @@ class MemoryHttpServer {
 
   /// One connection: the client sends `input` and closes its side; the server reads it in
   /// pieces of at most `read_size` bytes (0: as much as it asks for), as TCP may cut it
-  /// anywhere. Every handler that is ready runs on this thread until none is; after each one,
-  /// while a WebSocket client is connected, the stream's broadcaster runs once (as its timer
-  /// would), so snapshots interleave with answers.
+  /// anywhere. Every handler that is ready runs on this thread until none is; after every
+  /// 16th, while a WebSocket client is connected, the stream's broadcaster runs once (as its
+  /// timer would), so snapshots interleave with answers.
   Exchange exchange(std::string_view input, std::size_t read_size = 0);
 
   /// WebSocket clients connected now (0 between exchanges unless one never ended).
