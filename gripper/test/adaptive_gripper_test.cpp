@@ -272,6 +272,14 @@ TEST(ParallelGripperModesTest, TheTwoFingerGripperRefusesEveryModeButPinch) {
   }
   const auto id = gripper.start("PinchMode", {});
   EXPECT_EQ(gripper.poll(id).state, OperationState::kSuccess);
+  // SetMode, the 3-finger gripper's way, answers the same.
+  const auto pinch = gripper.start("SetMode", {{"mode", std::string("pinch")}});
+  EXPECT_EQ(gripper.poll(pinch).state, OperationState::kSuccess);
+  const auto wide = gripper.start("SetMode", {{"mode", std::string("wide")}});
+  const OperationResult refused = gripper.poll(wide);
+  EXPECT_EQ(refused.state, OperationState::kFailure);
+  EXPECT_NE(refused.reason.find("SetMode(wide): mode not supported by this gripper"), std::string::npos)
+      << refused.reason;
 }
 
 }  // namespace
