@@ -140,7 +140,7 @@ def read_description(path):
 
     act = reader.get(root, "actuation", "", "object")
     g["actuation"] = {}
-    for key in ("lever_m", "closed_deg", "min_force_n", "max_force_n", "servo_gain_nm_rad", "max_speed_deg_s", "scissor_speed_deg_s",
+    for key in ("lever_m", "closed_deg", "min_force_n", "max_force_n", "servo_gain_nm_rad", "scissor_speed_deg_s",
                 "scissor_gain_nm_rad", "scissor_max_torque_nm"):
         g["actuation"][key] = reader.get(act, key, "actuation", "number", positive=True)
     for key in ("scissor_lower_deg", "scissor_upper_deg"):

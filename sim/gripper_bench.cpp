@@ -369,7 +369,8 @@ GripperTrialResult runGripperTrial(const GripperTrialOptions& options) {
   // The flange turned 180 degrees about x, then by the yaw: R = Rz(yaw) Rx(pi), whose x column
   // is (cos yaw, sin yaw, 0).
   const Eigen::Vector3d x = flange.linear().col(0);
-  const double yaw = std::atan2(x.y(), x.x());
+  const double yaw = std::atan2(x.y(), x.x()) + options.approach_error.z();
+  flange.translation() += Eigen::Vector3d(options.approach_error.x(), options.approach_error.y(), 0.0);
   const Eigen::Vector3d above = flange.translation() + Eigen::Vector3d(0, 0, 0.08);
   if (!moveAndWait(*bench, clock, above, yaw, 0.3) || !moveAndWait(*bench, clock, flange.translation(), yaw, 0.1)) {
     return fail("the carrier did not reach the grasp");

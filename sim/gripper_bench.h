@@ -87,8 +87,11 @@ struct GripperTrialOptions {
   /// The grasp: the gripper's tool centre point in the part's frame (a taught grasp T,
   /// smartmove::GraspLibrary for this gripper). The flange goes to part * T * tcp^-1.
   world::Pose tcp_in_part = world::Pose::Identity();
-  double force = 40.0;  // N per finger
-  double lift = 0.05;   // m
+  /// Where the gripper goes wrong, as a perception error would put it: the grasp moved by
+  /// (x, y) in the world (m) and turned by `yaw` (rad) about the vertical.
+  Eigen::Vector3d approach_error = Eigen::Vector3d::Zero();  // x, y, yaw
+  double force = 40.0;                                       // N per finger
+  double lift = 0.05;                                        // m
   double hold_seconds = 2.0;
 };
 

@@ -65,7 +65,7 @@ class GenerateGripper(unittest.TestCase):
         force = [float(x) for x in servos["robotiq3f_finger_1"].get("forcerange").split()]
         self.assertAlmostEqual(force[1], 60 * 0.07)  # max_force_n x lever_m
         closed = float(servos["robotiq3f_finger_1"].get("ctrlrange").split()[1])
-        self.assertAlmostEqual(closed, math.radians(120))  # closed_deg
+        self.assertAlmostEqual(closed, math.radians(110))  # closed_deg
         equalities = [e.get("name") for e in sections.find("equality")]
         self.assertEqual(equalities[0], "robotiq3f_finger_2_scissor_coupling")
         # For fingertip modes, per finger: the medial and distal phalanges straight; off until a

@@ -66,6 +66,22 @@ INSTANTIATE_TEST_SUITE_P(ModesAndParts, AdaptiveGripperPickTest,
                            return test.param.part + "_" + std::string(gripper::toString(test.param.mode));
                          });
 
+TEST(AdaptiveGripperGraspsTest, EachModesGraspPutsThePartNearTheModesGraspCentre) {
+  const smartmove::GraspLibrary grasps(dataRoot() / "data/grasps.json", {}, smartmove::kAdaptiveGripper);
+  const auto description =
+      gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile(smartmove::kAdaptiveGripper));
+  for (const std::string part : {"node", "link"}) {
+    for (const GripperMode mode : gripper::kGripperModes) {
+      const auto grasp = grasps.find(part, std::string(gripper::toString(mode)));
+      ASSERT_TRUE(grasp) << part << " " << gripper::toString(mode);
+      // The part's origin in the flange frame: tcp * T^-1 applied to the origin.
+      const Eigen::Vector3d in_flange = description.tcp + grasp->tcp_in_object.inverse().translation();
+      EXPECT_LT((in_flange - description.mode(mode).grasp_centre).norm(), 0.008)
+          << part << " " << gripper::toString(mode) << ": " << in_flange.transpose();
+    }
+  }
+}
+
 TEST(AdaptiveGripperBenchTest, ClosingOnNothingClosesFullyAndTouchesNoPart) {
   GripperBenchOptions options;
   options.part_x = 0.3;  // far from the gripper
