@@ -28,6 +28,7 @@ import sys
 
 FORMAT = "costar-gripper-description/1"
 PHALANGES = ("proximal", "medial", "distal")
+FINGERS = ("finger_middle", "finger_1", "finger_2")
 
 
 class DescriptionError(Exception):
@@ -113,6 +114,11 @@ def read_description(path):
         fingers.append(entry)
     if len(fingers) != 3:
         reader.fail("fingers", f"a 3-finger gripper needs 3 fingers, not {len(fingers)}")
+    # The driver (gripper/adaptive_gripper_driver.h) knows the fingers by these names, in this order.
+    if [f["name"] for f in fingers] != list(FINGERS):
+        reader.fail("fingers", f"must be {', '.join(FINGERS)}, in this order")
+    if fingers[0]["scissor_sign"] != 0:
+        reader.fail("fingers[0].scissor_sign", "must be 0: finger_middle does not turn on the scissor axis")
     if not any(f["scissor_sign"] != 0 for f in fingers):
         reader.fail("fingers", "no finger turns on the scissor axis (scissor_sign 0 everywhere)")
     g["fingers"] = fingers

@@ -96,6 +96,8 @@ class GenerateGripper(unittest.TestCase):
         self.expect_error(setter(["fingers", 1, "scissor_sign"], 2), "fingers[1].scissor_sign: must be -1, 0")
         self.expect_error(setter(["fingers", 2, "name"], "finger_1"), 'fingers[2].name: "finger_1" appears twice')
         self.expect_error(lambda d: d["fingers"].pop(), "fingers: a 3-finger gripper needs 3 fingers, not 2")
+        self.expect_error(setter(["fingers", 0, "name"], "thumb"), "fingers: must be finger_middle, finger_1, finger_2")
+        self.expect_error(setter(["fingers", 0, "scissor_sign"], 1), "fingers[0].scissor_sign: must be 0")
         self.expect_error(setter(["phalanges", 0, "length"], -0.05), "phalanges[0].length: must be positive")
         self.expect_error(setter(["phalanges", 1, "lower_deg"], 10), "phalanges[1]: the straight finger")
         self.expect_error(setter(["modes", 3, "scissor_deg"], 120), "modes[3].scissor_deg: must be within")
