@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "core/files.h"
 #include "core/image.h"
 #include "core/paths.h"
 #include "perception/aruco_marker.h"
@@ -141,6 +142,11 @@ struct EvalOptions {
 int evaluate(const EvalOptions& options) {
   try {
     const trials::PerceptionEvalOptions& eval = options.eval;
+    // Refused now rather than after the evaluation's minutes.
+    if (const fs::path folder = fs::absolute(options.json).parent_path();
+        !options.json.empty() && !fs::is_directory(folder)) {
+      throw std::runtime_error("cannot write --json " + options.json + ": no folder " + folder.string());
+    }
     std::printf(
         "eval: %d random cluttered scene(s), seed %llu, %d frames per DetectObjects, %d repeat(s), %d push(es)\n",
         eval.scenes, static_cast<unsigned long long>(eval.seed), eval.frames, eval.repeats, eval.pushes);
@@ -156,7 +162,7 @@ int evaluate(const EvalOptions& options) {
         });
     std::fputs(summary.text().c_str(), stdout);
     if (!options.json.empty()) {
-      std::ofstream(options.json) << summary.toJson().dump(2) << "\n";
+      writeFileAtomically(options.json, summary.toJson().dump(2) + "\n");
       std::printf("\nwrote %s\n", options.json.c_str());
     }
     if (!eval.pictures.empty()) {
