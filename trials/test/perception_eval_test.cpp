@@ -3,6 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+
+#include "perception/training_data.h"
+#include "perception/workspace.h"
+#include "trials/perception_collect.h"
 
 #include "core/paths.h"
 
@@ -142,6 +147,45 @@ TEST(PerceptionEval, DetectInASceneFileFindsItsPartsAndDrawsThem) {
   EXPECT_GT(found.milliseconds, 0.0);
   EXPECT_GT(found.picture.width, 0);
   EXPECT_THROW(detectInScene(dataRoot() / "sim/scenes/no_such_scene.json", 1, 5), std::runtime_error);
+}
+
+// Collection, small: one placement per class, one of clutter, 2 frames each.
+TEST(PerceptionCollect, ASmallCollectionLabelsEveryClassAndFindsTheWorkspaceCentre) {
+  const auto folder = std::filesystem::temp_directory_path() / "costar_perception_collect_test";
+  std::filesystem::remove_all(folder);
+  CollectOptions options;
+  options.out = folder;
+  options.scenes_per_class = 1;
+  options.parts_per_scene = 2;
+  options.arm_scenes = 0;
+  options.clutter_scenes = 1;
+  options.frames = 2;
+  std::vector<CollectProgress> events;
+  const CollectResult result =
+      collectTrainingData(options, [&events](const CollectProgress& event) { events.push_back(event); });
+  // Steps 1-3 announced, then 3 placements (node, link, clutter), counted to their total.
+  ASSERT_EQ(events.size(), 6u);
+  EXPECT_EQ(events[0].step, 1);
+  EXPECT_TRUE(events[0].scene.empty());
+  EXPECT_EQ(events.back().done, 3);
+  EXPECT_EQ(events.back().total, 3);
+  EXPECT_EQ(events.back().scene, "clutter scene 1");
+  // The marker lies at the table's centre (x 0.5 m, y 0) on the table top.
+  EXPECT_NEAR(result.table_center.translation().x(), 0.5, 0.003);
+  EXPECT_NEAR(result.table_center.translation().y(), 0.0, 0.003);
+  EXPECT_NEAR(result.table_center.translation().z(), 0.0, 0.003);
+  // The file keeps 0.01 mm and 0.001 degrees.
+  const world::Pose saved = perception::loadTableCenter(result.workspace_file);
+  EXPECT_LT((saved.translation() - result.table_center.translation()).norm(), 1e-4);
+  EXPECT_LT(Eigen::AngleAxisd(saved.linear().transpose() * result.table_center.linear()).angle(), 1e-4);
+  // Every class labelled, the clutter as background; the files read back as written.
+  const perception::TrainingSet set = perception::loadTrainingSet(folder);
+  EXPECT_EQ(static_cast<long>(set.labels.size()), result.rows);
+  for (const auto& [label, name] : result.names) {
+    EXPECT_GT(result.voxels.at(label), 50) << name;
+  }
+  EXPECT_EQ(result.names.at(0), "background");
+  std::filesystem::remove_all(folder);
 }
 
 }  // namespace
