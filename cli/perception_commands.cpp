@@ -143,9 +143,10 @@ int evaluate(const EvalOptions& options) {
   try {
     const trials::PerceptionEvalOptions& eval = options.eval;
     // Refused now rather than after the evaluation's minutes.
-    if (const fs::path folder = fs::absolute(options.json).parent_path();
-        !options.json.empty() && !fs::is_directory(folder)) {
-      throw std::runtime_error("cannot write --json " + options.json + ": no folder " + folder.string());
+    if (!options.json.empty()) {
+      if (const fs::path folder = fs::absolute(options.json).parent_path(); !fs::is_directory(folder)) {
+        throw std::runtime_error("cannot write --json " + options.json + ": no folder " + folder.string());
+      }
     }
     std::printf(
         "eval: %d random cluttered scene(s), seed %llu, %d frames per DetectObjects, %d repeat(s), %d push(es)\n",
