@@ -219,7 +219,7 @@ void GlRenderer::render(const mjModel* model, mjData* data, int camera_id, int w
   const bool colour = rgb != nullptr;
   // The shadow pass (the scene drawn again from the key light into a 2048 x 2048 map, and a
   // shadow lookup per lit pixel) only in pictures for people: a camera frame's colour is
-  // lit without it (2/3 of its render CPU on llvmpipe).
+  // lit without it (about 60 % of its render CPU on llvmpipe).
   scene_.flags[mjRND_SHADOW] = colour && depth == nullptr ? 1 : 0;
   scene_.flags[mjRND_REFLECTION] = colour ? 1 : 0;
   scene_.flags[mjRND_SKYBOX] = colour ? 1 : 0;
