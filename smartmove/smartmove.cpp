@@ -42,13 +42,22 @@ class Script final : public RunningOperation {
   Script(std::vector<Step> steps, nlohmann::json data, std::function<void(bool)> on_end)
       : steps_(std::move(steps)), data_(std::move(data)), on_end_(std::move(on_end)) {}
 
+  /// When a step from `from` to `to` fails, `backing_off` steps run before the failure is
+  /// reported (e.g. the tool lifted clear of a part it missed), their outcome added to it.
+  void backOff(std::size_t from, std::size_t to, std::vector<Step> backing_off, std::string done_note) {
+    back_off_from_ = from;
+    back_off_to_ = to;
+    back_off_ = std::move(backing_off);
+    back_off_note_ = std::move(done_note);
+  }
+
   OperationResult poll() override {
     while (next_ < steps_.size() || current_) {
       if (!current_) {
         try {
           current_ = steps_[next_].start();
         } catch (const std::exception& e) {
-          return finish(OperationResult::failure(steps_[next_].what + ": " + e.what(), data_));
+          return fail(steps_[next_].what + ": " + e.what());
         }
       }
       OperationResult result = current_->poll();
@@ -58,11 +67,11 @@ class Script final : public RunningOperation {
       current_.reset();
       const Step& step = steps_[next_++];
       if (result.state == OperationState::kFailure) {
-        return finish(OperationResult::failure(step.what + ": " + result.reason, data_));
+        return fail(step.what + ": " + result.reason);
       }
       if (step.check) {
         if (const std::string problem = step.check(result); !problem.empty()) {
-          return finish(OperationResult::failure(step.what + ": " + problem, data_));
+          return fail(step.what + ": " + problem);
         }
       }
     }
@@ -81,7 +90,26 @@ class Script final : public RunningOperation {
   }
 
  private:
+  /// Steps that run once the script has failed (backing off), then the failure.
+  OperationResult fail(std::string reason) {
+    const std::size_t failed_step = next_ - 1;  // poll() has moved past it
+    if (!failure_ && next_ > 0 && failed_step >= back_off_from_ && failed_step <= back_off_to_ && !back_off_.empty()) {
+      failure_ = std::move(reason);
+      steps_ = std::move(back_off_);
+      back_off_.clear();
+      next_ = 0;
+      return poll();
+    }
+    if (failure_) {  // backing off failed too: both reasons
+      return finish(OperationResult::failure(*failure_ + "; backing off, " + reason, data_));
+    }
+    return finish(OperationResult::failure(std::move(reason), data_));
+  }
+
   OperationResult finish(OperationResult result) {
+    if (failure_ && result.state == OperationState::kSuccess) {
+      result = OperationResult::failure(*failure_ + " (" + back_off_note_ + ")", data_);
+    }
     if (on_end_) {
       on_end_(result.state == OperationState::kSuccess);
       on_end_ = nullptr;
@@ -94,6 +122,11 @@ class Script final : public RunningOperation {
   std::unique_ptr<RunningOperation> current_;
   nlohmann::json data_;
   std::function<void(bool)> on_end_;
+  std::size_t back_off_from_ = 0;
+  std::size_t back_off_to_ = 0;
+  std::vector<Step> back_off_;
+  std::string back_off_note_;
+  std::optional<std::string> failure_;
 };
 
 std::unique_ptr<RunningOperation> failed(std::string reason, nlohmann::json data = {}) {
@@ -660,8 +693,26 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
                      [this](const OperationResult&) -> std::string {
                        return world_.holds("gripper_holding", {}) || !held_ ? std::string() : "the part slipped out";
                      }});
-    return std::make_unique<Script>(std::move(steps), data,
-                                    [this, object](bool) { allowGripperContact(object, false); });
+    // A grasp that fails once the tool went down (it closed on nothing, or on the part's top
+    // because the part moved) opens and lifts straight up before it reports the failure, so
+    // that the tool is clear of where the part was seen and a plan that looks again can go on
+    // (from down there every motion would start in collision with the part as it was seen).
+    const std::size_t approach_step = 2;
+    const std::size_t close_step = 3;
+    auto script =
+        std::make_unique<Script>(std::move(steps), data, [this, object](bool) { allowGripperContact(object, false); });
+    script->backOff(
+        approach_step, close_step,
+        {{"open the gripper",
+          [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); }, nullptr},
+         {"lift clear",
+          [this] {
+            return arm_.execute(arm_.planLine(up(config_.retreat) * arm_.endpoint(), config_.approach_speed),
+                                "back off");
+          },
+          nullptr}},
+        "the tool backed off up");
+    return script;
   }
 
   if (operation == "SmartRelease") {
