@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "sim/simulation.h"
+#include "smartmove/footprint.h"
 
 namespace costar::trials {
 
@@ -37,46 +38,6 @@ const world::ObjectClass* classOf(const sim::Simulation& simulation, const std::
     }
   }
   return nullptr;
-}
-
-/// The corners of a part's bounding box, in the world's x and y.
-std::vector<Eigen::Vector2d> footprint(const world::ObjectClass& object_class, const world::Pose& pose) {
-  const Eigen::AlignedBox3d box = object_class.bounds();
-  std::vector<Eigen::Vector2d> corners;
-  for (int i = 0; i < 8; ++i) {
-    corners.push_back((pose * box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(i))).head<2>());
-  }
-  return corners;
-}
-
-/// The gap between two footprints along the axes their boxes' sides give (separating axes):
-/// negative when they overlap.
-double footprintGap(const std::vector<Eigen::Vector2d>& a, const world::Pose& pose_a,
-                    const std::vector<Eigen::Vector2d>& b, const world::Pose& pose_b) {
-  std::vector<Eigen::Vector2d> axes;
-  for (const world::Pose* pose : {&pose_a, &pose_b}) {
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector2d axis = pose->linear().col(k).head<2>();
-      if (axis.norm() > 1e-6) {
-        axes.push_back(axis.normalized());
-        axes.emplace_back(-axis.y() / axis.norm(), axis.x() / axis.norm());
-      }
-    }
-  }
-  double gap = -std::numeric_limits<double>::infinity();
-  for (const Eigen::Vector2d& axis : axes) {
-    double a_min = 1e9, a_max = -1e9, b_min = 1e9, b_max = -1e9;
-    for (const auto& p : a) {
-      a_min = std::min(a_min, axis.dot(p));
-      a_max = std::max(a_max, axis.dot(p));
-    }
-    for (const auto& p : b) {
-      b_min = std::min(b_min, axis.dot(p));
-      b_max = std::max(b_max, axis.dot(p));
-    }
-    gap = std::max(gap, std::max(b_min - a_max, a_min - b_max));
-  }
-  return gap;
 }
 
 }  // namespace
@@ -199,13 +160,12 @@ void Disturber::nudge(sim::Simulation& simulation, Pending& pending, const std::
     moved.translation() += Eigen::Vector3d(d * std::cos(angle), d * std::sin(angle), 0.0);
     bool clear = true;
     if (object_class != nullptr) {
-      const auto corners = footprint(*object_class, moved);
       for (const sim::PartState& other : parts) {
         const world::ObjectClass* other_class = classOf(simulation, other.object_class);
         if (other.name == name || other_class == nullptr || other.pose.translation().z() > 0.2) {
           continue;
         }
-        if (footprintGap(corners, moved, footprint(*other_class, other.pose), other.pose) < kNudgeGap) {
+        if (smartmove::footprintGap(*object_class, moved, *other_class, other.pose) < kNudgeGap) {
           clear = false;
           break;
         }
