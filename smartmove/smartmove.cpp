@@ -721,9 +721,25 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
         {{"open the gripper",
           [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); }, nullptr},
          {"lift clear",
-          [this] {
-            return arm_.execute(arm_.planLine(up(config_.retreat) * arm_.endpoint(), config_.approach_speed),
-                                "back off");
+          [this, object] {
+            // Straight up from wherever the miss left the fingers, even beside a neighbour (a
+            // part moved or caught by the fingers): up is away from every part on the table.
+            std::vector<std::string> beside;
+            for (const std::string& obstacle : obstacles_) {
+              if (obstacle != partObstacle(object)) {
+                beside.push_back(obstacle);
+                for (const auto& link : config_.gripper_links) {
+                  collisions_.allow(link, obstacle);
+                }
+              }
+            }
+            arm::MotionPlan lift = arm_.planLine(up(config_.retreat) * arm_.endpoint(), config_.approach_speed);
+            for (const std::string& obstacle : beside) {
+              for (const auto& link : config_.gripper_links) {
+                collisions_.disallow(link, obstacle);
+              }
+            }
+            return arm_.execute(std::move(lift), "back off");
           },
           nullptr}},
         "the tool backed off up");
