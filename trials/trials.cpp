@@ -51,13 +51,12 @@ std::vector<DisturbanceSpec> parseDisturbances(const std::vector<std::string>& t
 /// The workcell of trial `index` (seed options.seed + index), fresh.
 std::unique_ptr<workcell::Workcell> trialWorkcell(const TrialOptions& options, int index) {
   const std::uint64_t seed = options.seed + static_cast<std::uint64_t>(index);
-  workcell::WorkcellOptions cell_options{
-      .name = "ur5-sim",
-      .scene = options.scene,
-      .seed = seed,
-      .waypoints = options.waypoints,
-      .memory_only = true,
-      .faults = nullptr};
+  workcell::WorkcellOptions cell_options{.name = "ur5-sim",
+                                         .scene = options.scene,
+                                         .seed = seed,
+                                         .waypoints = options.waypoints,
+                                         .memory_only = true,
+                                         .faults = nullptr};
   // The faults asked for, and those the trial's disturbances need (drawn from the same seed as
   // the Disturber that runOne makes).
   std::vector<std::string> inject = options.inject;
