@@ -102,14 +102,21 @@ class FaultyCamera final : public camera::RgbdCamera {
   Duration framePeriod() const override { return inner_.framePeriod(); }
 
   camera::RgbdFrame capture() override {
-    if (!injector_.active(fault_, true)) {
+    FaultRecord& record = injector_.record(fault_);
+    if (!injector_.active(fault_, true) || (record.spec.kind == FaultKind::kDropFrame && record.spent)) {
       last_ = inner_.capture();
       newest_ = std::max(newest_, last_.stamp);
       return last_;
     }
     injector_.effect(fault_);
-    const FaultRecord& record = injector_.record(fault_);
     switch (record.spec.kind) {
+      case FaultKind::kDropFrame: {  // one frame lost on the way, then the stream goes on
+        record.spent = true;
+        camera::RgbdFrame frame = inner_.capture();
+        frame.points.clear();
+        frame.rgb = RgbImage();
+        return frame;
+      }
       case FaultKind::kThrow:
         throw std::runtime_error("camera: capturing a frame failed" + injected(record));
       case FaultKind::kHang:
@@ -129,10 +136,11 @@ class FaultyCamera final : public camera::RgbdCamera {
     }
   }
 
-  /// Not counted for op=N (the frames are). A camera that cannot tell stays silent.
+  /// Not counted for op=N (the frames are). A camera that cannot tell stays silent; one frame
+  /// lost on the way (drop-frame) does not stop the stream.
   std::optional<camera::StreamStatus> streamStatus() override {
     std::optional<camera::StreamStatus> status = inner_.streamStatus();
-    if (!status || !injector_.active(fault_, false)) {
+    if (!status || !injector_.active(fault_, false) || injector_.record(fault_).spec.kind == FaultKind::kDropFrame) {
       if (status) {
         newest_ = std::max(newest_, status->stamp);
       }
