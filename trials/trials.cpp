@@ -34,7 +34,7 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
   const auto wall_start = std::chrono::steady_clock::now();
   try {
     workcell::WorkcellOptions cell_options{
-        .name = "ur5-sim",
+        .name = options.workcell,
         .scene = options.scene,
         .seed = result.seed,
         .waypoints = options.waypoints,
@@ -169,7 +169,7 @@ Summary runTrials(const TrialOptions& options, const std::function<void(const Tr
   {
     // Validate once, before any trial, against the workcell the trials use (the faults too).
     const auto cell = workcell::makeWorkcell(
-        {.name = "ur5-sim",
+        {.name = options.workcell,
          .scene = options.scene,
          .seed = options.seed,
          .waypoints = options.waypoints,
@@ -251,6 +251,7 @@ std::map<std::string, double> Summary::cycleTimes() const {
 nlohmann::json Summary::toJson() const {
   nlohmann::json json;
   json["plan"] = options.plan.string();
+  json["workcell"] = options.workcell;
   json["scene"] = options.scene.string();
   json["judge"] = options.judge;
   json["trials"] = trials.size();
@@ -308,6 +309,7 @@ Summary Summary::fromJson(const nlohmann::json& json) {
   Summary summary;
   const std::string where = "trial results";
   summary.options.plan = field<std::string>(json, "plan", where);
+  summary.options.workcell = json.value("workcell", summary.options.workcell);
   summary.options.scene = field<std::string>(json, "scene", where);
   summary.options.judge = field<std::string>(json, "judge", where);
   summary.options.seed = field<std::uint64_t>(json, "seed", where);
@@ -362,6 +364,7 @@ Summary mergeShards(const std::vector<Summary>& shards) {
       }
     };
     differs("plan", first.plan.string(), options.plan.string());
+    differs("workcell", first.workcell, options.workcell);
     differs("scene", first.scene.string(), options.scene.string());
     differs("judge", first.judge, options.judge);
     differs("first seed", std::to_string(first.seed), std::to_string(options.seed));

@@ -1,7 +1,8 @@
 // makeWorkcell: the light cells from costar_workcell_base, the robot cells from here.
 
 #include "faults/injector.h"
-#include "workcell/ur5_sim_workcell.h"
+#include "workcell/sim_cell_description.h"
+#include "workcell/sim_workcell.h"
 #include "workcell/workcell.h"
 
 namespace costar::workcell {
@@ -28,7 +29,8 @@ std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& given) {
   if (auto cell = makeLightWorkcell(light)) {
     return cell;
   }
-  return makeUr5SimWorkcell(options);  // the one robot cell makeLightWorkcell knows by name
+  // A robot cell makeLightWorkcell knows by name: a simulated cell of workcells/NAME.json.
+  return makeSimWorkcell(loadSimCellDescription(simCellFile(options.name)), options);
 }
 
 }  // namespace costar::workcell
