@@ -1,6 +1,9 @@
 // makeWorkcell: the light cells from costar_workcell_base, the robot cells from here.
 
+#include <stdexcept>
+
 #include "faults/injector.h"
+#include "workcell/grippers.h"
 #include "workcell/sim_cell_description.h"
 #include "workcell/sim_workcell.h"
 #include "workcell/workcell.h"
@@ -30,7 +33,13 @@ std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& given) {
     return cell;
   }
   // A robot cell makeLightWorkcell knows by name: a simulated cell of workcells/NAME.json.
-  return makeSimWorkcell(loadSimCellDescription(simCellFile(options.name)), options);
+  const SimCellDescription cell = loadSimCellDescription(simCellFile(options.name));
+  try {
+    gripperModel(cell.gripper);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("workcell description '" + cell.file.string() + "': gripper: " + e.what());
+  }
+  return makeSimWorkcell(cell, options);
 }
 
 }  // namespace costar::workcell
