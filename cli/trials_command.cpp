@@ -196,7 +196,9 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
       "trials", "Rerun a plan as N randomized trials in the simulated cell, judged from its true state");
   command->add_option("plan", options->trials.plan, "plan file (required unless merging)")->check(CLI::ExistingFile);
   command->add_option("--judge", options->trials.judge, "how success is judged (see below; required)");
-  command->add_option("--scene", options->trials.scene, "scene file (default sim/scenes/assembly.json)")
+  command->add_option("-w,--workcell", options->trials.workcell, "simulated workcell the trials run in")
+      ->capture_default_str();
+  command->add_option("--scene", options->trials.scene, "scene file (default: the workcell's)")
       ->check(CLI::ExistingFile);
   command->add_option("-n,--n", options->trials.count, "number of trials")
       ->check(CLI::Range(1, 100000))

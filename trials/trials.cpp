@@ -51,7 +51,7 @@ std::vector<DisturbanceSpec> parseDisturbances(const std::vector<std::string>& t
 /// The workcell of trial `index` (seed options.seed + index), fresh.
 std::unique_ptr<workcell::Workcell> trialWorkcell(const TrialOptions& options, int index) {
   const std::uint64_t seed = options.seed + static_cast<std::uint64_t>(index);
-  workcell::WorkcellOptions cell_options{.name = "ur5-sim",
+  workcell::WorkcellOptions cell_options{.name = options.workcell,
                                          .scene = options.scene,
                                          .seed = seed,
                                          .waypoints = options.waypoints,
@@ -227,7 +227,7 @@ Summary runTrials(const TrialOptions& options, const std::function<void(const Tr
   summary.options = options;
   summary.trials.resize(indices.size());
   // Slot 0 is this thread's, in first_cell: a workcell shares the perception pipeline of the
-  // thread that built it (workcell/ur5_sim_workcell.cpp), so it must run on that thread.
+  // thread that built it (workcell/sim_workcell.cpp), so it must run on that thread.
   std::atomic<std::size_t> next{1};
   int done = 0;
   std::mutex mutex;
@@ -309,6 +309,7 @@ double Summary::residentGrowthPercent() const {
 nlohmann::json Summary::toJson() const {
   nlohmann::json json;
   json["plan"] = options.plan.string();
+  json["workcell"] = options.workcell;
   json["scene"] = options.scene.string();
   json["judge"] = options.judge;
   json["trials"] = trials.size();
@@ -376,6 +377,7 @@ Summary Summary::fromJson(const nlohmann::json& json) {
   Summary summary;
   const std::string where = "trial results";
   summary.options.plan = field<std::string>(json, "plan", where);
+  summary.options.workcell = json.value("workcell", summary.options.workcell);
   summary.options.scene = field<std::string>(json, "scene", where);
   summary.options.judge = field<std::string>(json, "judge", where);
   summary.options.seed = field<std::uint64_t>(json, "seed", where);
@@ -437,6 +439,7 @@ Summary mergeShards(const std::vector<Summary>& shards) {
       }
     };
     differs("plan", first.plan.string(), options.plan.string());
+    differs("workcell", first.workcell, options.workcell);
     differs("scene", first.scene.string(), options.scene.string());
     differs("judge", first.judge, options.judge);
     differs("first seed", std::to_string(first.seed), std::to_string(options.seed));

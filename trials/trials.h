@@ -17,6 +17,8 @@ namespace costar::trials {
 
 struct TrialOptions {
   std::filesystem::path plan;
+  /// The simulated workcell the trials run in (workcells/NAME.json).
+  std::string workcell = "ur5-sim";
   std::filesystem::path scene;
   std::string judge;
   int count = 10;
