@@ -47,8 +47,15 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
     const auto cell = workcell::makeWorkcell(cell_options);
     sim::Simulation& simulation = *cell->simulation();
     if (options.calibrate) {
+      const std::vector<sim::PartState> before = simulation.parts();
       const component::OperationResult calibrated =
           workcell::runOperation(*cell, "Calibrate", {}, std::chrono::seconds(120));
+      double moved = 0.0;
+      const std::vector<sim::PartState> after = simulation.parts();
+      for (std::size_t i = 0; i < before.size() && i < after.size(); ++i) {
+        moved = std::max(moved, (after[i].pose.translation() - before[i].pose.translation()).norm());
+      }
+      result.calibrate_moved_part_m = moved;
       if (calibrated.state != component::OperationState::kSuccess) {
         result.failure_path = "Calibrate";
         result.reason = calibrated.reason;
@@ -273,6 +280,9 @@ nlohmann::json Summary::toJson() const {
                            {"success", trial.success},
                            {"cycle_time_s", trial.cycle_time_s},
                            {"wall_s", trial.wall_s}};
+    if (trial.calibrate_moved_part_m) {
+      item["calibrate_moved_part_mm"] = std::round(*trial.calibrate_moved_part_m * 1e4) / 10.0;
+    }
     if (!trial.success) {
       item["failure_path"] = trial.failure_path;
       item["reason"] = trial.reason;
@@ -333,6 +343,9 @@ Summary Summary::fromJson(const nlohmann::json& json) {
     trial.success = field<bool>(item, "success", at);
     trial.cycle_time_s = field<double>(item, "cycle_time_s", at);
     trial.wall_s = item.value("wall_s", 0.0);
+    if (item.contains("calibrate_moved_part_mm") && item["calibrate_moved_part_mm"].is_number()) {
+      trial.calibrate_moved_part_m = item["calibrate_moved_part_mm"].get<double>() / 1000.0;
+    }
     if (!trial.success) {
       trial.failure_path = field<std::string>(item, "failure_path", at);
       trial.reason = field<std::string>(item, "reason", at);

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,9 @@ struct TrialResult {
   std::string reason;
   double cycle_time_s = 0.0;  // simulated
   double wall_s = 0.0;
+  /// With --calibrate: the farthest any part moved while Calibrate ran (m; the arm knows no
+  /// part before the camera is calibrated, so this is how much it disturbed the table).
+  std::optional<double> calibrate_moved_part_m;
 };
 
 struct Summary {
