@@ -79,7 +79,8 @@ void BM_CaptureDepthFrame(benchmark::State& state) {
 BENCHMARK(BM_CaptureDepthFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_CaptureDepthFrame)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
 
-/// The render alone: colour only, no depth read-back, no noise.
+/// The render alone as a picture for people takes it: colour only (with the shadow pass, which
+/// camera frames leave out), no depth read-back, no noise.
 void BM_RenderColourOnly(benchmark::State& state) {
   const auto simulation = assembly();
   simulation->renderImage("rgbd", 640, 480);

@@ -35,8 +35,11 @@ class GlRenderer {
   /// Renders camera `camera_id` at width x height (at most the model's offscreen size).
   /// `rgb`, if given, receives the colour image; `depth`, if given, metric depth along the
   /// optical axis, row-major, top row first. The image rows are top first too. Without `rgb`
-  /// only depth is rendered (flat, no shadows: faster, the same depth). Not for two threads at
-  /// once on one renderer.
+  /// only depth is rendered (flat, no shadows: faster, the same depth). Shadows are cast only
+  /// in a colour picture without depth (a view for people): a camera frame (colour and depth)
+  /// is lit without them, which takes 60 % of a colour frame's render CPU off and leaves
+  /// DetectObjects' results as they were (docs/BENCHMARKS.md, issue 13). Not for two threads
+  /// at once on one renderer.
   void render(const mjModel* model, mjData* data, int camera_id, int width, int height, RgbImage* rgb,
               std::vector<float>* depth);
 

@@ -310,19 +310,14 @@ Scene loadScene(const std::filesystem::path& file) {
   return parseScene(text.str(), file.string());
 }
 
-namespace {
+Footprint Footprint::of(const world::ObjectClass& object, double x, double y, double yaw) {
+  const Eigen::AlignedBox3d bounds = object.bounds();
+  const Eigen::Vector2d offset = bounds.center().head<2>();  // of the box centre from the part's origin
+  return {Eigen::Vector2d(x, y) + Eigen::Rotation2Dd(yaw) * offset, 0.5 * bounds.sizes().head<2>(), yaw};
+}
 
-/// A part's footprint on the table: the rectangle of its bounding box, turned by its yaw.
-struct Footprint {
-  Eigen::Vector2d centre;
-  Eigen::Vector2d half_size;  // along the part's own x and y
-  double yaw = 0.0;
+Eigen::Matrix2d Footprint::axes() const { return Eigen::Rotation2Dd(yaw).toRotationMatrix(); }
 
-  Eigen::Matrix2d axes() const { return Eigen::Rotation2Dd(yaw).toRotationMatrix(); }
-};
-
-/// True when the two rectangles, each grown by `gap` / 2 on every side, overlap (separating
-/// axis test over the four edge normals).
 bool closerThan(const Footprint& a, const Footprint& b, double gap) {
   const Eigen::Matrix2d axes_a = a.axes();
   const Eigen::Matrix2d axes_b = b.axes();
@@ -343,8 +338,6 @@ bool closerThan(const Footprint& a, const Footprint& b, double gap) {
   }
   return true;
 }
-
-}  // namespace
 
 std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<world::ObjectClass>& classes,
                                       std::optional<std::uint64_t> seed) {
@@ -370,9 +363,6 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
     const PartRequest& request = scene.parts[r];
     const std::string field = "parts[" + std::to_string(r) + "]";
     const world::ObjectClass& object = findClass(request.object_class, field);
-    const Eigen::AlignedBox3d bounds = object.bounds();
-    const Eigen::Vector2d half_size = 0.5 * bounds.sizes().head<2>();
-    const Eigen::Vector2d offset = bounds.center().head<2>();  // of the box centre from the part's origin
     for (int i = 0; i < request.count; ++i) {
       PartPlacement part;
       part.object_class = object.name;
@@ -400,7 +390,7 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
           xy = region->second.min +
                (region->second.max - region->second.min).cwiseProduct(Eigen::Vector2d(unit(random), unit(random)));
           yaw = 2.0 * M_PI * unit(random);
-          const Footprint candidate{xy + Eigen::Rotation2Dd(yaw) * offset, half_size, yaw};
+          const Footprint candidate = Footprint::of(object, xy.x(), xy.y(), yaw);
           fits = std::none_of(footprints.begin(), footprints.end(),
                               [&](const Footprint& other) { return closerThan(candidate, other, scene.min_gap); });
         }
@@ -411,12 +401,93 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
                                    "min_gap)");
         }
       }
-      footprints.push_back({xy + Eigen::Rotation2Dd(yaw) * offset, half_size, yaw});
+      footprints.push_back(Footprint::of(object, xy.x(), xy.y(), yaw));
       part.pose = world::poseFromXyzRpy(xy.x(), xy.y(), object.rest_height + 0.0005, 0, 0, yaw);
       placed.push_back(std::move(part));
     }
   }
   return placed;
+}
+
+ClutteredScene clutteredScene(const std::vector<world::ObjectClass>& classes,
+                              const std::vector<std::pair<std::string, int>>& counts, double touching,
+                              std::mt19937_64& random, const std::string& label, double gap) {
+  const auto findClass = [&classes](const std::string& name) -> const world::ObjectClass& {
+    for (const auto& object : classes) {
+      if (object.name == name) {
+        return object;
+      }
+    }
+    throw std::runtime_error("unknown object class '" + name + "'");
+  };
+  const Region table = defaultRegions().at("table");
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  ClutteredScene out;
+  out.scene.label = label;
+  out.scene.regions = defaultRegions();
+  out.scene.min_gap = 0.0;
+  std::vector<Footprint> placed;
+  std::vector<std::string> order;
+  for (const auto& [name, count] : counts) {
+    order.insert(order.end(), static_cast<std::size_t>(std::max(count, 0)), name);
+  }
+  std::shuffle(order.begin(), order.end(), random);
+  for (const std::string& name : order) {
+    const world::ObjectClass& object = findClass(name);
+    for (int attempt = 0; attempt < 400; ++attempt) {
+      Footprint candidate;
+      Eigen::Vector2d origin;
+      bool touches = false;
+      if (!placed.empty() && unit(random) < touching && attempt < 200) {
+        // Against a side of an earlier part, turned like it give or take 12 degrees.
+        const Footprint& other = placed[static_cast<std::size_t>(unit(random) * placed.size()) % placed.size()];
+        const double quarter = unit(random) < 0.5 ? 0.0 : M_PI / 2;  // draws one at a time, in this order
+        const double yaw = other.yaw + quarter + (unit(random) - 0.5) * 0.42;
+        candidate = Footprint::of(object, 0, 0, yaw);
+        const double side_angle = other.yaw + std::floor(unit(random) * 4.0) * M_PI / 2;
+        const Eigen::Vector2d normal(std::cos(side_angle), std::sin(side_angle));
+        const Eigen::Vector2d tangent(-normal.y(), normal.x());
+        const auto support = [&normal](const Footprint& f) {
+          const Eigen::Matrix2d axes = f.axes();
+          return f.half_size.x() * std::abs(axes.col(0).dot(normal)) +
+                 f.half_size.y() * std::abs(axes.col(1).dot(normal));
+        };
+        const double side_half =
+            std::abs(other.axes().col(0).dot(tangent)) > 0.5 ? other.half_size.x() : other.half_size.y();
+        const double slide = (unit(random) - 0.5) * 1.2 * side_half;
+        // The footprint's centre there; the part's origin lies off it by the bounds' offset.
+        const Eigen::Vector2d centre =
+            other.centre + normal * (support(other) + support(candidate) + 0.001) + tangent * slide;
+        origin = centre - Eigen::Rotation2Dd(yaw) * object.bounds().center().head<2>();
+        candidate = Footprint::of(object, origin.x(), origin.y(), yaw);
+        touches = true;
+      } else {
+        // Drawn one at a time: the order of a constructor's arguments is the compiler's.
+        const double x = unit(random);
+        const double y = unit(random);
+        const double yaw = 2 * M_PI * unit(random);
+        origin = table.min + (table.max - table.min).cwiseProduct(Eigen::Vector2d(x, y));
+        candidate = Footprint::of(object, origin.x(), origin.y(), yaw);
+      }
+      if ((candidate.centre.array() < table.min.array()).any() ||
+          (candidate.centre.array() > table.max.array()).any()) {
+        continue;
+      }
+      // Touching parts may meet their neighbour (0.4 mm into it: the test's rounding), nothing else.
+      if (std::any_of(placed.begin(), placed.end(),
+                      [&](const Footprint& other) { return closerThan(candidate, other, touches ? -0.0004 : gap); })) {
+        continue;
+      }
+      placed.push_back(candidate);
+      PartRequest request;
+      request.object_class = name;
+      request.at = Eigen::Vector3d(origin.x(), origin.y(), candidate.yaw * 180.0 / M_PI);
+      out.scene.parts.push_back(request);
+      out.touching_parts += touches ? 1 : 0;
+      break;
+    }
+  }
+  return out;
 }
 
 }  // namespace costar::sim

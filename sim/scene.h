@@ -17,7 +17,9 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -103,5 +105,34 @@ struct PartPlacement {
 /// not fit.
 std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<world::ObjectClass>& classes,
                                       std::optional<std::uint64_t> seed = std::nullopt);
+
+/// A part's footprint on the table: the rectangle of its bounding box, turned by its yaw.
+struct Footprint {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  Eigen::Vector2d half_size = Eigen::Vector2d::Zero();  // along the part's own x and y
+  double yaw = 0.0;
+
+  /// The footprint of a part of `object` whose origin lies at (x, y), turned by `yaw` (rad).
+  static Footprint of(const world::ObjectClass& object, double x, double y, double yaw);
+  Eigen::Matrix2d axes() const;
+};
+
+/// True when the two rectangles, each grown by `gap` / 2 on every side, overlap (separating
+/// axis test over the four edge normals). A negative gap lets them overlap by that much.
+bool closerThan(const Footprint& a, const Footprint& b, double gap);
+
+/// A cluttered scene of fixed placements (the perception evaluation's): `counts` parts per
+/// class in random order, each uniformly in the "table" region with any yaw and `gap` or more
+/// from every other part, or, with probability `touching`, against a side of a part already
+/// placed (turned like it give or take 12 degrees, slid along that side, 1 mm apart before the
+/// physics settles them). Draws from `random`; parts that find no place in 400 tries are left
+/// out. @throws std::runtime_error for an unknown class.
+struct ClutteredScene {
+  Scene scene;  // every part placed with "at"
+  int touching_parts = 0;
+};
+ClutteredScene clutteredScene(const std::vector<world::ObjectClass>& classes,
+                              const std::vector<std::pair<std::string, int>>& counts, double touching,
+                              std::mt19937_64& random, const std::string& label, double gap = 0.01);
 
 }  // namespace costar::sim

@@ -27,24 +27,32 @@ namespace costar::trials {
 
 namespace {
 
-TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judge& judge, int index) {
+/// The workcell of trial `index` (seed options.seed + index), fresh.
+std::unique_ptr<workcell::Workcell> trialWorkcell(const TrialOptions& options, int index) {
+  const std::uint64_t seed = options.seed + static_cast<std::uint64_t>(index);
+  workcell::WorkcellOptions cell_options{
+      .name = "ur5-sim",
+      .scene = options.scene,
+      .seed = seed,
+      .waypoints = options.waypoints,
+      .memory_only = true,
+      .faults = options.inject.empty() ? nullptr : faults::Injector::fromText(options.inject, seed)};
+  if (options.camera_move_m > 0 || options.camera_turn_deg > 0) {
+    cell_options.camera_move =
+        workcell::WorkcellOptions::CameraMove{options.camera_move_m, options.camera_turn_deg, {}};
+  }
+  return workcell::makeWorkcell(cell_options);
+}
+
+/// Runs trial `index` in `built` (its fresh workcell, built by trialWorkcell) or in one it builds.
+TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judge& judge, int index,
+                   std::unique_ptr<workcell::Workcell> built = nullptr) {
   TrialResult result;
   result.index = index;
   result.seed = options.seed + static_cast<std::uint64_t>(index);
   const auto wall_start = std::chrono::steady_clock::now();
   try {
-    workcell::WorkcellOptions cell_options{
-        .name = "ur5-sim",
-        .scene = options.scene,
-        .seed = result.seed,
-        .waypoints = options.waypoints,
-        .memory_only = true,
-        .faults = options.inject.empty() ? nullptr : faults::Injector::fromText(options.inject, result.seed)};
-    if (options.camera_move_m > 0 || options.camera_turn_deg > 0) {
-      cell_options.camera_move =
-          workcell::WorkcellOptions::CameraMove{options.camera_move_m, options.camera_turn_deg, {}};
-    }
-    const auto cell = workcell::makeWorkcell(cell_options);
+    const auto cell = built ? std::move(built) : trialWorkcell(options, index);
     sim::Simulation& simulation = *cell->simulation();
     if (options.calibrate) {
       const std::vector<sim::PartState> before = simulation.parts();
@@ -173,33 +181,30 @@ Summary runTrials(const TrialOptions& options, const std::function<void(const Tr
   checkOptions(options);
   const Judge judge = trials::judge(options.judge);
   const bt::Plan plan = bt::loadPlan(options.plan);
-  {
-    // Validate once, before any trial, against the workcell the trials use (the faults too).
-    const auto cell = workcell::makeWorkcell(
-        {.name = "ur5-sim",
-         .scene = options.scene,
-         .seed = options.seed,
-         .waypoints = options.waypoints,
-         .memory_only = true,
-         .faults = options.inject.empty() ? nullptr : faults::Injector::fromText(options.inject, options.seed)});
-    if (auto diagnostics = bt::validatePlan(plan, cell->nodes()); !diagnostics.empty()) {
-      throw bt::PlanError(std::move(diagnostics));
-    }
-  }
   // This shard's trials: every shard_count-th index, so that slices take about as long.
   std::vector<int> indices;
   for (int index = options.shard_index; index < options.count; index += options.shard_count) {
     indices.push_back(index);
   }
+  // Validate once, before any trial, against the workcell the trials use (the faults too):
+  // the first trial's, which that trial then runs in (a workcell load saved per run; nothing
+  // has ticked in it: validation only reads the node models).
+  std::unique_ptr<workcell::Workcell> first_cell =
+      trialWorkcell(options, indices.empty() ? options.shard_index : indices.front());
+  if (auto diagnostics = bt::validatePlan(plan, first_cell->nodes()); !diagnostics.empty()) {
+    throw bt::PlanError(std::move(diagnostics));
+  }
   Summary summary;
   summary.options = options;
   summary.trials.resize(indices.size());
-  std::atomic<std::size_t> next{0};
+  // Slot 0 is this thread's, in first_cell: a workcell shares the perception pipeline of the
+  // thread that built it (workcell/ur5_sim_workcell.cpp), so it must run on that thread.
+  std::atomic<std::size_t> next{1};
   int done = 0;
   std::mutex mutex;
-  const auto worker = [&] {
-    for (std::size_t slot = next++; slot < indices.size(); slot = next++) {
-      TrialResult result = runOne(options, plan, judge, indices[slot]);
+  const auto worker = [&](std::size_t first_slot) {
+    for (std::size_t slot = first_slot; slot < indices.size(); slot = next++) {
+      TrialResult result = runOne(options, plan, judge, indices[slot], slot == 0 ? std::move(first_cell) : nullptr);
       std::lock_guard lock(mutex);
       summary.trials[slot] = result;
       ++done;
@@ -210,9 +215,9 @@ Summary runTrials(const TrialOptions& options, const std::function<void(const Tr
   };
   std::vector<std::thread> threads;
   for (int j = 1; j < std::max(1, options.jobs); ++j) {
-    threads.emplace_back(worker);
+    threads.emplace_back([&worker, &next] { worker(next++); });
   }
-  worker();
+  worker(0);
   for (auto& thread : threads) {
     thread.join();
   }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <random>
 
 #include "core/paths.h"
 
@@ -113,6 +114,90 @@ TEST(Scene, CrowdedPartsKeepTheGapBetweenTheirFootprintsNotTheirBoundingCircles)
   }
   // Crowded indeed: some pair is closer than a finger is thick.
   EXPECT_LT(closest, 0.02);
+}
+
+TEST(Scene, FootprintsCloserThanAGapAreFoundWhateverTheirTurn) {
+  const auto all = classes();
+  const world::ObjectClass& link =
+      *std::find_if(all.begin(), all.end(), [](const auto& c) { return c.name == "link"; });
+  // Two links side by side along y, 25 mm wide: 5 mm apart at 30 mm between centres.
+  const Footprint a = Footprint::of(link, 0.5, 0.0, 0.0);
+  EXPECT_TRUE(closerThan(a, Footprint::of(link, 0.5, 0.030, 0.0), 0.006));
+  EXPECT_FALSE(closerThan(a, Footprint::of(link, 0.5, 0.030, 0.0), 0.004));
+  // Touching (0 mm apart) counts as overlapping only with a gap above 0; a negative gap allows that much overlap.
+  EXPECT_FALSE(closerThan(a, Footprint::of(link, 0.5, 0.0245, 0.0), -0.001));
+  EXPECT_TRUE(closerThan(a, Footprint::of(link, 0.5, 0.0245, 0.0), 0.0));
+  // Crossed at right angles: the other reaches 75 mm from its centre, this one 12.5 mm.
+  EXPECT_TRUE(closerThan(a, Footprint::of(link, 0.5, 0.085, M_PI / 2), 0.0));
+  EXPECT_FALSE(closerThan(a, Footprint::of(link, 0.5, 0.089, M_PI / 2), 0.001));  // 1.5 mm apart
+  EXPECT_TRUE(closerThan(a, Footprint::of(link, 0.5, 0.089, M_PI / 2), 0.002));
+  // A node turned 45 degrees, a corner 2 mm from the link's end: grown by 1.5 mm, the corner
+  // reaches 2.1 mm further along its diagonal.
+  const world::ObjectClass& node =
+      *std::find_if(all.begin(), all.end(), [](const auto& c) { return c.name == "node"; });
+  const Footprint turned = Footprint::of(node, 0.5 + 0.075 + 0.025 * std::sqrt(2.0) + 0.002, 0.0, M_PI / 4);
+  EXPECT_FALSE(closerThan(a, turned, 0.001));
+  EXPECT_TRUE(closerThan(a, turned, 0.003));
+}
+
+/// Placements of a cluttered scene (every part fixed with "at").
+std::vector<PartPlacement> placed(const ClutteredScene& cluttered) { return placeParts(cluttered.scene, classes()); }
+
+TEST(Scene, ClutteredScenesAreDeterministicOnTheTableAndApartOrTouching) {
+  const auto all = classes();
+  const auto find = [&](const std::string& name) {
+    return *std::find_if(all.begin(), all.end(), [&](const world::ObjectClass& c) { return c.name == name; });
+  };
+  const std::vector<std::pair<std::string, int>> counts = {{"node", 5}, {"link", 3}};
+  const auto nearest = [&](const std::vector<PartPlacement>& parts, std::size_t i) {
+    double closest = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < parts.size(); ++j) {
+      if (j != i) {
+        closest = std::min(closest, polygonDistance(corners(parts[i], find(parts[i].object_class)),
+                                                    corners(parts[j], find(parts[j].object_class))));
+      }
+    }
+    return closest;
+  };
+  for (const std::uint64_t seed : {1u, 2u, 3u}) {
+    // Apart: every part 1 cm or more from every other, on the table, as many as asked.
+    std::mt19937_64 random(seed);
+    const ClutteredScene apart = clutteredScene(all, counts, 0.0, random, "apart");
+    EXPECT_EQ(apart.touching_parts, 0);
+    const auto parts = placed(apart);
+    ASSERT_EQ(parts.size(), 8u);
+    const Region table = defaultRegions().at("table");
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      const Eigen::Vector2d xy = parts[i].pose.translation().head<2>();
+      EXPECT_TRUE((xy.array() >= table.min.array()).all() && (xy.array() <= table.max.array()).all());
+      EXPECT_GE(nearest(parts, i), 0.01 - 1e-9) << "seed " << seed << ", " << parts[i].name;
+    }
+    // The same seed, the same scene; the stream goes on from where the scene left it.
+    std::mt19937_64 again(seed);
+    const auto same = placed(clutteredScene(all, counts, 0.0, again, "apart"));
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      EXPECT_TRUE(parts[i].pose.isApprox(same[i].pose, 0.0)) << parts[i].name;
+    }
+    EXPECT_EQ(random(), again());
+
+    // Touching: most parts against a side of another, 1 mm from it along that side's normal
+    // (a part turned up to 12 degrees off its neighbour, or slid past the end of a shorter
+    // side, is a few mm from it elsewhere), so nearer to it than the 1 cm between the others.
+    std::mt19937_64 touching_random(seed);
+    const ClutteredScene touching = clutteredScene(all, counts, 1.0, touching_random, "touching");
+    EXPECT_GE(touching.touching_parts, 4) << "seed " << seed;
+    const auto touching_parts = placed(touching);
+    int near = 0;
+    for (std::size_t i = 0; i < touching_parts.size(); ++i) {
+      near += nearest(touching_parts, i) < 0.009 ? 1 : 0;
+    }
+    EXPECT_GE(near, touching.touching_parts) << "seed " << seed;
+    // Differs from the scene with parts apart.
+    EXPECT_FALSE(touching_parts[0].pose.isApprox(parts[0].pose, 1e-6) &&
+                 touching_parts[1].pose.isApprox(parts[1].pose, 1e-6));
+  }
+  std::mt19937_64 random(1);
+  EXPECT_THROW(clutteredScene(all, {{"widget", 1}}, 0.0, random, "bad"), std::runtime_error);
 }
 
 TEST(Scene, ProblemsAreNamed) {

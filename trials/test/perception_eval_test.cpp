@@ -1,0 +1,192 @@
+#include "trials/perception_eval.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "perception/training_data.h"
+#include "perception/workspace.h"
+#include "trials/perception_collect.h"
+
+#include "core/paths.h"
+
+namespace costar::trials {
+namespace {
+
+const std::vector<world::ObjectClass>& classes() {
+  static const std::vector<world::ObjectClass> loaded = world::loadObjectClasses(dataRoot() / "data/objects");
+  return loaded;
+}
+
+world::Pose at(double x, double y, double yaw_deg = 0.0) {
+  return world::poseFromXyzRpy(x, y, 0.025, 0, 0, yaw_deg * M_PI / 180.0);
+}
+
+TruePart part(const std::string& name, const std::string& object_class, const world::Pose& pose, double visible = 1.0) {
+  return {name, object_class, pose, visible};
+}
+
+DetectedPart detection(const std::string& name, const std::string& object_class, const world::Pose& pose) {
+  return {name, object_class, pose, 0.9};
+}
+
+TEST(PerceptionEval, MatchingTakesTheClosestPairsFirstWithinTheirClass) {
+  const std::vector<TruePart> truth = {part("node_0", "node", at(0.50, 0.00)), part("node_1", "node", at(0.53, 0.00)),
+                                       part("link_0", "link", at(0.40, 0.20))};
+  const std::vector<DetectedPart> detected = {
+      detection("a", "node", at(0.515, 0.0)),        // 15 mm from both nodes; node_1 is taken by
+      detection("b", "node", at(0.529, 0.0)),        // b, 1 mm from it, first
+      detection("c", "link", at(0.50, 0.0)),         // a link where a node is: no match
+      detection("d", "link", at(0.402, 0.20, 93))};  // 2 mm, 3 degrees off
+  const Match match = matchToTruth(detected, truth, classes());
+  EXPECT_EQ(match.detection_of_part, (std::vector<int>{0, 1, 3}));
+  EXPECT_EQ(match.part_of_detection, (std::vector<int>{0, 1, -1, 2}));
+  EXPECT_NEAR(match.translation_error[0], 0.015, 1e-9);
+  EXPECT_NEAR(match.translation_error[1], 0.001, 1e-9);
+  EXPECT_FALSE(match.accurate(0));  // 15 mm off
+  EXPECT_TRUE(match.accurate(1));
+  // A link (symmetric under 180 degrees about z and 90 about its long axis x) turned 93
+  // degrees about z is 87 degrees from the nearest of its symmetric poses.
+  EXPECT_NEAR(match.rotation_error[2] * 180.0 / M_PI, 87.0, 1e-6);
+  EXPECT_FALSE(match.accurate(2));
+
+  // A node is symmetric under 90 degrees about z: 92 degrees is 2 off.
+  const Match turned = matchToTruth({detection("e", "node", at(0.5, 0.0, 92))}, {truth[0]}, classes());
+  EXPECT_NEAR(turned.rotation_error[0] * 180.0 / M_PI, 2.0, 1e-6);
+  EXPECT_TRUE(turned.accurate(0));
+
+  // 2.5 cm or more apart: no match.
+  const Match far = matchToTruth({detection("f", "node", at(0.5, 0.026))}, {truth[0]}, classes());
+  EXPECT_EQ(far.detection_of_part[0], -1);
+  EXPECT_THROW(matchToTruth({detection("g", "widget", at(0.5, 0))}, {part("w", "widget", at(0.5, 0))}, classes()),
+               std::runtime_error);
+}
+
+TEST(PerceptionEval, ScoresCountVisiblePartsFalseDetectionsAndNameTheProblems) {
+  const std::vector<TruePart> truth = {part("node_0", "node", at(0.50, 0.00)), part("node_1", "node", at(0.60, 0.00)),
+                                       part("node_2", "node", at(0.60, 0.10), 0.1),  // mostly hidden
+                                       part("link_0", "link", at(0.40, 0.20))};
+  const std::vector<DetectedPart> detected = {detection("node_7", "node", at(0.501, 0.0)),
+                                              detection("node_8", "node", at(0.608, 0.0)),  // 8 mm off
+                                              detection("node_9", "node", at(0.30, -0.3))};
+  Scores scores;
+  scores.add(detected, truth, matchToTruth(detected, truth, classes()), "scene 1");
+  const ClassScore& nodes = scores.classes.at("node");
+  EXPECT_EQ(nodes.visible, 2);
+  EXPECT_EQ(nodes.visible_found, 2);
+  EXPECT_EQ(nodes.visible_accurate, 1);
+  EXPECT_EQ(nodes.detections, 3);
+  EXPECT_EQ(nodes.false_positives, 1);
+  EXPECT_NEAR(nodes.precision(), 2.0 / 3.0, 1e-12);
+  EXPECT_EQ(scores.classes.at("link").visible, 1);
+  EXPECT_EQ(scores.classes.at("link").recall(), 0.0);
+  EXPECT_EQ(scores.hidden_part_views, 1);
+  EXPECT_EQ(scores.visiblePartViews(), 3);
+  EXPECT_NEAR(scores.foundWithinTolerance(), 1.0 / 3.0, 1e-12);
+  ASSERT_EQ(scores.problems.size(), 3u);
+  EXPECT_NE(scores.problems[0].find("scene 1: node_1 (node) found with 8.0 mm"), std::string::npos)
+      << scores.problems[0];
+  EXPECT_NE(scores.problems[1].find("scene 1: missed link_0"), std::string::npos) << scores.problems[1];
+  EXPECT_NE(scores.problems[2].find("false detection node_9"), std::string::npos) << scores.problems[2];
+}
+
+TEST(PerceptionEval, PercentilesInterpolate) {
+  EXPECT_EQ(percentile({}, 50), 0.0);
+  EXPECT_EQ(percentile({3, 1, 2}, 50), 2.0);
+  EXPECT_DOUBLE_EQ(percentile({0, 10}, 95), 9.5);
+  EXPECT_EQ(percentile({4, 1, 9}, 100), 9.0);
+}
+
+// The whole loop on the simulated cell, small: one scene, one repeat, one push, 5 frames.
+TEST(PerceptionEval, ASmallEvaluationScoresEveryRoundAndKeepsItsCountsConsistent) {
+  PerceptionEvalOptions options;
+  options.scenes = 1;
+  options.seed = 3;
+  options.repeats = 1;
+  options.pushes = 1;
+  options.frames = 5;
+  int reports = 0;
+  SceneReport last;
+  const PerceptionEvalSummary summary = evaluatePerception(options, [&](const SceneReport& report) {
+    ++reports;
+    last = report;
+  });
+  EXPECT_EQ(reports, 1);
+  EXPECT_EQ(last.scene, 1);
+  EXPECT_GE(last.parts, 4);  // 3-6 nodes and 1-3 links
+  EXPECT_LE(last.parts, 9);
+  EXPECT_EQ(summary.parts, last.parts);
+  // Three rounds scored (first look, repeat, push): every part view counted once per round.
+  EXPECT_EQ(summary.latency_ms.at("total").size(), 3u);
+  EXPECT_EQ(summary.scores.visiblePartViews() + summary.scores.hidden_part_views, 3 * last.parts);
+  EXPECT_EQ(summary.repeat_checks, last.name_checks);
+  EXPECT_GE(summary.scores.foundWithinTolerance(), 0.9);
+  EXPECT_GE(last.accurate_first_look, last.parts - 1);
+  EXPECT_EQ(summary.pushed_part_checks, 1);
+  const nlohmann::json json = summary.toJson();
+  EXPECT_EQ(json.at("parts"), last.parts);
+  EXPECT_EQ(json.at("persistence").at("still_name_checks"), summary.repeat_checks);
+  EXPECT_NE(summary.text().find("latency per DetectObjects (3 runs"), std::string::npos);
+
+  // The same seed, the same scores (scenes, noise and pushes are drawn from it).
+  const PerceptionEvalSummary again = evaluatePerception(options);
+  EXPECT_EQ(again.toJson().at("classes"), json.at("classes"));
+  EXPECT_EQ(again.scores.problems, summary.scores.problems);
+}
+
+TEST(PerceptionEval, DetectInASceneFileFindsItsPartsAndDrawsThem) {
+  const SceneDetection found = detectInScene(dataRoot() / "sim/scenes/assembly.json", 7, 5);
+  ASSERT_EQ(found.truth.size(), 5u);
+  int accurate = 0;
+  for (std::size_t p = 0; p < found.truth.size(); ++p) {
+    accurate += found.match.accurate(p) ? 1 : 0;
+  }
+  EXPECT_EQ(accurate, 5);
+  EXPECT_EQ(found.detected.size(), 5u);
+  EXPECT_GT(found.milliseconds, 0.0);
+  EXPECT_GT(found.picture.width, 0);
+  EXPECT_THROW(detectInScene(dataRoot() / "sim/scenes/no_such_scene.json", 1, 5), std::runtime_error);
+}
+
+// Collection, small: one placement per class, one of clutter, 2 frames each.
+TEST(PerceptionCollect, ASmallCollectionLabelsEveryClassAndFindsTheWorkspaceCentre) {
+  const auto folder = std::filesystem::temp_directory_path() / "costar_perception_collect_test";
+  std::filesystem::remove_all(folder);
+  CollectOptions options;
+  options.out = folder;
+  options.scenes_per_class = 1;
+  options.parts_per_scene = 2;
+  options.arm_scenes = 0;
+  options.clutter_scenes = 1;
+  options.frames = 2;
+  std::vector<CollectProgress> events;
+  const CollectResult result =
+      collectTrainingData(options, [&events](const CollectProgress& event) { events.push_back(event); });
+  // Steps 1-3 announced, then 3 placements (node, link, clutter), counted to their total.
+  ASSERT_EQ(events.size(), 6u);
+  EXPECT_EQ(events[0].step, 1);
+  EXPECT_TRUE(events[0].scene.empty());
+  EXPECT_EQ(events.back().done, 3);
+  EXPECT_EQ(events.back().total, 3);
+  EXPECT_EQ(events.back().scene, "clutter scene 1");
+  // The marker lies at the table's centre (x 0.5 m, y 0) on the table top.
+  EXPECT_NEAR(result.table_center.translation().x(), 0.5, 0.003);
+  EXPECT_NEAR(result.table_center.translation().y(), 0.0, 0.003);
+  EXPECT_NEAR(result.table_center.translation().z(), 0.0, 0.003);
+  // The file keeps 0.01 mm and 0.001 degrees.
+  const world::Pose saved = perception::loadTableCenter(result.workspace_file);
+  EXPECT_LT((saved.translation() - result.table_center.translation()).norm(), 1e-4);
+  EXPECT_LT(Eigen::AngleAxisd(saved.linear().transpose() * result.table_center.linear()).angle(), 1e-4);
+  // Every class labelled, the clutter as background; the files read back as written.
+  const perception::TrainingSet set = perception::loadTrainingSet(folder);
+  EXPECT_EQ(static_cast<long>(set.labels.size()), result.rows);
+  for (const auto& [label, name] : result.names) {
+    EXPECT_GT(result.voxels.at(label), 50) << name;
+  }
+  EXPECT_EQ(result.names.at(0), "background");
+  std::filesystem::remove_all(folder);
+}
+
+}  // namespace
+}  // namespace costar::trials
