@@ -119,8 +119,8 @@ TEST_F(PerceptionComponentTest, DetectsThePartsAndReportsThemAsSymbols) {
 // Each part's colour as DetectObjects sees it (the mean of its points in the colour image)
 // against its material in the simulator: near it, and nearer to it than to the class's other
 // colours. The image is lit (ambient, head light, key and fill lights), so the seen colour is
-// brighter than the material on the lit faces and darker in shade (measured: red node 0.81,
-// 0.11, 0.11 for 0.8, 0.1, 0.1; blue 0.11, 0.27, 0.80 for 0.1, 0.25, 0.8; wood link 0.83, 0.62,
+// brighter than the material on the lit faces and darker in shade (measured: red node 0.83,
+// 0.11, 0.11 for 0.8, 0.1, 0.1; blue 0.11, 0.28, 0.82 for 0.1, 0.25, 0.8; wood link 0.83, 0.62,
 // 0.36 for 0.72, 0.52, 0.3); the tolerance allows that.
 TEST_F(PerceptionComponentTest, ReportsEachPartsColourNearItsMaterial) {
   const component::OperationResult result = detect();
