@@ -125,12 +125,16 @@ ParallelGripper::ParallelGripper(GripperDriver& driver, const Clock& clock, Para
                     driver_.maxOpening()};
   opening.min = 0.005;
   opening.max = driver_.maxOpening();
-  description_.operations = {{"Open", "Opens the fingers fully, or as far as `opening`.", {speed, opening}},
-                             {"Close", "Closes the fingers until they stop on a part or close fully.", {speed, force}},
-                             {"BasicMode", "Selects Basic mode (3-finger grippers only).", {}},
-                             {"PinchMode", "Selects Pinch mode, the only mode of a parallel gripper.", {}},
-                             {"WideMode", "Selects Wide mode (3-finger grippers only).", {}},
-                             {"ScissorMode", "Selects Scissor mode (3-finger grippers only).", {}}};
+  ParamSpec mode{"mode", ValueType::kString, "basic, pinch, wide or scissor (only pinch here)", std::string("pinch")};
+  mode.choices = {"basic", "pinch", "wide", "scissor"};
+  description_.operations = {
+      {"Open", "Opens the fingers fully, or as far as `opening`.", {speed, opening}},
+      {"Close", "Closes the fingers until they stop on a part or close fully.", {speed, force}},
+      {"BasicMode", "Selects Basic mode (3-finger grippers only).", {}},
+      {"PinchMode", "Selects Pinch mode, the only mode of a parallel gripper.", {}},
+      {"WideMode", "Selects Wide mode (3-finger grippers only).", {}},
+      {"ScissorMode", "Selects Scissor mode (3-finger grippers only).", {}},
+      {"SetMode", "Selects a mode by name: pinch, the only mode of a parallel gripper.", {mode}}};
   description_.predicates = {{"gripper_open", 0, "the fingers are fully open"},
                              {"gripper_closed", 0, "the fingers are fully closed, nothing between them"},
                              {"gripper_holding", 0, "the fingers stopped on something and squeeze it"},
@@ -173,11 +177,12 @@ std::unique_ptr<component::RunningOperation> ParallelGripper::begin(const std::s
     return std::make_unique<FingerMotion>(*this, driver_, clock_, 0.0, params.at("speed").asDouble(),
                                           params.at("force").asDouble(), options_.timeout, true);
   }
-  if (operation == "PinchMode") {
+  if (operation == "PinchMode" || (operation == "SetMode" && params.at("mode").asString() == "pinch")) {
     return std::make_unique<component::FinishedOperation>(OperationResult::success());
   }
+  const std::string what = operation == "SetMode" ? "SetMode(" + params.at("mode").asString() + ")" : operation;
   return std::make_unique<component::FinishedOperation>(OperationResult::failure(
-      operation + ": mode not supported by this gripper (a parallel 2-finger gripper has only Pinch mode)"));
+      what + ": mode not supported by this gripper (a parallel 2-finger gripper has only Pinch mode)"));
 }
 
 }  // namespace costar::gripper

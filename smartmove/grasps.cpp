@@ -1,5 +1,6 @@
 #include "smartmove/grasps.h"
 
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -10,32 +11,41 @@ namespace costar::smartmove {
 
 namespace {
 
-void read(const std::filesystem::path& file, std::map<std::pair<std::string, std::string>, Grasp>& into) {
+using Key = std::tuple<std::string, std::string, std::string>;
+
+void read(const std::filesystem::path& file, std::map<Key, Grasp>& into) {
   std::ifstream stream(file);
   if (!stream) {
     throw std::runtime_error("cannot open grasp file '" + file.string() + "'");
   }
+  std::size_t index = 0;
   try {
     const nlohmann::json json = nlohmann::json::parse(stream);
     for (const auto& item : json.at("grasps")) {
       Grasp grasp;
+      grasp.gripper = item.contains("gripper") ? item.at("gripper").get<std::string>() : kParallelGripper;
+      if (grasp.gripper.empty()) {
+        throw std::runtime_error("\"gripper\" must not be empty");
+      }
       grasp.object_class = item.at("class").get<std::string>();
       grasp.name = item.at("name").get<std::string>();
       const auto p = item.at("position").get<std::array<double, 3>>();
       const auto rpy = item.at("rpy_degrees").get<std::array<double, 3>>();
       constexpr double kDeg = M_PI / 180.0;
       grasp.tcp_in_object = world::poseFromXyzRpy(p[0], p[1], p[2], rpy[0] * kDeg, rpy[1] * kDeg, rpy[2] * kDeg);
-      into[{grasp.object_class, grasp.name}] = grasp;
+      into[{grasp.gripper, grasp.object_class, grasp.name}] = grasp;
+      ++index;
     }
   } catch (const std::exception& e) {
-    throw std::runtime_error("grasp file '" + file.string() + "': " + e.what());
+    throw std::runtime_error("grasp file '" + file.string() + "': grasps[" + std::to_string(index) + "]: " + e.what());
   }
 }
 
 }  // namespace
 
-GraspLibrary::GraspLibrary(const std::filesystem::path& defaults_file, std::filesystem::path taught_file)
-    : taught_file_(std::move(taught_file)) {
+GraspLibrary::GraspLibrary(const std::filesystem::path& defaults_file, std::filesystem::path taught_file,
+                           std::string gripper)
+    : taught_file_(std::move(taught_file)), gripper_(std::move(gripper)) {
   read(defaults_file, defaults_);
   if (!taught_file_.empty() && std::filesystem::exists(taught_file_)) {
     read(taught_file_, taught_);
@@ -43,10 +53,10 @@ GraspLibrary::GraspLibrary(const std::filesystem::path& defaults_file, std::file
 }
 
 std::optional<Grasp> GraspLibrary::find(const std::string& object_class, const std::string& name) const {
-  if (const auto it = taught_.find({object_class, name}); it != taught_.end()) {
+  if (const auto it = taught_.find({gripper_, object_class, name}); it != taught_.end()) {
     return it->second;
   }
-  if (const auto it = defaults_.find({object_class, name}); it != defaults_.end()) {
+  if (const auto it = defaults_.find({gripper_, object_class, name}); it != defaults_.end()) {
     return it->second;
   }
   return std::nullopt;
@@ -55,8 +65,8 @@ std::optional<Grasp> GraspLibrary::find(const std::string& object_class, const s
 std::optional<Grasp> GraspLibrary::defaultFor(const std::string& object_class) const {
   for (const auto* source : {&defaults_, &taught_}) {
     for (const auto& [key, grasp] : *source) {
-      if (key.first == object_class) {
-        return find(object_class, key.second);
+      if (std::get<0>(key) == gripper_ && std::get<1>(key) == object_class) {
+        return find(object_class, std::get<2>(key));
       }
     }
   }
@@ -67,8 +77,8 @@ std::vector<Grasp> GraspLibrary::forClass(const std::string& object_class) const
   std::map<std::string, Grasp> found;
   for (const auto* source : {&defaults_, &taught_}) {
     for (const auto& [key, grasp] : *source) {
-      if (key.first == object_class) {
-        found[key.second] = grasp;
+      if (std::get<0>(key) == gripper_ && std::get<1>(key) == object_class) {
+        found[std::get<2>(key)] = grasp;
       }
     }
   }
@@ -83,16 +93,20 @@ std::vector<std::string> GraspLibrary::names() const {
   std::vector<std::string> names;
   for (const auto* source : {&defaults_, &taught_}) {
     for (const auto& [key, grasp] : *source) {
-      if (std::find(names.begin(), names.end(), key.second) == names.end()) {
-        names.push_back(key.second);
+      if (std::get<0>(key) == gripper_ && std::find(names.begin(), names.end(), std::get<2>(key)) == names.end()) {
+        names.push_back(std::get<2>(key));
       }
     }
   }
   return names;
 }
 
-void GraspLibrary::teach(const Grasp& grasp) {
-  taught_[{grasp.object_class, grasp.name}] = grasp;
+void GraspLibrary::teach(const Grasp& taught) {
+  Grasp grasp = taught;
+  if (grasp.gripper.empty()) {
+    grasp.gripper = gripper_;
+  }
+  taught_[{grasp.gripper, grasp.object_class, grasp.name}] = grasp;
   if (taught_file_.empty()) {
     return;
   }
@@ -100,10 +114,14 @@ void GraspLibrary::teach(const Grasp& grasp) {
   for (const auto& [key, g] : taught_) {
     const Eigen::Vector3d rpy = world::rpyOf(g.tcp_in_object.linear()) * (180.0 / M_PI);
     const Eigen::Vector3d& p = g.tcp_in_object.translation();
-    json["grasps"].push_back({{"class", g.object_class},
-                              {"name", g.name},
-                              {"position", {p.x(), p.y(), p.z()}},
-                              {"rpy_degrees", {rpy.x(), rpy.y(), rpy.z()}}});
+    nlohmann::json item = {{"class", g.object_class},
+                           {"name", g.name},
+                           {"position", {p.x(), p.y(), p.z()}},
+                           {"rpy_degrees", {rpy.x(), rpy.y(), rpy.z()}}};
+    if (g.gripper != kParallelGripper) {  // files of the 2-finger gripper stay as they were
+      item["gripper"] = g.gripper;
+    }
+    json["grasps"].push_back(item);
   }
   if (taught_file_.has_parent_path()) {
     std::filesystem::create_directories(taught_file_.parent_path());

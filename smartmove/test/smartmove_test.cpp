@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 
 #include "core/paths.h"
@@ -56,6 +59,66 @@ TEST(Grasps, TaughtGraspsOverrideDefaultsAndPersist) {
   EXPECT_NEAR(reloaded.find("node", "top")->tcp_in_object.translation().z(), 0.01, 1e-12);
   EXPECT_TRUE(reloaded.find("node", "side").has_value());
   EXPECT_EQ(reloaded.forClass("node").size(), 2u);
+  std::filesystem::remove(file);
+}
+
+TEST(Grasps, OneClassHasATwoFingerAndAThreeFingerGrasp) {
+  const GraspLibrary two(dataRoot() / "data/grasps.json", {});
+  const GraspLibrary three(dataRoot() / "data/grasps.json", {}, kAdaptiveGripper);
+  EXPECT_EQ(two.gripper(), kParallelGripper);
+  // The 2-finger gripper sees only its own grasps (the file's entries without "gripper").
+  ASSERT_EQ(two.forClass("node").size(), 1u);
+  EXPECT_EQ(two.defaultFor("node")->name, "top");
+  EXPECT_FALSE(two.find("node", "basic").has_value());
+  // The 3-finger gripper has one grasp per mode for the same class, and none of the 2-finger's.
+  EXPECT_EQ(three.forClass("node").size(), 4u);
+  EXPECT_EQ(three.forClass("link").size(), 4u);
+  EXPECT_FALSE(three.find("node", "top").has_value());
+  ASSERT_TRUE(three.find("link", "scissor").has_value());
+  EXPECT_EQ(three.find("link", "scissor")->gripper, kAdaptiveGripper);
+  // Scissor closes fingers 1 and 2 along the tool's x: across the link (object y), not along it.
+  const Eigen::Vector3d closing = three.find("link", "scissor")->tcp_in_object.linear().col(0);
+  EXPECT_NEAR(std::abs(closing.y()), 1.0, 1e-9);
+}
+
+TEST(Grasps, TeachingKeepsTheOtherGrippersGraspsAndOldFilesStayValid) {
+  const auto file = std::filesystem::temp_directory_path() / "costar_grasps_gripper_test.json";
+  // A taught file written before grasps had grippers: its entries are the 2-finger gripper's.
+  std::ofstream(file) << R"({"grasps": [{"class": "node", "name": "edge", "position": [0, 0, 0.01],)"
+                         R"( "rpy_degrees": [180, 0, 0]}]})";
+  {
+    GraspLibrary three(dataRoot() / "data/grasps.json", file, kAdaptiveGripper);
+    EXPECT_FALSE(three.find("node", "edge").has_value());
+    three.teach({"node", "corner", world::poseFromXyzRpy(0.01, 0, 0, M_PI, 0, 0)});
+  }
+  const GraspLibrary two(dataRoot() / "data/grasps.json", file);
+  EXPECT_TRUE(two.find("node", "edge").has_value());  // still there after the 3-finger teach
+  EXPECT_FALSE(two.find("node", "corner").has_value());
+  const GraspLibrary three(dataRoot() / "data/grasps.json", file, kAdaptiveGripper);
+  ASSERT_TRUE(three.find("node", "corner").has_value());
+  EXPECT_NEAR(three.find("node", "corner")->tcp_in_object.translation().x(), 0.01, 1e-12);
+  // The 2-finger entry is written back without a "gripper" field, as before.
+  std::ifstream in(file);
+  const nlohmann::json saved = nlohmann::json::parse(in);
+  for (const auto& item : saved.at("grasps")) {
+    EXPECT_EQ(item.contains("gripper"), item.at("name") == "corner") << item.dump();
+  }
+  std::filesystem::remove(file);
+}
+
+TEST(Grasps, ABadEntryNamesTheFileAndTheEntry) {
+  const auto file = std::filesystem::temp_directory_path() / "costar_grasps_bad_test.json";
+  std::ofstream(file)
+      << R"({"grasps": [{"class": "node", "name": "a", "position": [0, 0, 0], "rpy_degrees": [0, 0, 0]},)"
+         R"( {"gripper": "", "class": "node", "name": "b", "position": [0, 0, 0], "rpy_degrees": [0, 0, 0]}]})";
+  try {
+    GraspLibrary library(file, {});
+    ADD_FAILURE() << "accepted an empty gripper";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("costar_grasps_bad_test.json': grasps[1]: \"gripper\" must not be empty"),
+              std::string::npos)
+        << e.what();
+  }
   std::filesystem::remove(file);
 }
 

@@ -1,0 +1,167 @@
+#include "gripper/adaptive_gripper_description.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "core/paths.h"
+
+namespace costar::gripper {
+
+std::string_view toString(GripperMode mode) {
+  switch (mode) {
+    case GripperMode::kBasic:
+      return "basic";
+    case GripperMode::kPinch:
+      return "pinch";
+    case GripperMode::kWide:
+      return "wide";
+    case GripperMode::kScissor:
+      return "scissor";
+  }
+  return "unknown";
+}
+
+std::optional<GripperMode> modeFromString(std::string_view name) {
+  for (const GripperMode mode : kGripperModes) {
+    if (toString(mode) == name) {
+      return mode;
+    }
+  }
+  return std::nullopt;
+}
+
+std::filesystem::path gripperDescriptionFile(const std::string& name, const std::filesystem::path& data_root) {
+  const std::filesystem::path root = data_root.empty() ? dataRoot() : data_root;
+  return root / "robots" / "grippers" / (name + ".json");
+}
+
+namespace {
+
+/// Typed access that names the field in its errors.
+class Fields {
+ public:
+  explicit Fields(std::string label) : label_(std::move(label)) {}
+  [[noreturn]] void fail(const std::string& field, const std::string& problem) const {
+    throw std::runtime_error(label_ + ": " + field + ": " + problem);
+  }
+  const nlohmann::json& at(const nlohmann::json& object, const std::string& key, const std::string& field) const {
+    if (!object.is_object() || !object.contains(key)) {
+      fail(field.empty() ? key : field + "." + key, "missing");
+    }
+    return object.at(key);
+  }
+  double number(const nlohmann::json& object, const std::string& key, const std::string& field) const {
+    const auto& value = at(object, key, field);
+    if (!value.is_number() || !std::isfinite(value.get<double>())) {
+      fail(field.empty() ? key : field + "." + key, "must be a finite number");
+    }
+    return value.get<double>();
+  }
+  Eigen::Vector3d vec3(const nlohmann::json& object, const std::string& key, const std::string& field) const {
+    const auto& value = at(object, key, field);
+    if (!value.is_array() || value.size() != 3 ||
+        !std::all_of(value.begin(), value.end(), [](const auto& x) { return x.is_number(); })) {
+      fail(field.empty() ? key : field + "." + key, "must be 3 numbers");
+    }
+    return {value[0].get<double>(), value[1].get<double>(), value[2].get<double>()};
+  }
+
+ private:
+  std::string label_;
+};
+
+}  // namespace
+
+AdaptiveGripperDescription loadAdaptiveGripperDescription(const std::filesystem::path& file) {
+  const Fields fields("gripper description '" + file.string() + "'");
+  std::ifstream in(file);
+  if (!in) {
+    throw std::runtime_error("gripper description '" + file.string() + "': cannot open");
+  }
+  nlohmann::json root;
+  try {
+    root = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    fields.fail("(syntax)", e.what());
+  }
+  if (!root.is_object() || root.value("format", "") != "costar-gripper-description/1") {
+    fields.fail("format", "must be \"costar-gripper-description/1\"");
+  }
+  AdaptiveGripperDescription description;
+  const auto& name = fields.at(root, "name", "");
+  if (!name.is_string()) {
+    fields.fail("name", "must be a string");
+  }
+  description.name = name.get<std::string>();
+  description.tcp = fields.vec3(root, "tcp", "");
+  const auto& actuation = fields.at(root, "actuation", "");
+  description.max_force = fields.number(actuation, "max_force_n", "actuation");
+  description.lever = fields.number(actuation, "lever_m", "actuation");
+  description.min_force = fields.number(actuation, "min_force_n", "actuation");
+  if (description.min_force <= 0 || description.min_force > fields.number(actuation, "max_force_n", "actuation")) {
+    fields.fail("actuation.min_force_n", "must be positive and at most max_force_n");
+  }
+  if (description.max_force <= 0 || description.lever <= 0) {
+    fields.fail("actuation", "max_force_n and lever_m must be positive");
+  }
+  description.scissor_lower_deg = fields.number(actuation, "scissor_lower_deg", "actuation");
+  description.scissor_upper_deg = fields.number(actuation, "scissor_upper_deg", "actuation");
+  description.scissor_speed_deg_s = fields.number(actuation, "scissor_speed_deg_s", "actuation");
+  if (description.scissor_speed_deg_s <= 0) {
+    fields.fail("actuation.scissor_speed_deg_s", "must be positive");
+  }
+  const auto& modes = fields.at(root, "modes", "");
+  if (!modes.is_array()) {
+    fields.fail("modes", "must be a list");
+  }
+  for (std::size_t i = 0; i < modes.size(); ++i) {
+    const std::string field = "modes[" + std::to_string(i) + "]";
+    AdaptiveModeDescription mode;
+    const auto& mode_name = fields.at(modes[i], "name", field);
+    const auto parsed = mode_name.is_string() ? modeFromString(mode_name.get<std::string>()) : std::nullopt;
+    if (!parsed) {
+      fields.fail(field + ".name", "must be one of basic, pinch, wide, scissor");
+    }
+    if (description.modes.count(*parsed) != 0) {
+      fields.fail(field + ".name", "\"" + std::string(toString(*parsed)) + "\" appears twice");
+    }
+    mode.mode = *parsed;
+    mode.description = modes[i].value("description", "");
+    mode.scissor_deg = fields.number(modes[i], "scissor_deg", field);
+    if (mode.scissor_deg < description.scissor_lower_deg || mode.scissor_deg > description.scissor_upper_deg) {
+      fields.fail(field + ".scissor_deg", "must be within the scissor axis' limits");
+    }
+    mode.grasp_centre = fields.vec3(modes[i], "grasp_centre", field);
+    if (modes[i].contains("fingertip")) {
+      if (!modes[i]["fingertip"].is_boolean()) {
+        fields.fail(field + ".fingertip", "must be true or false");
+      }
+      mode.fingertip = modes[i]["fingertip"].get<bool>();
+    }
+    const auto& closing = fields.at(modes[i], "closing", field);
+    if (!closing.is_array() || closing.empty()) {
+      fields.fail(field + ".closing", "must be a non-empty list of fingers");
+    }
+    for (std::size_t k = 0; k < closing.size(); ++k) {
+      const auto it = closing[k].is_string()
+                          ? std::find(kFingerNames.begin(), kFingerNames.end(), closing[k].get<std::string>())
+                          : kFingerNames.end();
+      if (it == kFingerNames.end()) {
+        fields.fail(field + ".closing[" + std::to_string(k) + "]", "must be one of finger_middle, finger_1, finger_2");
+      }
+      mode.closing[static_cast<std::size_t>(it - kFingerNames.begin())] = true;
+    }
+    description.modes[mode.mode] = mode;
+  }
+  for (const GripperMode mode : kGripperModes) {
+    if (description.modes.count(mode) == 0) {
+      fields.fail("modes", "mode \"" + std::string(toString(mode)) + "\" is missing");
+    }
+  }
+  return description;
+}
+
+}  // namespace costar::gripper

@@ -1,0 +1,286 @@
+#include "gripper/adaptive_gripper.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+#include "component/abstract.h"
+#include "core/paths.h"
+#include "gripper/parallel_gripper.h"
+#include "world/world_state.h"
+
+namespace costar::gripper {
+namespace {
+
+using component::OperationResult;
+using component::OperationState;
+
+/// Three fingers that move at the commanded speed and stop where a part blocks them; a scissor
+/// axis that takes 200 ms to reach a mode.
+class FakeHand final : public AdaptiveGripperDriver {
+ public:
+  explicit FakeHand(SimClock& clock) : clock_(clock) {
+    clock_.addStepListener([this](TimePoint from, TimePoint to) { advance(toSeconds(to - from)); });
+  }
+  AdaptiveGripperReading read() const override {
+    AdaptiveGripperReading reading = reading_;
+    reading.stamp = stale ? TimePoint{} + std::chrono::milliseconds(1) : clock_.now();
+    if (broken) {
+      reading.fingers[1].position = std::nan("");
+    }
+    return reading;
+  }
+  void commandFingers(const std::array<double, kFingerCount>& positions, double speed, double force) override {
+    targets_ = positions;
+    speed_ = speed;
+    force_ = force;
+    ++finger_commands;
+  }
+  void commandMode(GripperMode mode) override {
+    reading_.mode = mode;
+    reading_.mode_reached = false;
+    mode_time_ = 0.0;
+  }
+
+  /// Where a part stops each finger (1: nothing in the way).
+  std::array<double, kFingerCount> block = {1.0, 1.0, 1.0};
+  bool stale = false;
+  bool broken = false;
+  bool scissor_jammed = false;
+  int finger_commands = 0;
+
+ private:
+  void advance(double dt) {
+    for (std::size_t i = 0; i < kFingerCount; ++i) {
+      auto& finger = reading_.fingers[i];
+      const double wanted = std::min(targets_[i], block[i]);
+      const double step = std::clamp(wanted - finger.position, -speed_ * dt, speed_ * dt);
+      finger.position += step;
+      finger.speed = step / dt;
+      const bool blocked = block[i] < 1.0 && finger.position >= block[i] - 1e-9 && targets_[i] > block[i];
+      finger.contact = blocked;
+      finger.force = blocked ? force_ : 0.0;
+    }
+    mode_time_ += dt;
+    if (!scissor_jammed && mode_time_ >= 0.2) {
+      reading_.mode_reached = true;
+    }
+  }
+
+  SimClock& clock_;
+  AdaptiveGripperReading reading_{};
+  std::array<double, kFingerCount> targets_{};
+  double speed_ = 0.5;
+  double force_ = 40.0;
+  double mode_time_ = 1.0;
+};
+
+AdaptiveGripperDescription robotiq3f() { return loadAdaptiveGripperDescription(gripperDescriptionFile("robotiq3f")); }
+
+class AdaptiveGripperTest : public ::testing::Test {
+ protected:
+  OperationResult run(const std::string& operation, component::ParamMap params = {}) {
+    for (const auto& spec : gripper.description().operation(operation)->params) {
+      params.try_emplace(spec.name, *spec.default_value);
+    }
+    const auto id = gripper.start(operation, params);
+    for (int tick = 0; tick < 1000; ++tick) {
+      const OperationResult result = gripper.poll(id);
+      if (result.state != OperationState::kRunning) {
+        return result;
+      }
+      clock.advanceBy(std::chrono::milliseconds(10));
+    }
+    return OperationResult::failure("test: did not finish");
+  }
+  bool holds(const std::string& predicate, std::vector<std::string> args = {}) {
+    world::WorldState world;
+    world.update("gripper", gripper.report());
+    return world.holds(predicate, args);
+  }
+
+  SimClock clock;
+  FakeHand hand{clock};
+  AdaptiveGripper gripper{hand, clock, robotiq3f()};
+};
+
+TEST(AdaptiveGripperDescriptionTest, ReadsTheFourModesFromTheGeneratorsFile) {
+  const AdaptiveGripperDescription description = robotiq3f();
+  EXPECT_EQ(description.name, "robotiq3f");
+  ASSERT_EQ(description.modes.size(), 4u);
+  EXPECT_DOUBLE_EQ(description.mode(GripperMode::kBasic).scissor_deg, 0.0);
+  EXPECT_GT(description.mode(GripperMode::kPinch).scissor_deg, 0.0);  // turned toward each other
+  EXPECT_LT(description.mode(GripperMode::kWide).scissor_deg, 0.0);   // spread
+  EXPECT_NEAR(description.mode(GripperMode::kScissor).scissor_deg, 90.0, 1e-9);
+  // In Scissor mode only fingers 1 and 2 close; elsewhere all three.
+  EXPECT_EQ(description.mode(GripperMode::kScissor).closing, (std::array<bool, 3>{false, true, true}));
+  EXPECT_EQ(description.mode(GripperMode::kBasic).closing, (std::array<bool, 3>{true, true, true}));
+  EXPECT_GT(description.max_force, 0.0);
+}
+
+TEST(AdaptiveGripperDescriptionTest, BadFilesNameTheFieldAndTheProblem) {
+  const auto dir = std::filesystem::temp_directory_path() / "costar_adaptive_gripper_test";
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& text) {
+    const auto file = dir / "bad.json";
+    std::ofstream(file) << text;
+    return file;
+  };
+  const auto error = [](const std::filesystem::path& file) {
+    try {
+      loadAdaptiveGripperDescription(file);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  std::ifstream in(gripperDescriptionFile("robotiq3f"));
+  std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(error(dir / "missing.json").find("cannot open"), std::string::npos);
+  EXPECT_NE(error(write("{")).find("bad.json"), std::string::npos);
+  std::string unknown_mode = good;
+  unknown_mode.replace(unknown_mode.find("\"name\": \"wide\""), 14, "\"name\": \"wild\"");
+  EXPECT_NE(error(write(unknown_mode)).find("modes[2].name: must be one of basic, pinch, wide, scissor"),
+            std::string::npos)
+      << error(write(unknown_mode));
+  std::string bad_finger = good;
+  bad_finger.replace(bad_finger.find("\"closing\": [\"finger_1\""), 22, "\"closing\": [\"finger_9\"");
+  EXPECT_NE(error(write(bad_finger)).find("modes[3].closing[0]"), std::string::npos) << error(write(bad_finger));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_F(AdaptiveGripperTest, ImplementsTheAbstractGripper) {
+  EXPECT_TRUE(component::missingRequirements(component::abstractGripper(), gripper.description()).empty());
+  for (const auto* name : {"Open", "Close", "SetMode", "BasicMode", "PinchMode", "WideMode", "ScissorMode"}) {
+    EXPECT_NE(gripper.description().operation(name), nullptr) << name;
+  }
+}
+
+TEST_F(AdaptiveGripperTest, StartsOpenInBasicMode) {
+  EXPECT_TRUE(holds("gripper_open"));
+  EXPECT_FALSE(holds("gripper_closed"));
+  EXPECT_FALSE(holds("gripper_holding"));
+  EXPECT_TRUE(holds("gripper_mode", {"basic"}));
+}
+
+TEST_F(AdaptiveGripperTest, CloseOnNothingClosesFully) {
+  const OperationResult result = run("Close");
+  ASSERT_EQ(result.state, OperationState::kSuccess) << result.reason;
+  EXPECT_FALSE(result.data.at("holding").get<bool>());
+  EXPECT_TRUE(holds("gripper_closed"));
+  EXPECT_FALSE(holds("gripper_open"));
+  EXPECT_FALSE(holds("gripper_holding"));
+}
+
+TEST_F(AdaptiveGripperTest, CloseOnAPartHoldsIt) {
+  hand.block = {0.3, 0.35, 0.32};
+  const OperationResult result = run("Close", {{"force", 30.0}});
+  ASSERT_EQ(result.state, OperationState::kSuccess) << result.reason;
+  EXPECT_TRUE(result.data.at("holding").get<bool>());
+  EXPECT_NEAR(result.data.at("fingers").at("finger_1").at("position").get<double>(), 0.35, 0.01);
+  EXPECT_TRUE(holds("gripper_holding"));
+  EXPECT_FALSE(holds("gripper_closed"));
+  // Open lets go.
+  ASSERT_EQ(run("Open").state, OperationState::kSuccess);
+  EXPECT_TRUE(holds("gripper_open"));
+  EXPECT_FALSE(holds("gripper_holding"));
+}
+
+TEST_F(AdaptiveGripperTest, OneFingerOnSomethingIsNotHolding) {
+  hand.block = {0.3, 1.0, 1.0};  // the part touches finger_middle only
+  const OperationResult result = run("Close");
+  ASSERT_EQ(result.state, OperationState::kSuccess);
+  EXPECT_FALSE(result.data.at("holding").get<bool>());
+  EXPECT_FALSE(holds("gripper_holding"));
+}
+
+TEST_F(AdaptiveGripperTest, EveryModeIsReachedAndReported) {
+  for (const GripperMode mode : kGripperModes) {
+    const OperationResult result = run("SetMode", {{"mode", std::string(toString(mode))}});
+    ASSERT_EQ(result.state, OperationState::kSuccess) << toString(mode) << ": " << result.reason;
+    EXPECT_TRUE(holds("gripper_mode", {std::string(toString(mode))})) << toString(mode);
+  }
+  // The abstract Gripper's per-mode operations do the same.
+  ASSERT_EQ(run("PinchMode").state, OperationState::kSuccess);
+  EXPECT_TRUE(holds("gripper_mode", {"pinch"}));
+  EXPECT_FALSE(holds("gripper_mode", {"scissor"}));
+}
+
+TEST_F(AdaptiveGripperTest, ScissorModeClosesFingersOneAndTwoOnly) {
+  ASSERT_EQ(run("ScissorMode").state, OperationState::kSuccess);
+  ASSERT_EQ(run("Close").state, OperationState::kSuccess);
+  const auto reading = hand.read();
+  EXPECT_LT(reading.fingers[0].position, 0.01);  // finger_middle stays open
+  EXPECT_GT(reading.fingers[1].position, 0.99);
+  EXPECT_GT(reading.fingers[2].position, 0.99);
+  EXPECT_TRUE(holds("gripper_closed"));  // closed: the mode's closing fingers are
+}
+
+TEST_F(AdaptiveGripperTest, ModeChangeWithClosedFingersFailsAndSaysWhy) {
+  hand.block = {0.3, 0.35, 0.32};
+  ASSERT_EQ(run("Close").state, OperationState::kSuccess);
+  const OperationResult result = run("WideMode");
+  ASSERT_EQ(result.state, OperationState::kFailure);
+  EXPECT_NE(result.reason.find("Open the gripper first"), std::string::npos) << result.reason;
+  EXPECT_TRUE(holds("gripper_mode", {"basic"}));  // nothing moved
+  EXPECT_TRUE(holds("gripper_holding"));
+}
+
+TEST_F(AdaptiveGripperTest, AJammedScissorAxisTimesOut) {
+  hand.scissor_jammed = true;
+  const OperationResult result = run("SetMode", {{"mode", std::string("wide")}});
+  ASSERT_EQ(result.state, OperationState::kFailure);
+  EXPECT_NE(result.reason.find("did not reach wide mode"), std::string::npos) << result.reason;
+  EXPECT_FALSE(holds("gripper_mode", {"wide"}));
+}
+
+TEST_F(AdaptiveGripperTest, UntrustworthyReadingsStopTheFingers) {
+  // Mid-stroke: the operation fails and says why.
+  const auto id = gripper.start("Close", {{"speed", 0.5}, {"force", 30.0}});
+  clock.advanceBy(std::chrono::milliseconds(100));
+  hand.broken = true;
+  const OperationResult result = gripper.poll(id);
+  ASSERT_EQ(result.state, OperationState::kFailure);
+  EXPECT_NE(result.reason.find("finger_1 is not a number; the fingers were stopped"), std::string::npos)
+      << result.reason;
+  EXPECT_THROW(gripper.report(), std::runtime_error);
+  // Before it starts: Close cannot start (the executor reports "could not start: ...").
+  EXPECT_THROW(gripper.start("Close", {{"speed", 0.5}, {"force", 30.0}}), std::runtime_error);
+  hand.broken = false;
+  hand.stale = true;
+  clock.advanceBy(std::chrono::seconds(1));
+  EXPECT_THROW(gripper.report(), std::runtime_error);
+}
+
+TEST(ParallelGripperModesTest, TheTwoFingerGripperRefusesEveryModeButPinch) {
+  // The 2-finger gripper's answer to the modes a 3-finger gripper has.
+  class Fingers final : public GripperDriver {
+   public:
+    FingerReading read() const override { return {0.085, 0.0, 0.0, false}; }
+    void command(double, double, double) override {}
+    double maxOpening() const override { return 0.085; }
+  } fingers;
+  SimClock clock;
+  ParallelGripper gripper(fingers, clock);
+  for (const auto* mode : {"BasicMode", "WideMode", "ScissorMode"}) {
+    const auto id = gripper.start(mode, {});
+    const OperationResult result = gripper.poll(id);
+    EXPECT_EQ(result.state, OperationState::kFailure) << mode;
+    EXPECT_NE(result.reason.find("only Pinch mode"), std::string::npos) << result.reason;
+  }
+  const auto id = gripper.start("PinchMode", {});
+  EXPECT_EQ(gripper.poll(id).state, OperationState::kSuccess);
+  // SetMode, the 3-finger gripper's way, answers the same.
+  const auto pinch = gripper.start("SetMode", {{"mode", std::string("pinch")}});
+  EXPECT_EQ(gripper.poll(pinch).state, OperationState::kSuccess);
+  const auto wide = gripper.start("SetMode", {{"mode", std::string("wide")}});
+  const OperationResult refused = gripper.poll(wide);
+  EXPECT_EQ(refused.state, OperationState::kFailure);
+  EXPECT_NE(refused.reason.find("SetMode(wide): mode not supported by this gripper"), std::string::npos)
+      << refused.reason;
+}
+
+}  // namespace
+}  // namespace costar::gripper

@@ -1,0 +1,120 @@
+#!/usr/bin/env python3
+"""robots/generate_gripper.py: the model it writes from robots/grippers/robotiq3f.json, and the
+errors it gives for bad descriptions (file, field, problem; exit status 1; nothing written)."""
+import json
+import math
+import pathlib
+import subprocess
+import sys
+import tempfile
+import unittest
+import xml.etree.ElementTree as ET
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+GENERATOR = ROOT / "robots" / "generate_gripper.py"
+ROBOTIQ = ROOT / "robots" / "grippers" / "robotiq3f.json"
+
+
+def run(description, out):
+    return subprocess.run([sys.executable, str(GENERATOR), str(description), str(out)], capture_output=True, text=True)
+
+
+class GenerateGripper(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.TemporaryDirectory()
+        self.tmp = pathlib.Path(self.dir.name)
+
+    def tearDown(self):
+        self.dir.cleanup()
+
+    def variant(self, change):
+        data = json.loads(ROBOTIQ.read_text())
+        change(data)
+        path = self.tmp / "gripper.json"
+        path.write_text(json.dumps(data))
+        return path
+
+    def expect_error(self, change, *fragments):
+        out = self.tmp / "out"
+        result = run(self.variant(change), out)
+        self.assertEqual(result.returncode, 1, result.stderr)
+        for fragment in ("gripper.json",) + fragments:
+            self.assertIn(fragment, result.stderr)
+        self.assertFalse(out.exists(), "nothing is written for a bad description")
+
+    def test_writes_three_underactuated_fingers_and_a_scissor_axis(self):
+        result = run(ROBOTIQ, self.tmp)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        alone = ET.parse(self.tmp / "robotiq3f.xml").getroot()
+        body = ET.parse(self.tmp / "robotiq3f_body.xml").getroot()
+        sections = ET.parse(self.tmp / "robotiq3f_sections.xml").getroot()
+        fingers = ["finger_middle", "finger_1", "finger_2"]
+        joints = [j.get("name") for j in body.iter("joint")]
+        for finger in fingers:
+            for phalanx in ("proximal", "medial", "distal"):
+                self.assertIn(f"robotiq3f_{finger}_{phalanx}", joints)
+        # Fingers 1 and 2 turn on the scissor axis, in opposite senses; finger_middle does not.
+        scissors = {j.get("name"): j.get("axis") for j in body.iter("joint") if j.get("name").endswith("_scissor")}
+        self.assertEqual(scissors, {"robotiq3f_finger_1_scissor": "0 0 1", "robotiq3f_finger_2_scissor": "0 0 -1"})
+        # Per finger a flexion tendon (proximal + medial) that a force-limited servo pulls.
+        tendons = {t.get("name"): [j.get("joint") for j in t.iter("joint")] for t in sections.iter("fixed")}
+        self.assertEqual(len(tendons), 3)
+        self.assertEqual(tendons["robotiq3f_finger_1_flex"], ["robotiq3f_finger_1_proximal", "robotiq3f_finger_1_medial"])
+        servos = {p.get("name"): p for p in sections.iter("position")}
+        self.assertEqual(set(servos), {"robotiq3f_" + f for f in fingers} | {"robotiq3f_scissor"})
+        force = [float(x) for x in servos["robotiq3f_finger_1"].get("forcerange").split()]
+        self.assertAlmostEqual(force[1], 60 * 0.07)  # max_force_n x lever_m
+        closed = float(servos["robotiq3f_finger_1"].get("ctrlrange").split()[1])
+        self.assertAlmostEqual(closed, math.radians(110))  # closed_deg
+        equalities = [e.get("name") for e in sections.find("equality")]
+        self.assertEqual(equalities[0], "robotiq3f_finger_2_scissor_coupling")
+        # For fingertip modes, per finger: the medial and distal phalanges straight; off until a
+        # mode needs them.
+        locks = [e for e in sections.find("equality") if e.get("name").endswith(("_medial_lock", "_distal_lock"))]
+        self.assertEqual(len(locks), 6)
+        self.assertTrue(all(e.get("active") == "false" for e in locks))
+        # The gripper's geoms touch parts (contype 2), not each other (conaffinity 0).
+        self.assertTrue(all(g.get("contype") == "2" and g.get("conaffinity") == "0" for g in body.iter("geom")))
+        # The standalone model holds both.
+        self.assertEqual(len(list(alone.iter("fixed"))), 3)
+        self.assertEqual(alone.find("worldbody/body").get("name"), "robotiq3f_base")
+
+    def test_bad_descriptions_name_the_field(self):
+        def drop(key):
+            return lambda d: d.pop(key)
+
+        def setter(path, value):
+            def change(d):
+                target = d
+                for key in path[:-1]:
+                    target = target[key]
+                target[path[-1]] = value
+            return change
+
+        self.expect_error(drop("modes"), "modes: missing")
+        self.expect_error(setter(["format"], "x"), "format: must be")
+        self.expect_error(setter(["fingers", 1, "scissor_sign"], 2), "fingers[1].scissor_sign: must be -1, 0")
+        self.expect_error(setter(["fingers", 2, "name"], "finger_1"), 'fingers[2].name: "finger_1" appears twice')
+        self.expect_error(lambda d: d["fingers"].pop(), "fingers: a 3-finger gripper needs 3 fingers, not 2")
+        self.expect_error(setter(["fingers", 0, "name"], "thumb"), "fingers: must be finger_middle, finger_1, finger_2")
+        self.expect_error(setter(["fingers", 0, "scissor_sign"], 1), "fingers[0].scissor_sign: must be 0")
+        self.expect_error(setter(["phalanges", 0, "length"], -0.05), "phalanges[0].length: must be positive")
+        self.expect_error(setter(["phalanges", 1, "lower_deg"], 10), "phalanges[1]: the straight finger")
+        self.expect_error(setter(["modes", 3, "scissor_deg"], 120), "modes[3].scissor_deg: must be within")
+        self.expect_error(setter(["modes", 0, "closing"], ["finger_9"]), 'modes[0].closing[0]: "finger_9" is not a finger')
+        self.expect_error(setter(["modes", 1, "name"], "wide"), 'modes[2].name: "wide" appears twice')
+        self.expect_error(setter(["actuation", "max_force_n"], "a lot"), "actuation.max_force_n: must be a finite number")
+        self.expect_error(setter(["tcp"], [0, 0]), "tcp: must be 3 finite numbers")
+        self.expect_error(setter(["actuation", "closed_deg"], 200), "actuation.closed_deg: must be above the open finger")
+        self.expect_error(setter(["phalanges", 1, "spring_rest_deg"], 5), "phalanges[1].spring_rest_deg: must be at most 0")
+
+    def test_unreadable_json_names_the_line(self):
+        path = self.tmp / "gripper.json"
+        path.write_text('{\n  "format": \n}')
+        result = run(path, self.tmp / "out")
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("gripper.json: line 3", result.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
