@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "arm/robot_description.h"
+#include "arm/srs_kinematics.h"
 #include "arm/ur5_kinematics.h"
 
 namespace costar::arm {
@@ -44,10 +45,23 @@ std::shared_ptr<const Kinematics> makeUr(const RobotDescription& robot) {
   return std::make_shared<Ur5Kinematics>(dh, robot.limits);
 }
 
+/// "srs": 7-joint S-R-S arms (the LBR iiwa); the geometry from the joints and tool of the
+/// robot's description file (format costar-robot-description/1, checked for the S-R-S form by
+/// readSrsArmDescription), the limits from the description.
+std::shared_ptr<const Kinematics> makeSrs(const RobotDescription& robot) {
+  if (!robot.solver_parameters.empty()) {
+    throw std::runtime_error("kinematics." + robot.solver_parameters.begin()->first +
+                             ": solver 'srs' takes no parameters (its geometry comes from the joints)");
+  }
+  const SrsArmDescription arm = readSrsArmDescription(robot.file);
+  return std::make_shared<SrsArmKinematics>(arm.geometry, robot.limits);
+}
+
 using Maker = std::shared_ptr<const Kinematics> (*)(const RobotDescription&);
 
 /// Every solver: key, maker. Sorted by key.
 constexpr std::pair<const char*, Maker> kSolvers[] = {
+    {"srs", &makeSrs},
     {"ur", &makeUr},
 };
 

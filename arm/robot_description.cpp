@@ -1,8 +1,10 @@
 #include "arm/robot_description.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -14,6 +16,8 @@ namespace costar::arm {
 namespace {
 
 using nlohmann::json;
+
+constexpr const char* kGeneratedFormat = "costar-robot-description/1";
 
 /// A problem with one field: "joints[2].max: ...".
 [[noreturn]] void fail(const std::string& field, const std::string& problem) {
@@ -168,17 +172,21 @@ RobotDescription parse(const json& root_object, const std::filesystem::path& dat
     }
   }
 
-  const json& tool = objectAt(root_object, "", "tool");
-  onlyKnown(tool, "tool", {"position", "orientation"});
-  const auto p = numbers(member(tool, "tool", "position"), "tool.position", 3, "[x, y, z] (m)");
-  const auto q = numbers(member(tool, "tool", "orientation"), "tool.orientation", 4, "a unit quaternion [w, x, y, z]");
-  const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
-  if (std::abs(rotation.norm() - 1.0) > 0.01) {
-    fail("tool.orientation", "must be a unit quaternion [w, x, y, z], not " + shown(tool.at("orientation")));
-  }
   robot.tool_in_flange = world::Pose::Identity();
-  robot.tool_in_flange.translation() = Eigen::Vector3d(p[0], p[1], p[2]);
-  robot.tool_in_flange.linear() = rotation.normalized().toRotationMatrix();
+  if (root_object.contains("tool")) {
+    const json& tool = objectAt(root_object, "", "tool");
+    onlyKnown(tool, "tool", {"position", "orientation"});
+    const auto p = numbers(member(tool, "tool", "position"), "tool.position", 3, "[x, y, z] (m)");
+    const auto q =
+        numbers(member(tool, "tool", "orientation"), "tool.orientation", 4, "a unit quaternion [w, x, y, z]");
+    const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
+    if (std::abs(rotation.norm() - 1.0) > 0.01) {
+      fail("tool.orientation", "must be a unit quaternion [w, x, y, z], not " + shown(tool.at("orientation")));
+    }
+    robot.tool_in_flange = world::Pose::Identity();
+    robot.tool_in_flange.translation() = Eigen::Vector3d(p[0], p[1], p[2]);
+    robot.tool_in_flange.linear() = rotation.normalized().toRotationMatrix();
+  }
 
   const json& links = objectAt(root_object, "", "links");
   onlyKnown(links, "links", {"base", "first_moving", "gripper"});
@@ -194,6 +202,116 @@ RobotDescription parse(const json& root_object, const std::filesystem::path& dat
     }
     robot.gripper_links.push_back(gripper[i].get<std::string>());
   }
+  return robot;
+}
+
+/// Where the build writes generated models (robots/generate_models.py):
+/// $COSTAR_GENERATED_DIR if set, else this build's tree.
+std::filesystem::path generatedRoot() {
+  if (const char* dir = std::getenv("COSTAR_GENERATED_DIR"); dir != nullptr && *dir != '\0') {
+    return dir;
+  }
+  return COSTAR_GENERATED_DIR;
+}
+
+std::filesystem::path generatedModel(const std::string& name, const std::string& extension) {
+  const std::filesystem::path path = generatedRoot() / "robots" / name / (name + extension);
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) {
+    fail("name", "the model generated from this file, '" + path.string() + "', is missing: build the target costar_" +
+                     name + "_models (robots/generate_models.py)");
+  }
+  return path;
+}
+
+double degrees(const json& object, const std::string& field, const std::string& key) {
+  return number(member(object, field, key), field + "." + key) * std::numbers::pi / 180.0;
+}
+
+/// Format costar-robot-description/1 (robots/README.md), the file robots/generate_models.py
+/// makes the models from: the generator's fields plus those only the runtime needs (type,
+/// label, kinematics, joints[].label and .acceleration_deg_s2, gripper_links). The fields of
+/// the models (links' masses and shapes, joint origins) are the generator's and the solver's
+/// business and are checked there; here the keys are checked against the format's.
+RobotDescription parseGenerated(const json& root_object) {
+  onlyKnown(root_object, "",
+            {"format", "name", "model", "type", "label", "notes", "sources", "published_lengths", "base_link", "links",
+             "joints", "tool", "home_deg", "kinematics", "gripper_links"});
+  RobotDescription robot;
+  robot.name = text(root_object, "", "name");
+  robot.type = text(root_object, "", "type");
+  robot.label = text(root_object, "", "label");
+  const json& kinematics = objectAt(root_object, "", "kinematics");
+  robot.solver = text(kinematics, "kinematics", "solver");
+  for (const auto& [key, value] : kinematics.items()) {
+    if (key != "solver") {
+      robot.solver_parameters[key] = numbers(value, "kinematics." + key);
+    }
+  }
+  const json& joints = member(root_object, "", "joints");
+  if (!joints.is_array() || joints.empty() || joints.size() > static_cast<std::size_t>(kMaxJoints)) {
+    fail("joints", "must be a list of 1 to " + std::to_string(kMaxJoints) + " joints, not " + shown(joints));
+  }
+  const int count = static_cast<int>(joints.size());
+  robot.limits = {JointVector(count), JointVector(count), JointVector(count), JointVector(count)};
+  std::set<std::string> names;
+  for (int j = 0; j < count; ++j) {
+    const std::string field = "joints[" + std::to_string(j) + "]";
+    const json& joint = joints[j];
+    if (!joint.is_object()) {
+      fail(field, "must be an object {\"name\": ..., \"lower_deg\": ..., ...}, not " + shown(joint));
+    }
+    onlyKnown(joint, field,
+              {"name", "label", "parent", "child", "origin", "rpy", "axis", "lower_deg", "upper_deg", "velocity_deg_s",
+               "acceleration_deg_s2", "effort_nm"});
+    const std::string name = text(joint, field, "name");
+    if (!names.insert(name).second) {
+      fail(field + ".name", "'" + name + "' is taken already; joint names must differ");
+    }
+    robot.joint_names.push_back(name);
+    robot.joint_labels.push_back(text(joint, field, "label"));
+    if (j == 0) {
+      robot.first_moving_link = text(joint, field, "child");
+    }
+    robot.limits.min_position[j] = degrees(joint, field, "lower_deg");
+    robot.limits.max_position[j] = degrees(joint, field, "upper_deg");
+    robot.limits.max_velocity[j] = degrees(joint, field, "velocity_deg_s");
+    robot.limits.max_acceleration[j] = degrees(joint, field, "acceleration_deg_s2");
+    if (robot.limits.min_position[j] > robot.limits.max_position[j]) {
+      fail(field, "lower_deg " + shown(joint.at("lower_deg")) + " is above upper_deg " + shown(joint.at("upper_deg")));
+    }
+    if (!(robot.limits.max_velocity[j] > 0.0)) {
+      fail(field + ".velocity_deg_s", "must be positive, not " + shown(joint.at("velocity_deg_s")));
+    }
+    if (!(robot.limits.max_acceleration[j] > 0.0)) {
+      fail(field + ".acceleration_deg_s2", "must be positive, not " + shown(joint.at("acceleration_deg_s2")));
+    }
+  }
+  const std::vector<double> home = numbers(member(root_object, "", "home_deg"), "home_deg", joints.size(),
+                                           std::to_string(count) + " angles (degrees), one per joint");
+  robot.home = JointVector(count);
+  for (int j = 0; j < count; ++j) {
+    robot.home[j] = home[j] * std::numbers::pi / 180.0;
+    if (robot.home[j] < robot.limits.min_position[j] || robot.home[j] > robot.limits.max_position[j]) {
+      fail("home_deg[" + std::to_string(j) + "]", "is outside joint " + std::to_string(j + 1) + "'s limits");
+    }
+  }
+  robot.base_link = text(root_object, "", "base_link");
+  const json& tool = objectAt(root_object, "", "tool");
+  robot.urdf_base_link = robot.base_link;
+  robot.urdf_tool_link = text(tool, "tool", "name");  // the flange
+  const json& gripper = member(root_object, "", "gripper_links");
+  if (!gripper.is_array()) {
+    fail("gripper_links", "must be a list of link names, not " + shown(gripper));
+  }
+  for (std::size_t i = 0; i < gripper.size(); ++i) {
+    if (!gripper[i].is_string() || gripper[i].get<std::string>().empty()) {
+      fail("gripper_links[" + std::to_string(i) + "]", "must be a link name, not " + shown(gripper[i]));
+    }
+    robot.gripper_links.push_back(gripper[i].get<std::string>());
+  }
+  robot.mjcf = generatedModel(robot.name, ".xml");
+  robot.urdf = generatedModel(robot.name, ".urdf");
   return robot;
 }
 
@@ -219,7 +337,13 @@ RobotDescription loadRobotDescription(const std::filesystem::path& file, const s
     } catch (const json::parse_error& e) {
       throw std::runtime_error(std::string("not valid JSON: ") + e.what());
     }
-    RobotDescription robot = parse(parsed, data_root.empty() ? dataRoot() : data_root);
+    const bool generated = parsed.is_object() && parsed.contains("format");
+    if (generated && parsed.at("format") != kGeneratedFormat) {
+      throw std::runtime_error("format: must be \"" + std::string(kGeneratedFormat) + "\", not " +
+                               shown(parsed.at("format")));
+    }
+    RobotDescription robot =
+        generated ? parseGenerated(parsed) : parse(parsed, data_root.empty() ? dataRoot() : data_root);
     robot.file = file;
     return robot;
   } catch (const std::exception& e) {

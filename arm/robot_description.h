@@ -1,18 +1,30 @@
 #pragma once
 // A robot arm as data: one JSON file per robot (robots/NAME/NAME.json) says what the rest of
 // costar needs to know about it, so that no code names a particular robot's joints or links.
+// Two formats, told apart by the "format" field:
+//
+// 1. "format": "costar-robot-description/1" (robots/README.md; the LBR iiwa 14): the file
+//    robots/generate_models.py makes the arm's MJCF and URDF from at build time, with the
+//    fields only the runtime needs: type, label, kinematics, joints[].label,
+//    joints[].acceleration_deg_s2 and gripper_links. Angles in degrees; the models are the
+//    generated ones (build tree, $COSTAR_GENERATED_DIR to override); the flange is tool.name.
+// 2. No "format" (the UR5, whose models are hand-written): the fields below, SI units.
 //
 //   name, type, label      the robot's id ("ur5"), its component type ("UR5"), a readable name
 //   kinematics             {"solver": KEY, ...parameters}: KEY picks the Kinematics class in
 //                          makeKinematics() (e.g. "ur": the UR closed form, with its DH table
-//                          d, a, alpha); the other fields are that solver's numbers
-//   models                 mjcf (MuJoCo model), urdf (for the collision model), and the URDF's
-//                          base and tool links; paths relative to the data root (core/paths.h)
+//                          d, a, alpha; "srs": 7-joint S-R-S arms, geometry from the joints of
+//                          a format-1 file); the other fields are that solver's numbers
+//   models                 mjcf (MuJoCo model of the arm alone), urdf (the same chain for the
+//                          planner), and the URDF's base link and flange link (urdf_tool_link,
+//                          also the flange body in the MJCF, where a gripper is mounted); paths
+//                          relative to the data root (core/paths.h)
 //   joints                 [{name, label, min, max, max_velocity, max_acceleration}, ...], base
 //                          first; name as in the models, label for people ("wrist 3")
 //   home                   the home configuration, one angle per joint
-//   tool                   the tool centre point in the flange frame:
-//                          {position [x, y, z], orientation [w, x, y, z]}
+//   tool                   optional: a fixed tool frame in the flange frame (an adapter plate):
+//                          {position [x, y, z], orientation [w, x, y, z]}; the gripper's tool
+//                          centre point is the workcell's (workcells/NAME.json)
 //   links                  base (the link standing on the table), first_moving (the first link
 //                          that moves: it and its children are the arm in the simulator's
 //                          contacts), gripper (links that may touch a part being grasped)

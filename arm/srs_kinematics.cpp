@@ -688,4 +688,139 @@ std::optional<Joints7> SrsKinematics::inverseNearest(const world::Pose& flange, 
   return toReal(*best);
 }
 
+int SrsKinematics::solutionsWithin(const world::Pose& flange, const Joints7& seed, const SrsLimits& limits,
+                                   std::array<Joints7, kMaxNearSolutions>& solutions) const {
+  if (!seed.allFinite()) {
+    throw std::invalid_argument("SrsKinematics::solutionsWithin: the seed has a non-finite joint angle");
+  }
+  PoseTerms terms;
+  if (!poseTerms(geometry_, flange_to_wrist_, flange, terms)) {
+    return 0;
+  }
+  const Joints7 seed_c = toCanonical(seed);
+  Joints7 lower_c;
+  Joints7 upper_c;
+  for (int i = 0; i < 7; ++i) {
+    const bool positive = geometry_.axis_sign[i] > 0;
+    lower_c[i] = positive ? limits.lower[i] : -limits.upper[i];
+    upper_c[i] = positive ? limits.upper[i] : -limits.lower[i];
+  }
+  const std::function<bool(const Joints7&)> accept_all = [](const Joints7&) { return true; };
+  const NearestSearch search(terms, seed_c, lower_c, upper_c, accept_all);
+  int count = 0;
+  const auto add = [&](const Joints7& canonical) {
+    for (int s = 0; s < count; ++s) {
+      if ((solutions[s] - canonical).squaredNorm() < 1e-18) {
+        return;
+      }
+    }
+    if (count < kMaxNearSolutions) {
+      solutions[count++] = canonical;
+    }
+  };
+  Joints7 candidate;
+  const int seed_elbow = terms.elbow_branches == 2 && seed_c[3] < 0.0 ? 1 : 0;
+  const int seed_sign2 = seed_c[1] < 0.0 ? -1 : 1;
+  const int seed_sign6 = seed_c[5] < 0.0 ? -1 : 1;
+  const double seed_psi = search.seedArmAngle(seed_elbow);
+  if (search.solve(seed_elbow, seed_sign2, seed_sign6, seed_psi, candidate)) {
+    add(candidate);
+  }
+  Intervals intervals;
+  for (int k = 0; k < terms.elbow_branches; ++k) {
+    double q4_within = 0.0;
+    if (!intoLimits(terms.q4[k], seed_c[3], lower_c[3], upper_c[3], q4_within)) {
+      continue;
+    }
+    search.feasibleIntervals(k, intervals);
+    const double psi_seed = search.seedArmAngle(k);
+    for (int sign2 : {1, -1}) {
+      for (int sign6 : {1, -1}) {
+        if (search.nearestOnBranch(k, sign2, sign6, psi_seed, intervals, candidate)) {
+          add(candidate);
+        }
+      }
+    }
+  }
+  for (double degrees : {10.0, 20.0, 40.0, 80.0}) {
+    for (int direction : {1, -1}) {
+      if (count < kMaxNearSolutions && search.solve(seed_elbow, seed_sign2, seed_sign6,
+                                                    wrap(seed_psi + direction * degrees * kPi / 180.0), candidate)) {
+        add(candidate);
+      }
+    }
+  }
+  for (int s = 0; s < count; ++s) {
+    solutions[s] = toReal(solutions[s]);
+  }
+  return count;
+}
+
+namespace {
+
+SrsLimits srsLimits(const JointLimits& limits) {
+  if (limits.size() != 7) {
+    throw std::invalid_argument("SrsArmKinematics: an S-R-S arm has 7 joints, the limits " +
+                                std::to_string(limits.size()));
+  }
+  SrsLimits out;
+  for (int j = 0; j < 7; ++j) {
+    out.lower[j] = limits.min_position[j];
+    out.upper[j] = limits.max_position[j];
+  }
+  return out;
+}
+
+Joints7 toJoints7(const JointVector& q) {
+  Joints7 out;
+  for (int j = 0; j < 7; ++j) {
+    out[j] = q[j];
+  }
+  return out;
+}
+
+}  // namespace
+
+SrsArmKinematics::SrsArmKinematics(SrsGeometry geometry, JointLimits limits)
+    : Kinematics(std::move(limits)), solver_(geometry), srs_limits_(srsLimits(this->limits())) {}
+
+world::Pose SrsArmKinematics::forward(const JointVector& q) const {
+  if (q.size() != 7) {
+    throw std::invalid_argument("SrsArmKinematics::forward: " + std::to_string(q.size()) + " joints, the arm 7");
+  }
+  return solver_.forward(toJoints7(q));
+}
+
+void SrsArmKinematics::inverse(const world::Pose& flange, const JointVector& seed, IkSolutions& solutions) const {
+  solutions.clear();
+  if (seed.size() != 7 || !allFinite(seed) || !flange.matrix().allFinite()) {
+    return;
+  }
+  std::array<Joints7, SrsKinematics::kMaxNearSolutions> found;
+  const int count = solver_.solutionsWithin(flange, toJoints7(seed), srs_limits_, found);
+  for (int s = 0; s < count; ++s) {
+    solutions.push_back(JointVector::fromEigen(found[s]));
+  }
+}
+
+std::optional<JointVector> SrsArmKinematics::inverseNearest(const world::Pose& flange, const JointVector& seed,
+                                                            const Acceptable& acceptable) const {
+  if (seed.size() != 7) {
+    throw std::invalid_argument("SrsArmKinematics::inverseNearest: the seed has " + std::to_string(seed.size()) +
+                                " joints, the arm 7");
+  }
+  if (!allFinite(seed)) {
+    throw std::invalid_argument("SrsArmKinematics::inverseNearest: the seed has a non-finite joint angle");
+  }
+  SrsKinematics::Acceptable accept;
+  if (acceptable) {
+    accept = [&acceptable](const Joints7& q) { return acceptable(JointVector::fromEigen(q)); };
+  }
+  const std::optional<Joints7> q = solver_.inverseNearest(flange, toJoints7(seed), srs_limits_, accept);
+  if (!q) {
+    return std::nullopt;
+  }
+  return JointVector::fromEigen(*q);
+}
+
 }  // namespace costar::arm

@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "arm/kinematics.h"
 #include "world/pose.h"
 
 namespace costar::arm {
@@ -139,12 +140,49 @@ class SrsKinematics {
   std::optional<Joints7> inverseNearest(const world::Pose& flange, const Joints7& seed, const SrsLimits& limits,
                                         const Acceptable& acceptable = {}) const;
 
+  /// Most solutions solutionsWithin() returns.
+  static constexpr int kMaxNearSolutions = 16;
+  /// Solutions for `flange` within `limits`, near `seed`, for a caller that picks among them
+  /// (e.g. the first free of collisions): the seed's branch at the seed's arm angle; on each of
+  /// the 8 branches the feasible arm angle nearest the seed's (as inverseNearest() step 2);
+  /// then the seed's branch at arm angles 10, 20, 40 and 80 degrees either side of the seed's,
+  /// while there is room. Written to `solutions[0 .. count)`, returns count (0 to 16), without
+  /// duplicates, unsorted; each joint the 2*pi-equivalent within limits nearest the seed's. Does
+  /// not allocate. @throws std::invalid_argument when `seed` has a non-finite entry.
+  int solutionsWithin(const world::Pose& flange, const Joints7& seed, const SrsLimits& limits,
+                      std::array<Joints7, kMaxNearSolutions>& solutions) const;
+
  private:
   Joints7 toReal(const Joints7& canonical) const;
   Joints7 toCanonical(const Joints7& real) const;
 
   SrsGeometry geometry_;
   world::Pose flange_to_wrist_;
+};
+
+/// SrsKinematics as the arm's Kinematics (arm/kinematics.h), for the arm component, SmartMove
+/// and the planners: 7 joints, the joint limits of the robot description.
+/// - inverse(): SrsKinematics::solutionsWithin() (within the position limits, near the seed).
+/// - inverseNearest(): SrsKinematics::inverseNearest() (the feasible arm angles in closed
+///   form; the caller's predicate sees each candidate).
+/// Made by makeKinematics() for "kinematics": {"solver": "srs"} (arm/robot_description.h).
+class SrsArmKinematics final : public Kinematics {
+ public:
+  /// @throws std::invalid_argument when `limits` are not valid limits of 7 joints, or the
+  /// geometry is invalid (SrsKinematics).
+  SrsArmKinematics(SrsGeometry geometry, JointLimits limits);
+
+  const SrsKinematics& solver() const { return solver_; }
+
+  world::Pose forward(const JointVector& q) const override;
+  void inverse(const world::Pose& flange, const JointVector& seed, IkSolutions& solutions) const override;
+  std::optional<JointVector> inverseNearest(const world::Pose& flange, const JointVector& seed,
+                                            const Acceptable& acceptable) const override;
+  using Kinematics::inverseNearest;
+
+ private:
+  SrsKinematics solver_;
+  SrsLimits srs_limits_;
 };
 
 }  // namespace costar::arm

@@ -6,15 +6,39 @@
 
 #include <cmath>
 
+#include "arm/robot_description.h"
 #include "arm/trajectory.h"
 #include "core/paths.h"
 #include "sim/simulation.h"
+#include "workcell/sim_cell_description.h"
 
 namespace costar::bench {
 namespace {
 
 std::unique_ptr<sim::Simulation> assembly() {
   return sim::Simulation::create(sim::loadScene(dataRoot() / "sim/scenes/assembly.json"));
+}
+
+/// The iiwa-sim cell's simulation (workcells/iiwa-sim.json) with the assembly scene.
+std::unique_ptr<sim::Simulation> iiwaAssembly() {
+  const workcell::SimCellDescription cell = workcell::loadSimCellDescription(workcell::simCellFile("iiwa-sim"));
+  sim::SimulationOptions options;
+  options.robot = arm::loadRobotDescription(arm::robotDescriptionFile(cell.robot));
+  options.robot_base = cell.robot_base;
+  return sim::Simulation::create(sim::loadScene(cell.scene), options);
+}
+
+/// Swings the arm between its home and `away` at full speed within `limits`, for ever.
+void swing(sim::Simulation& simulation, const arm::JointVector& away, const arm::JointLimits& limits) {
+  const arm::JointVector a = simulation.armPositions();
+  const auto out = std::make_shared<arm::JointTrajectory>(arm::JointTrajectory::pointToPoint(a, away, limits, 1.0));
+  const auto back = std::make_shared<arm::JointTrajectory>(arm::JointTrajectory::pointToPoint(away, a, limits, 1.0));
+  const Duration period = out->duration() + back->duration();
+  simulation.setArmSetpointSource([out, back, period](TimePoint t) {
+    const Duration phase = Duration(t.time_since_epoch().count() % period.count());
+    const arm::TrajectoryPoint p = phase < out->duration() ? out->sample(phase) : back->sample(phase - out->duration());
+    return sim::ArmSetpoint{p.position, p.velocity, p.acceleration};
+  });
 }
 
 /// One simulated second per iteration; reports the real-time factor.
@@ -52,6 +76,23 @@ void BM_PhysicsArmMoving(benchmark::State& state) {
   simulateSeconds(state, *simulation);
 }
 BENCHMARK(BM_PhysicsArmMoving)->Unit(benchmark::kMillisecond);
+
+void BM_PhysicsArmHolding_Iiwa(benchmark::State& state) {
+  const auto simulation = iiwaAssembly();
+  simulateSeconds(state, *simulation);
+}
+BENCHMARK(BM_PhysicsArmHolding_Iiwa)->Unit(benchmark::kMillisecond);
+
+void BM_PhysicsArmMoving_Iiwa(benchmark::State& state) {
+  const auto simulation = iiwaAssembly();
+  const arm::RobotDescription iiwa = arm::loadRobotDescription(arm::robotDescriptionFile("iiwa14"));
+  arm::JointVector away = iiwa.home;
+  away[0] = -1.2;
+  away[1] = 0.6;
+  swing(*simulation, away, iiwa.limits);
+  simulateSeconds(state, *simulation);
+}
+BENCHMARK(BM_PhysicsArmMoving_Iiwa)->Unit(benchmark::kMillisecond);
 
 /// One frame as a plan's DetectObjects takes its last one: colour and depth, noise on 2 threads.
 /// "CPU" is the main thread's; the /process_time variant counts every thread (Mesa's

@@ -1,6 +1,8 @@
 // SmartMove's choice of a goal among 20 nodes x 24 symmetries (480 candidates) with the real
-// UR5 IK, joint limits, collision checks (table, the other parts, self) and path planning of the
-// chosen one. Target: <= 20 ms. Figures: docs/BENCHMARKS.md.
+// IK, joint limits, collision checks (table, the other parts, self) and path planning of the
+// chosen one, in each simulated cell's geometry (workcells/ur5-sim.json: the UR5 closed form;
+// workcells/iiwa-sim.json: the LBR iiwa 14's analytic S-R-S solver). Target: <= 20 ms.
+// Figures: docs/BENCHMARKS.md.
 
 #include <benchmark/benchmark.h>
 
@@ -8,9 +10,10 @@
 
 #include "arm/arm_component.h"
 #include "arm/robot_description.h"
-#include "arm/ur5_kinematics.h"
 #include "core/paths.h"
 #include "smartmove/smartmove.h"
+#include "workcell/grippers.h"
+#include "workcell/sim_cell_description.h"
 
 namespace costar::bench {
 namespace {
@@ -41,16 +44,21 @@ class NoGripper final : public component::LocalComponent {
 };
 
 struct Cell {
-  Cell()
-      : robot(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp")),
-        collisions(robot, kBase, {.padding = 0.005}, {kHome.eigen()}),
-        driver(kHome),
+  explicit Cell(const std::string& name)
+      : description(workcell::loadSimCellDescription(workcell::simCellFile(name))),
+        robot_description(arm::loadRobotDescription(arm::robotDescriptionFile(description.robot))),
+        gripper_model(workcell::gripperModel(description.gripper)),
+        robot(planning::RobotModel::fromUrdf(robot_description.urdf, dataRoot() / gripper_model.urdf,
+                                             robot_description.urdf_tool_link, robot_description.urdf_base_link,
+                                             gripper_model.tcp_link)),
+        collisions(robot, description.robot_base, {.padding = 0.005}, {robot_description.home.eigen()}),
+        driver(robot_description.home),
         grasps(dataRoot() / "data/grasps.json", {}),
-        arm(driver, clock, collisions, waypoints, nullptr, std::make_shared<arm::Ur5Kinematics>(), config()),
+        arm(driver, clock, collisions, waypoints, nullptr, arm::makeKinematics(robot_description), config()),
         smartmove(arm, gripper, world, collisions, world::loadObjectClasses(dataRoot() / "data/objects"), grasps,
                   smartmoveConfig()) {
-    collisions.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
-    collisions.allow("base_link", "table");
+    collisions.setBox("table", world::Pose(Eigen::Translation3d(description.table_centre)), description.table_size);
+    collisions.allow(robot_description.base_link, "table");
     // 20 nodes at random on the table, any yaw, 6 cm apart at least.
     std::mt19937 random(3);
     std::uniform_real_distribution<double> x(0.3, 0.7);
@@ -71,21 +79,24 @@ struct Cell {
     }
     world.update("perception", report);
   }
-  static arm::ArmConfig config() {
+  arm::ArmConfig config() const {
     arm::ArmConfig c;
-    c.base_in_world = kBase;
-    c.home = kHome;
-    c.tcp_in_flange = world::Pose(Eigen::Translation3d(0, 0, 0.14));
+    c.base_in_world = description.robot_base;
+    c.home = robot_description.home;
+    c.tcp_in_flange = robot_description.tool_in_flange * gripper_model.tcp_in_flange;
+    c.joint_names = robot_description.joint_names;
+    c.joint_labels = robot_description.joint_labels;
     return c;
   }
-  static smartmove::SmartMoveConfig smartmoveConfig() {
+  smartmove::SmartMoveConfig smartmoveConfig() const {
     smartmove::SmartMoveConfig c;
-    c.gripper_links = arm::loadRobotDescription(arm::robotDescriptionFile("ur5")).gripper_links;
+    c.gripper_links = robot_description.gripper_links;
     return c;
   }
-  static inline const arm::JointVector kHome = {0.0, -2.3, 1.9, -M_PI / 2 + 0.4, -M_PI / 2, 0.0};
-  static inline const world::Pose kBase{Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ())};
 
+  workcell::SimCellDescription description;
+  arm::RobotDescription robot_description;
+  const workcell::GripperModel& gripper_model;
   SimClock clock;
   world::WorldState world;
   planning::RobotModel robot;
@@ -98,8 +109,8 @@ struct Cell {
   smartmove::SmartMoveComponent smartmove;
 };
 
-void selection(benchmark::State& state, double approach) {
-  Cell cell;
+void selection(benchmark::State& state, const std::string& workcell, double approach) {
+  Cell cell(workcell);
   const world::Pose grasp = cell.grasps.find("node", "top")->tcp_in_object;
   smartmove::Selection last;
   for (auto _ : state) {
@@ -117,11 +128,17 @@ void selection(benchmark::State& state, double approach) {
   state.counters["fully_checked"] = checked;
 }
 
-void BM_SmartMoveSelection20x24(benchmark::State& state) { selection(state, 0.0); }
+void BM_SmartMoveSelection20x24(benchmark::State& state) { selection(state, "ur5-sim", 0.0); }
 BENCHMARK(BM_SmartMoveSelection20x24)->Unit(benchmark::kMillisecond);
 
-void BM_SmartGraspSelection20x24(benchmark::State& state) { selection(state, 0.1); }
+void BM_SmartGraspSelection20x24(benchmark::State& state) { selection(state, "ur5-sim", 0.1); }
 BENCHMARK(BM_SmartGraspSelection20x24)->Unit(benchmark::kMillisecond);
+
+void BM_SmartMoveSelection20x24_Iiwa(benchmark::State& state) { selection(state, "iiwa-sim", 0.0); }
+BENCHMARK(BM_SmartMoveSelection20x24_Iiwa)->Unit(benchmark::kMillisecond);
+
+void BM_SmartGraspSelection20x24_Iiwa(benchmark::State& state) { selection(state, "iiwa-sim", 0.1); }
+BENCHMARK(BM_SmartGraspSelection20x24_Iiwa)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace costar::bench

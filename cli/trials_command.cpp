@@ -11,6 +11,7 @@
 
 #include "bt/plan.h"
 #include "cli/inject_option.h"
+#include "trials/disturbance.h"
 #include "trials/judge.h"
 #include "trials/trials.h"
 
@@ -149,6 +150,9 @@ int run(Options options) {
         std::printf("[%4d/%d] trial %d (seed %llu): FAILURE at %s: %s\n", done, total, result.index,
                     static_cast<unsigned long long>(result.seed), result.failure_path.c_str(), result.reason.c_str());
       }
+      for (const std::string& event : result.disturbances) {
+        std::printf("         disturbed: %s\n", event.c_str());
+      }
       std::fflush(stdout);
     });
   } catch (const bt::PlanError& error) {
@@ -192,7 +196,9 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
       "trials", "Rerun a plan as N randomized trials in the simulated cell, judged from its true state");
   command->add_option("plan", options->trials.plan, "plan file (required unless merging)")->check(CLI::ExistingFile);
   command->add_option("--judge", options->trials.judge, "how success is judged (see below; required)");
-  command->add_option("--scene", options->trials.scene, "scene file (default sim/scenes/assembly.json)")
+  command->add_option("-w,--workcell", options->trials.workcell, "simulated workcell the trials run in")
+      ->capture_default_str();
+  command->add_option("--scene", options->trials.scene, "scene file (default: the workcell's)")
       ->check(CLI::ExistingFile);
   command->add_option("-n,--n", options->trials.count, "number of trials")
       ->check(CLI::Range(1, 100000))
@@ -226,6 +232,19 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
   command->add_flag("--calibrate", options->trials.calibrate,
                     "run Calibrate in each trial's cell before the plan (as a technician would after set-up)");
   addInjectOption(command, options->trials.inject);
+  command
+      ->add_option("--disturb", options->trials.disturb,
+                   "disturb the simulated world in each trial (repeatable): " + trials::disturbanceGrammar())
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            try {
+              trials::parseDisturbance(text);
+            } catch (const std::invalid_argument& e) {
+              return e.what();
+            }
+            return {};
+          },
+          "KIND[@grasp=N]"));
   command->add_option("--json", options->json, "write the summary and every trial as JSON");
   command->add_option("--plot", options->plot, "write a PNG: success rate, failures, cycle times");
   command->add_option("--require", options->require, "exit 1 when the success rate is below this (0..1)")

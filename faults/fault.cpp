@@ -10,12 +10,13 @@ namespace costar::faults {
 
 namespace {
 
-constexpr std::array<std::pair<FaultKind, const char*>, 6> kKinds = {{{FaultKind::kThrow, "throw"},
+constexpr std::array<std::pair<FaultKind, const char*>, 7> kKinds = {{{FaultKind::kThrow, "throw"},
                                                                       {FaultKind::kHang, "hang"},
                                                                       {FaultKind::kNan, "nan"},
                                                                       {FaultKind::kEmptyFrame, "empty-frame"},
                                                                       {FaultKind::kNanFrame, "nan-frame"},
-                                                                      {FaultKind::kDie, "die"}}};
+                                                                      {FaultKind::kDie, "die"},
+                                                                      {FaultKind::kDropFrame, "drop-frame"}}};
 
 std::string kindList() {
   std::string list;
@@ -32,7 +33,7 @@ std::vector<FaultKind> kindsOf(TargetType type) {
     case TargetType::kGripperDriver:
       return {FaultKind::kThrow, FaultKind::kHang, FaultKind::kNan};
     case TargetType::kCamera:
-      return {FaultKind::kThrow, FaultKind::kHang, FaultKind::kEmptyFrame, FaultKind::kNanFrame};
+      return {FaultKind::kThrow, FaultKind::kHang, FaultKind::kEmptyFrame, FaultKind::kNanFrame, FaultKind::kDropFrame};
     case TargetType::kComponent:
       return {FaultKind::kThrow, FaultKind::kHang, FaultKind::kDie};
   }
@@ -83,7 +84,8 @@ std::string faultGrammar() {
   return "KIND:TARGET@WHEN, e.g. nan:arm-driver@t=2.5s, hang:perception@op=1, die:smartmove@random=8s\n"
          "  TARGET: arm-driver, gripper-driver, camera, or a component's name (arm, gripper, perception, ...)\n"
          "  KIND:   drivers: throw, hang (readings stop updating), nan\n"
-         "          camera: throw, hang (the same old frame), empty-frame, nan-frame\n"
+         "          camera: throw, hang (the same old frame), empty-frame, nan-frame, drop-frame (one empty frame, "
+         "once)\n"
          "          components: throw (the next start or poll, once), hang (stops answering), die\n"
          "  WHEN:   t=SECONDS (clock time), op=N (the target's Nth command, start or frame),\n"
          "          random[=MAXs] (uniform in [0, MAX), default 10 s, drawn from --seed)";

@@ -8,7 +8,8 @@
 //           any component's name        arm, gripper, perception, smartmove, predicator, ...
 //   KIND    drivers:    throw (reads fail), hang (readings stop updating), nan (readings are NaN)
 //           camera:     throw (capture fails), hang (the same old frame again),
-//                       empty-frame (no pixels), nan-frame (every depth NaN)
+//                       empty-frame (no pixels), nan-frame (every depth NaN),
+//                       drop-frame (one frame comes empty, once: a frame lost on the way)
 //           components: throw (its next start or poll throws, once),
 //                       hang (stops answering: every call gets no answer in time),
 //                       die (its process is gone: every call fails)
@@ -17,7 +18,7 @@
 //                          command, the camera's Nth frame
 //           random[=MAXs]  at a time drawn uniformly in [0, MAX) (default 10 s) from the seed
 //
-// Faults other than a component's throw last: a broken device stays broken. The injector
+// Faults other than a component's throw and a camera's drop-frame last: a broken device stays broken. The injector
 // (faults/injector.h) breaks things; what keeps the cell safe is on the receiving side
 // (docs/FAULTS.md).
 
@@ -29,7 +30,7 @@
 
 namespace costar::faults {
 
-enum class FaultKind { kThrow, kHang, kNan, kEmptyFrame, kNanFrame, kDie };
+enum class FaultKind { kThrow, kHang, kNan, kEmptyFrame, kNanFrame, kDie, kDropFrame };
 const char* toString(FaultKind kind);
 
 /// What a target is, which decides the kinds it accepts.

@@ -101,13 +101,20 @@ class FaultyCamera final : public camera::RgbdCamera {
   Duration framePeriod() const override { return inner_.framePeriod(); }
 
   camera::RgbdFrame capture() override {
-    if (!injector_.active(fault_, true)) {
+    FaultRecord& record = injector_.record(fault_);
+    if (!injector_.active(fault_, true) || (record.spec.kind == FaultKind::kDropFrame && record.spent)) {
       last_ = inner_.capture();
       return last_;
     }
     injector_.effect(fault_);
-    const FaultRecord& record = injector_.record(fault_);
     switch (record.spec.kind) {
+      case FaultKind::kDropFrame: {  // one frame lost on the way, then the stream goes on
+        record.spent = true;
+        camera::RgbdFrame frame = inner_.capture();
+        frame.points.clear();
+        frame.rgb = RgbImage();
+        return frame;
+      }
       case FaultKind::kThrow:
         throw std::runtime_error("camera: capturing a frame failed" + injected(record));
       case FaultKind::kHang:

@@ -1,11 +1,13 @@
 #include "planning/robot_model.h"
 
 #include <urdf_parser/urdf_parser.h>
+
 #include <kdl/chain.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainiksolverpos_lma.hpp>
 #include <kdl/tree.hpp>
 #include <kdl_parser/kdl_parser.hpp>
+#include <pugixml.hpp>
 
 #include <fstream>
 #include <map>
@@ -64,14 +66,71 @@ RobotModel::RobotModel(RobotModel&&) noexcept = default;
 RobotModel& RobotModel::operator=(RobotModel&&) noexcept = default;
 RobotModel::~RobotModel() = default;
 
-RobotModel RobotModel::fromUrdf(const std::filesystem::path& path, const std::string& base_link,
-                                const std::string& tip_link) {
+namespace {
+
+std::string readUrdf(const std::filesystem::path& path) {
   std::ifstream stream(path);
   if (!stream) {
     throw std::runtime_error("cannot open URDF '" + path.string() + "'");
   }
   std::stringstream text;
   text << stream.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+RobotModel RobotModel::fromUrdf(const std::filesystem::path& path, const std::string& base_link,
+                                const std::string& tip_link) {
+  return fromUrdfText(readUrdf(path), path, base_link, tip_link);
+}
+
+RobotModel RobotModel::fromUrdf(const std::filesystem::path& arm, const std::filesystem::path& tool,
+                                const std::string& flange_link, const std::string& base_link,
+                                const std::string& tip_link) {
+  const std::string label = arm.string() + "' + '" + tool.string();
+  return fromUrdfText(mountUrdf(readUrdf(arm), readUrdf(tool), flange_link, label), label, base_link, tip_link);
+}
+
+std::string mountUrdf(const std::string& arm, const std::string& tool, const std::string& flange_link,
+                      const std::string& label) {
+  pugi::xml_document arm_doc;
+  pugi::xml_document tool_doc;
+  if (!arm_doc.load_string(arm.c_str()) || !tool_doc.load_string(tool.c_str())) {
+    throw std::runtime_error("URDF '" + label + "' cannot be parsed");
+  }
+  pugi::xml_node robot = arm_doc.child("robot");
+  const pugi::xml_node tool_robot = tool_doc.child("robot");
+  pugi::xml_node flange = robot.find_child_by_attribute("link", "name", flange_link.c_str());
+  const pugi::xml_node mount = tool_robot.find_child_by_attribute("link", "name", "mount");
+  if (!robot || !tool_robot || !flange || !mount) {
+    throw std::runtime_error("URDF '" + label + "': the arm needs a link '" + flange_link +
+                             "' (its flange) and the tool a link 'mount'");
+  }
+  for (const pugi::xml_node child : mount.children()) {
+    flange.append_copy(child);
+  }
+  for (const pugi::xml_node child : tool_robot.children()) {
+    if (child == mount || child.type() != pugi::node_element) {
+      continue;
+    }
+    pugi::xml_node copy = robot.append_copy(child);
+    if (std::string(copy.name()) == "joint") {
+      pugi::xml_attribute parent = copy.child("parent").attribute("link");
+      if (std::string(parent.value()) == "mount") {
+        parent.set_value(flange_link.c_str());
+      }
+    }
+  }
+  std::ostringstream out;
+  arm_doc.save(out, "  ");
+  return out.str();
+}
+
+RobotModel RobotModel::fromUrdfText(const std::string& urdf_text, const std::filesystem::path& path,
+                                    const std::string& base_link, const std::string& tip_link) {
+  std::stringstream text;
+  text << urdf_text;
   const urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(text.str());
   if (!model) {
     throw std::runtime_error("URDF '" + path.string() + "' cannot be parsed");

@@ -28,12 +28,26 @@ struct LinkGeometry {
   std::vector<CollisionShape> shapes;
 };
 
+/// An arm's URDF with a tool's URDF mounted on the arm's link `flange_link`: the tool's link
+/// "mount" stands for the flange (its shapes are added to the flange link, its joints start
+/// there); the tool's other links and joints are added as they are. `label` names the files in
+/// messages. @throws std::runtime_error when either is not URDF or lacks those links.
+std::string mountUrdf(const std::string& arm, const std::string& tool, const std::string& flange_link,
+                      const std::string& label);
+
 class RobotModel {
  public:
   /// Reads the chain from `base_link` to `tip_link` of a URDF file.
   /// @throws std::runtime_error naming the file and the problem.
   static RobotModel fromUrdf(const std::filesystem::path& urdf, const std::string& base_link,
                              const std::string& tip_link);
+  /// The same for an arm with a tool mounted on its flange (mountUrdf()): e.g. the arm's URDF
+  /// and its gripper's, the tip the gripper's tool centre point.
+  static RobotModel fromUrdf(const std::filesystem::path& arm, const std::filesystem::path& tool,
+                             const std::string& flange_link, const std::string& base_link, const std::string& tip_link);
+  /// From URDF text; `path` names it in messages.
+  static RobotModel fromUrdfText(const std::string& urdf, const std::filesystem::path& path,
+                                 const std::string& base_link, const std::string& tip_link);
   RobotModel(RobotModel&&) noexcept;
   RobotModel& operator=(RobotModel&&) noexcept;
   ~RobotModel();

@@ -11,7 +11,7 @@ writes, into OUTPUT_DIR:
 - NAME.xml: the gripper alone, fixed at the world origin (the two above put together).
 sim/adaptive_gripper_sim.h mounts the first two into a workcell model (mountAdaptiveGripper).
 
-Conventions (those of sim/models/ur5_workcell.xml): gripper geoms contype 2, conaffinity 0
+Conventions (those of sim/models/gripper_parallel-2f.xml): gripper geoms contype 2, conaffinity 0
 (they touch parts and the table box, not each other); pads condim 4 with friction 1.2. Each
 finger is an underactuated chain of three hinges (proximal, medial, distal) about the finger's
 -x axis (closing moves the tip along the finger's +y); one tendon sums the three angles, and a

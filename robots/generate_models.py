@@ -8,7 +8,7 @@ OUTPUT_DIR/NAME.xml, an MJCF model of the arm alone for MuJoCo, and OUTPUT_DIR/N
 same chain for Orocos KDL (kdl_parser) and collision checking (planning::RobotModel). Both are
 made from the same numbers, so the simulator and the planner cannot disagree.
 
-Conventions (those of sim/models/ur5_workcell.xml and sim/models/ur5.urdf):
+Conventions (those of sim/models/ur5_arm.xml and sim/models/ur5_arm.urdf):
 - The base link is fixed to the world at the origin; every link frame sits on its joint.
 - MJCF: arm geoms contype 2, conaffinity 0 (they touch the table and parts, not each other);
   one motor actuator per joint named after it, ctrlrange the joint's torque limit (the

@@ -77,7 +77,7 @@ struct Scene {
   std::optional<CameraOffset> camera_offset;
 };
 
-/// The table top (x, y in m), as sim/models/ur5_workcell.xml has it; regions and fixed
+/// The table top (x, y in m), as sim/models/table_cell.xml has it; regions and fixed
 /// placements must lie on it.
 Region tableTop();
 

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "core/paths.h"
+#include "sim/cell_model.h"
 #include "sim/gl_context.h"
 
 namespace costar::sim {
@@ -25,16 +26,6 @@ constexpr double kArmKd = 2.0 * kArmOmega;
 
 // Threads that turn a depth image into a noisy cloud (the noise does not depend on it).
 constexpr int kNoiseThreads = 2;
-
-std::string readText(const std::filesystem::path& file) {
-  std::ifstream stream(file);
-  if (!stream) {
-    throw std::runtime_error("cannot open '" + file.string() + "'");
-  }
-  std::stringstream text;
-  text << stream.rdbuf();
-  return text.str();
-}
 
 void replaceMarker(std::string& text, const std::string& marker, const std::string& content) {
   const auto at = text.find(marker);
@@ -292,8 +283,13 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   const arm::RobotDescription robot =
       options.robot ? *options.robot : arm::loadRobotDescription(arm::robotDescriptionFile(kDefaultRobot), root);
 
-  // Model: the workcell template plus a material per class colour and a body per part.
-  std::string xml = readText(robot.mjcf);
+  // Model: the cell, the robot and its gripper composed, plus a material per class colour and
+  // a body per part.
+  const auto under_root = [&root](const std::filesystem::path& path) {
+    return path.is_absolute() ? path : root / path;
+  };
+  std::string xml = composeCellModel({under_root(options.cell_model), robot.mjcf, under_root(options.gripper_model),
+                                      robot.urdf_tool_link, options.robot_base});
   std::string assets;
   for (const auto& object : impl->classes) {
     for (const auto& [color_name, rgb] : object.colors) {
@@ -307,11 +303,6 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
                                      [&](const world::ObjectClass& c) { return c.name == part.object_class; });
     bodies += partBody(part, *object);
   }
-  // Textures and meshes named in the model are files beside it.
-  const std::string models = robot.mjcf.parent_path().string();
-  replaceMarker(
-      xml, "<compiler angle=\"radian\" autolimits=\"true\"/>",
-      "<compiler angle=\"radian\" autolimits=\"true\" texturedir=\"" + models + "\" meshdir=\"" + models + "\"/>");
   replaceMarker(xml, "<!--PART_ASSETS-->", assets);
   replaceMarker(xml, "<!--PARTS-->", bodies);
 
@@ -354,7 +345,16 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->mountCamera(options.camera_offset.value_or(
       scene.camera_offset ? cameraOffsetPose(*scene.camera_offset, options.placement_seed.value_or(scene.seed))
                           : world::Pose::Identity()));
-  impl->tool_body = impl->id(mjOBJ_BODY, "tool0");  // the flange (the workcell model names it, like the gripper)
+  impl->tool_body = impl->id(mjOBJ_BODY, robot.urdf_tool_link.c_str());  // the flange, as the robot names it
+  if (options.robot_base) {
+    mj_kinematics(m, impl->data);
+    const world::Pose base = impl->bodyPose(impl->id(mjOBJ_BODY, robot.base_link.c_str()));
+    if ((base.matrix() - options.robot_base->matrix()).cwiseAbs().maxCoeff() > 1e-9) {
+      throw std::runtime_error("the robot's base body '" + robot.base_link + "' stands at " + vec(base.translation()) +
+                               " in the model, the workcell says " + vec(options.robot_base->translation()) +
+                               " (or turned otherwise)");
+    }
+  }
   for (const auto& part : impl->placements) {
     impl->part_bodies.push_back(impl->id(mjOBJ_BODY, part.name.c_str()));
   }

@@ -1,10 +1,11 @@
 #pragma once
-// The embedded default robot: a MuJoCo simulation of the UR5 workcell (arm, 2-finger gripper,
-// table, parts, RGB-D camera). No MuJoCo type appears here; MuJoCo stays in sim/*.cpp.
+// A MuJoCo simulation of a workcell: an arm (the UR5 by default, any arm with a robot
+// description), the 2-finger gripper on its flange, table, parts, RGB-D camera. No MuJoCo type appears here; MuJoCo
+// stays in sim/*.cpp.
 //
 // Physics advances in lockstep with a SimClock (attach()): each tick's interval is
 // simulated in fixed steps of the model's timestep (2 ms). The arm follows joint setpoints
-// with computed-torque control within the UR5's torque limits; the gripper's fingers close by
+// with computed-torque control within the arm's torque limits; the gripper's fingers close by
 // a force-limited servo, so parts are held only by contact and friction.
 //
 // Threads: a Simulation is used by one thread at a time, but belongs to none: it may be made,
@@ -52,9 +53,16 @@ inline constexpr const char* kDefaultRobot = "ur5";
 struct SimulationOptions {
   /// Folder with data/objects and sim/models (default: the repository, see core/paths.h).
   std::filesystem::path data_root;
-  /// The arm: its MuJoCo model (the workcell around it), joint names, home and links. Default:
+  /// The arm: its MuJoCo model (the arm alone), joint names, home, flange and links. Default:
   /// kDefaultRobot's description, its model files under `data_root`.
   std::optional<arm::RobotDescription> robot;
+  /// The cell around the robot (table, camera) and the gripper on its flange: MJCF pieces
+  /// composed with the robot's model (sim/cell_model.h). Relative paths are under `data_root`.
+  std::filesystem::path cell_model = "sim/models/table_cell.xml";
+  std::filesystem::path gripper_model = "sim/models/gripper_parallel-2f.xml";
+  /// Where the robot's base stands in the world; the composed model must agree (checked).
+  /// Absent: not checked.
+  std::optional<world::Pose> robot_base;
   /// Arm configuration at the start (radians). Default: the robot's home, tool pointing down.
   std::optional<ArmJoints> initial_arm;
   /// Seed of the random part placement (default: the scene's seed).
@@ -167,7 +175,5 @@ class Simulation {
   explicit Simulation(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
-
-/// The UR5's joint names in the simulator and the URDF, in order.
 
 }  // namespace costar::sim

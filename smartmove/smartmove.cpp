@@ -1,5 +1,9 @@
 #include "smartmove/smartmove.h"
 
+#include <numbers>
+
+#include "smartmove/footprint.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -42,13 +46,22 @@ class Script final : public RunningOperation {
   Script(std::vector<Step> steps, nlohmann::json data, std::function<void(bool)> on_end)
       : steps_(std::move(steps)), data_(std::move(data)), on_end_(std::move(on_end)) {}
 
+  /// When a step from `from` to `to` fails, `backing_off` steps run before the failure is
+  /// reported (e.g. the tool lifted clear of a part it missed), their outcome added to it.
+  void backOff(std::size_t from, std::size_t to, std::vector<Step> backing_off, std::string done_note) {
+    back_off_from_ = from;
+    back_off_to_ = to;
+    back_off_ = std::move(backing_off);
+    back_off_note_ = std::move(done_note);
+  }
+
   OperationResult poll() override {
     while (next_ < steps_.size() || current_) {
       if (!current_) {
         try {
           current_ = steps_[next_].start();
         } catch (const std::exception& e) {
-          return finish(OperationResult::failure(steps_[next_].what + ": " + e.what(), data_));
+          return fail(steps_[next_].what + ": " + e.what());
         }
       }
       OperationResult result = current_->poll();
@@ -58,11 +71,11 @@ class Script final : public RunningOperation {
       current_.reset();
       const Step& step = steps_[next_++];
       if (result.state == OperationState::kFailure) {
-        return finish(OperationResult::failure(step.what + ": " + result.reason, data_));
+        return fail(step.what + ": " + result.reason);
       }
       if (step.check) {
         if (const std::string problem = step.check(result); !problem.empty()) {
-          return finish(OperationResult::failure(step.what + ": " + problem, data_));
+          return fail(step.what + ": " + problem);
         }
       }
     }
@@ -81,7 +94,26 @@ class Script final : public RunningOperation {
   }
 
  private:
+  /// Steps that run once the script has failed (backing off), then the failure.
+  OperationResult fail(std::string reason) {
+    const std::size_t failed_step = next_ - 1;  // poll() has moved past it
+    if (!failure_ && next_ > 0 && failed_step >= back_off_from_ && failed_step <= back_off_to_ && !back_off_.empty()) {
+      failure_ = std::move(reason);
+      steps_ = std::move(back_off_);
+      back_off_.clear();
+      next_ = 0;
+      return poll();
+    }
+    if (failure_) {  // backing off failed too: both reasons
+      return finish(OperationResult::failure(*failure_ + "; backing off, " + reason, data_));
+    }
+    return finish(OperationResult::failure(std::move(reason), data_));
+  }
+
   OperationResult finish(OperationResult result) {
+    if (failure_ && result.state == OperationState::kSuccess) {
+      result = OperationResult::failure(*failure_ + " (" + back_off_note_ + ")", data_);
+    }
     if (on_end_) {
       on_end_(result.state == OperationState::kSuccess);
       on_end_ = nullptr;
@@ -94,6 +126,11 @@ class Script final : public RunningOperation {
   std::unique_ptr<RunningOperation> current_;
   nlohmann::json data_;
   std::function<void(bool)> on_end_;
+  std::size_t back_off_from_ = 0;
+  std::size_t back_off_to_ = 0;
+  std::vector<Step> back_off_;
+  std::string back_off_note_;
+  std::optional<std::string> failure_;
 };
 
 std::unique_ptr<RunningOperation> failed(std::string reason, nlohmann::json data = {}) {
@@ -171,6 +208,9 @@ SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Compon
   ParamSpec speed{"speed", ValueType::kDouble, "fraction of the arm's top speed", config_.default_speed};
   speed.min = 0.01;
   speed.max = 1.0;
+  ParamSpec push_distance{"distance", ValueType::kDouble, "how far the part is pushed (m)", 0.03};
+  push_distance.min = 0.01;
+  push_distance.max = 0.1;
   std::vector<std::string> optional_classes = class_names;
   optional_classes.insert(optional_classes.begin(), "");
   ParamSpec target_class{"target_class", ValueType::kString, "put the part on a part of this class", std::string(),
@@ -227,6 +267,11 @@ SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Compon
                               {target_class, predicates, target, approach, speed},
                               component::OperationKind::kRobotAction,
                               check_release},
+                             {"SmartPush",
+                              "Pushes the most crowded part that satisfies the conditions where it gets more room, "
+                              "with the closed gripper (when none can be grasped; look again after it).",
+                              {object_class, predicates, push_distance, speed},
+                              component::OperationKind::kRobotAction},
                              {"TeachGrasp",
                               "Saves how the gripper holds the nearest part of a class as a named grasp.",
                               {object_class, {"grasp", ValueType::kString, "name of the new grasp", {}}},
@@ -580,6 +625,9 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
     speed = params.at("speed").asDouble();
   }
 
+  if (operation == "SmartPush") {
+    return beginPush(text("object_class"), patterns, params.at("distance").asDouble(), speed);
+  }
   if (operation == "SmartMove" || operation == "SmartGrasp") {
     const bool grasping = operation == "SmartGrasp";
     const std::string object_class = text("object_class");
@@ -660,8 +708,42 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
                      [this](const OperationResult&) -> std::string {
                        return world_.holds("gripper_holding", {}) || !held_ ? std::string() : "the part slipped out";
                      }});
-    return std::make_unique<Script>(std::move(steps), data,
-                                    [this, object](bool) { allowGripperContact(object, false); });
+    // A grasp that fails once the tool went down (it closed on nothing, or on the part's top
+    // because the part moved) opens and lifts straight up before it reports the failure, so
+    // that the tool is clear of where the part was seen and a plan that looks again can go on
+    // (from down there every motion would start in collision with the part as it was seen).
+    const std::size_t approach_step = 2;
+    const std::size_t close_step = 3;
+    auto script =
+        std::make_unique<Script>(std::move(steps), data, [this, object](bool) { allowGripperContact(object, false); });
+    script->backOff(
+        approach_step, close_step,
+        {{"open the gripper",
+          [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); }, nullptr},
+         {"lift clear",
+          [this, object] {
+            // Straight up from wherever the miss left the fingers, even beside a neighbour (a
+            // part moved or caught by the fingers): up is away from every part on the table.
+            std::vector<std::string> beside;
+            for (const std::string& obstacle : obstacles_) {
+              if (obstacle != partObstacle(object)) {
+                beside.push_back(obstacle);
+                for (const auto& link : config_.gripper_links) {
+                  collisions_.allow(link, obstacle);
+                }
+              }
+            }
+            arm::MotionPlan lift = arm_.planLine(up(config_.retreat) * arm_.endpoint(), config_.approach_speed);
+            for (const std::string& obstacle : beside) {
+              for (const auto& link : config_.gripper_links) {
+                collisions_.disallow(link, obstacle);
+              }
+            }
+            return arm_.execute(std::move(lift), "back off");
+          },
+          nullptr}},
+        "the tool backed off up");
+    return script;
   }
 
   if (operation == "SmartRelease") {
@@ -872,6 +954,204 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
         OperationResult::success({{"object", nearest->first}, {"position", {p.x(), p.y(), p.z()}}}));
   }
   return failed("unknown operation " + operation);
+}
+
+std::unique_ptr<RunningOperation> SmartMoveComponent::beginPush(const std::string& object_class,
+                                                                const std::vector<predicator::Pattern>& patterns,
+                                                                double distance, double speed) {
+  constexpr int kDirections = 16;
+  constexpr double kStartGap = 0.012;  // m between the fingers and the part before the push
+  constexpr double kKeepGap = 0.005;   // m: a push leaves the part at least this far from others
+  if (held_ && world_.holds("gripper_holding", {})) {
+    return failed("the gripper holds " + *held_ + ": release it first");
+  }
+  const world::ObjectClass* pushed_class = objectClass(object_class);
+  if (pushed_class == nullptr) {
+    return failed("unknown object class '" + object_class + "'");
+  }
+  syncObstacles();
+  const Matches matches = matching(object_class, patterns);
+  if (matches.objects.empty()) {
+    return failed(matches.rejected.empty()
+                      ? "no part of the class is known (detect the parts first)"
+                      : "no " + object_class + " satisfies the conditions (" + matches.rejected.front().first + ": " +
+                            matches.rejected.front().second + ")");
+  }
+  // Every known part, to measure the room around the pushed one.
+  struct Known {
+    std::string name;
+    const world::ObjectClass* object_class;
+    world::Pose pose;
+  };
+  std::vector<Known> known;
+  for (const world::Predicate* is_a : world_.predicates("is_a")) {
+    const world::ObjectClass* c = is_a->args.size() == 2 ? objectClass(is_a->args[1]) : nullptr;
+    const auto pose = c != nullptr ? world_.worldPose(is_a->args[0]) : std::nullopt;
+    if (pose) {
+      known.push_back({is_a->args[0], c, *pose});
+    }
+  }
+  // The room a part has: the gap between its footprint and the nearest other part's (it must
+  // not shrink below kKeepGap), and the distance from its centre to the nearest other
+  // footprint (which a push should increase: a link slid along a parallel neighbour until its
+  // middle is past the neighbour's end can be taken by the middle).
+  struct Room {
+    double gap = 1.0;
+    double centre = 1.0;
+  };
+  const auto room = [&](const std::string& name, const world::Pose& pose) {
+    Room r;
+    for (const Known& other : known) {
+      if (other.name != name) {
+        r.gap = std::min(r.gap, footprintGap(*pushed_class, pose, *other.object_class, other.pose));
+        r.centre =
+            std::min(r.centre, distanceToFootprint(pose.translation().head<2>(), *other.object_class, other.pose));
+      }
+    }
+    return r;
+  };
+  // The closed fingers lead the push with their narrower side across it: the tool's x or y
+  // along the push, whichever leaves the fingers less wide across; their half length along it.
+  double half_x = 0.015;
+  double half_y = 0.015;
+  if (config_.fingers) {
+    half_x = half_y = 0.0;
+    for (const gripper::FingerBox& box : config_.fingers->at(0.0)) {
+      half_x = std::max(half_x, std::abs(box.centre.x()) + 0.5 * box.size.x());
+      half_y = std::max(half_y, std::abs(box.centre.y()) + 0.5 * box.size.y());
+    }
+  }
+  const auto grasp = grasps_.defaultFor(object_class);
+  // The most crowded part first.
+  std::vector<std::pair<Room, std::pair<std::string, world::Pose>>> order;
+  for (const auto& entry : matches.objects) {
+    order.push_back({room(entry.first, entry.second), entry});
+  }
+  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first.centre < b.first.centre; });
+  const PlannedFingers fingers(*this);
+  fingers.at(0.0);
+  nlohmann::json tried = nlohmann::json::array();
+  for (const auto& [room_now, entry] : order) {
+    const auto& [object, pose] = entry;
+    std::vector<std::pair<Room, double>> directions;  // room after the push, angle
+    for (int k = 0; k < kDirections; ++k) {
+      const double angle = 2.0 * std::numbers::pi * k / kDirections;
+      world::Pose moved = pose;
+      moved.translation() += distance * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0);
+      const Room after = room(object, moved);
+      if (after.gap >= std::min(room_now.gap, kKeepGap) && after.centre > room_now.centre + 0.002) {
+        directions.emplace_back(after, angle);
+      }
+    }
+    std::sort(directions.begin(), directions.end(),
+              [](const auto& a, const auto& b) { return a.first.centre > b.first.centre; });
+    for (const auto& [room_after, angle] : directions) {
+      const Eigen::Vector3d direction(std::cos(angle), std::sin(angle), 0.0);
+      const Eigen::AlignedBox3d bounds = pushed_class->bounds();
+      double half = 0.0;
+      for (int i = 0; i < 8; ++i) {
+        const Eigen::Vector3d corner = pose * bounds.corner(static_cast<Eigen::AlignedBox3d::CornerType>(i));
+        half = std::max(half, direction.dot(corner - pose.translation()));
+      }
+      // The tool pointing down, its x or y along the push (the narrower way across first), at
+      // the height it grasps the part.
+      for (const bool x_leads : {half_y <= half_x, half_y > half_x}) {
+        const double finger_half = x_leads ? half_x : half_y;
+        world::Pose start = world::Pose::Identity();
+        const Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();
+        start.linear().col(2) = down;
+        if (x_leads) {
+          start.linear().col(0) = direction;
+          start.linear().col(1) = down.cross(direction);
+        } else {
+          start.linear().col(1) = direction;
+          start.linear().col(0) = direction.cross(down);
+        }
+        const double height = grasp ? (pose * grasp->tcp_in_object).translation().z() : pose.translation().z();
+        start.translation() = pose.translation() - (half + finger_half + kStartGap) * direction;
+        start.translation().z() = height;
+        world::Pose end = start;
+        end.translation() += (distance + kStartGap) * direction;
+        const world::Pose above = up(config_.approach) * start;
+        nlohmann::json attempt = {{"object", object},
+                                  {"direction_deg", angle * 180.0 / std::numbers::pi},
+                                  {"leading_tool_axis", x_leads ? "x" : "y"},
+                                  {"centre_room_before", room_now.centre},
+                                  {"centre_room_after", room_after.centre}};
+        std::string reason;
+        const auto beside = freeConfiguration(arm_.solutions(start, arm_.joints()), collisions_, reason);
+        const auto top = beside ? freeConfiguration(arm_.solutions(above, *beside), collisions_, reason) : std::nullopt;
+        if (!beside || !top) {
+          attempt["rejected"] =
+              "no collision-free tool pose beside it: " + (reason.empty() ? "no IK solution" : reason);
+          tried.push_back(attempt);
+          continue;
+        }
+        const arm::MotionPlan descent = arm_.planLine(*top, start, config_.approach_speed);
+        if (!descent.ok()) {
+          attempt["rejected"] = "no straight way down beside it: " + descent.failure;
+          tried.push_back(attempt);
+          continue;
+        }
+        allowGripperContact(object, true);
+        const arm::MotionPlan push = arm_.planLine(descent.goal, end, config_.approach_speed);
+        allowGripperContact(object, false);
+        if (!push.ok()) {
+          attempt["rejected"] = "the push is blocked: " + push.failure;
+          tried.push_back(attempt);
+          continue;
+        }
+        nlohmann::json data = {{"object", object},
+                               {"direction_deg", angle * 180.0 / std::numbers::pi},
+                               {"distance", distance},
+                               {"centre_room_before", room_now.centre},
+                               {"centre_room_after", room_after.centre},
+                               {"tried", tried}};
+        const arm::JointVector seed = *top;
+        std::vector<Script::Step> steps;
+        steps.push_back({"close the gripper",
+                         [this] {
+                           return std::make_unique<ComponentStep>(gripper_, "Close",
+                                                                  component::ParamMap{{"speed", 0.5}, {"force", 40.0}});
+                         },
+                         nullptr});
+        steps.push_back({"move beside " + object,
+                         [this, above, seed, speed] {
+                           return moveToFreeConfiguration(above, seed, speed, "pre-push", "no collision-free pre-push");
+                         },
+                         nullptr});
+        steps.push_back(
+            {"go down beside " + object,
+             [this, start] { return arm_.execute(arm_.planLine(start, config_.approach_speed), "descent"); }, nullptr});
+        steps.push_back({"push " + object,
+                         [this, end, object] {
+                           allowGripperContact(object, true);
+                           return arm_.execute(arm_.planLine(end, config_.approach_speed), "push");
+                         },
+                         nullptr});
+        steps.push_back({"lift clear",
+                         [this] {
+                           return arm_.execute(
+                               arm_.planLine(up(config_.retreat) * arm_.endpoint(), config_.approach_speed), "retreat");
+                         },
+                         nullptr});
+        return std::make_unique<Script>(std::move(steps), data,
+                                        [this, object](bool) { allowGripperContact(object, false); });
+      }
+    }
+  }
+  std::map<std::string, int> reasons;  // why the pushes were not made, by kind
+  for (const auto& attempt : tried) {
+    const std::string reason = attempt.value("rejected", "");
+    ++reasons[reason.substr(0, reason.find(':'))];
+  }
+  std::string why;
+  for (const auto& [reason, count] : reasons) {
+    why += (why.empty() ? "" : ", ") + std::to_string(count) + " " + reason;
+  }
+  return failed("no " + object_class + " can be pushed where it gets more room (" + std::to_string(tried.size()) +
+                    " pushes that would give it more room, none possible" + (why.empty() ? "" : ": " + why) + ")",
+                {{"tried", tried}});
 }
 
 }  // namespace costar::smartmove

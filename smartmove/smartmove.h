@@ -14,6 +14,12 @@
 //                                                 at a free spot on the table that satisfies the
 //                                                 predicates), lowering onto it in a straight
 //                                                 line, opens, lifts
+//   SmartPush(object_class, predicates, distance) when no grasp is feasible among crowded parts:
+//                                                 pushes the most crowded matching part
+//                                                 `distance` along the direction that leaves it
+//                                                 the most room, with the closed fingers (moved
+//                                                 collision-free above its far side, down, across,
+//                                                 up); the plan then looks again
 //   TeachGrasp(object_class, grasp)               stores the tool's pose relative to the nearest
 //                                                 part of the class as a named grasp
 //
@@ -139,6 +145,10 @@ class SmartMoveComponent final : public component::LocalComponent {
   std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
                                                      const component::ParamMap& params) override;
   const world::ObjectClass* objectClass(const std::string& name) const;
+  /// SmartPush (see the top of this file).
+  std::unique_ptr<component::RunningOperation> beginPush(const std::string& object_class,
+                                                         const std::vector<predicator::Pattern>& patterns,
+                                                         double distance, double speed);
   /// Why a spot on the table does not satisfy `pattern` (empty if it does).
   std::string spotFailsPattern(const Eigen::Vector3d& spot, const predicator::Pattern& pattern) const;
   ArmModel armModel() const;

@@ -20,6 +20,7 @@
 #include "core/files.h"
 #include "faults/injector.h"
 #include "sim/simulation.h"
+#include "trials/disturbance.h"
 #include "trials/judge.h"
 #include "workcell/workcell.h"
 
@@ -27,16 +28,44 @@ namespace costar::trials {
 
 namespace {
 
+/// The process's resident set size in kB (Linux /proc/self/status), 0 when unknown.
+long residentKilobytes() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) {
+      return std::strtol(line.c_str() + 6, nullptr, 10);
+    }
+  }
+  return 0;
+}
+
+std::vector<DisturbanceSpec> parseDisturbances(const std::vector<std::string>& texts) {
+  std::vector<DisturbanceSpec> specs;
+  for (const std::string& text : texts) {
+    specs.push_back(parseDisturbance(text));
+  }
+  return specs;
+}
+
 /// The workcell of trial `index` (seed options.seed + index), fresh.
 std::unique_ptr<workcell::Workcell> trialWorkcell(const TrialOptions& options, int index) {
   const std::uint64_t seed = options.seed + static_cast<std::uint64_t>(index);
-  workcell::WorkcellOptions cell_options{
-      .name = "ur5-sim",
-      .scene = options.scene,
-      .seed = seed,
-      .waypoints = options.waypoints,
-      .memory_only = true,
-      .faults = options.inject.empty() ? nullptr : faults::Injector::fromText(options.inject, seed)};
+  workcell::WorkcellOptions cell_options{.name = options.workcell,
+                                         .scene = options.scene,
+                                         .seed = seed,
+                                         .waypoints = options.waypoints,
+                                         .memory_only = true,
+                                         .faults = nullptr};
+  // The faults asked for, and those the trial's disturbances need (drawn from the same seed as
+  // the Disturber that runOne makes).
+  std::vector<std::string> inject = options.inject;
+  for (const std::string& fault : Disturber(parseDisturbances(options.disturb), seed).faultSpecs()) {
+    inject.push_back(fault);
+  }
+  if (!inject.empty()) {
+    cell_options.faults = faults::Injector::fromText(inject, seed);
+  }
   if (options.camera_move_m > 0 || options.camera_turn_deg > 0) {
     cell_options.camera_move =
         workcell::WorkcellOptions::CameraMove{options.camera_move_m, options.camera_turn_deg, {}};
@@ -51,6 +80,7 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
   result.index = index;
   result.seed = options.seed + static_cast<std::uint64_t>(index);
   const auto wall_start = std::chrono::steady_clock::now();
+  Disturber disturber(parseDisturbances(options.disturb), result.seed);
   try {
     const auto cell = built ? std::move(built) : trialWorkcell(options, index);
     sim::Simulation& simulation = *cell->simulation();
@@ -74,8 +104,12 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
     const std::vector<sim::PartState> initial = simulation.parts();
     bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
     bt::Executor executor(tree, cell->clock(), {.time_limit = fromSeconds(options.time_limit_s)});
-    executor.setBeforeTick([&cell] { cell->beforeTick(); });
+    executor.setBeforeTick([&cell, &disturber, &simulation] {
+      disturber.watch(simulation);
+      cell->beforeTick();
+    });
     const bt::RunResult run = executor.run();
+    result.disturbances = disturber.events();
     result.cycle_time_s = toSeconds(run.elapsed);
     if (run.status != bt::Status::kSuccess) {
       result.failure_path = run.failure_path;
@@ -94,6 +128,7 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
     result.reason = e.what();
   }
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  result.rss_kb = residentKilobytes();
   return result;
 }
 
@@ -180,6 +215,7 @@ void writeJson(const Summary& summary, const std::filesystem::path& file) {
 Summary runTrials(const TrialOptions& options, const std::function<void(const TrialResult&, int)>& progress) {
   checkOptions(options);
   const Judge judge = trials::judge(options.judge);
+  parseDisturbances(options.disturb);  // a bad one is an error before any trial
   const bt::Plan plan = bt::loadPlan(options.plan);
   // This shard's trials: every shard_count-th index, so that slices take about as long.
   std::vector<int> indices;
@@ -198,7 +234,7 @@ Summary runTrials(const TrialOptions& options, const std::function<void(const Tr
   summary.options = options;
   summary.trials.resize(indices.size());
   // Slot 0 is this thread's, in first_cell: a workcell shares the perception pipeline of the
-  // thread that built it (workcell/ur5_sim_workcell.cpp), so it must run on that thread.
+  // thread that built it (workcell/sim_workcell.cpp), so it must run on that thread.
   std::atomic<std::size_t> next{1};
   int done = 0;
   std::mutex mutex;
@@ -260,9 +296,27 @@ std::map<std::string, double> Summary::cycleTimes() const {
           {"mean", mean}};
 }
 
+std::vector<std::pair<int, long>> Summary::residentMemory() const {
+  std::vector<std::pair<int, long>> samples;
+  for (std::size_t i = 0; i < trials.size(); ++i) {
+    if (trials[i].rss_kb > 0 && ((i + 1) % 100 == 0 || i + 1 == trials.size())) {
+      samples.emplace_back(static_cast<int>(i + 1), trials[i].rss_kb);
+    }
+  }
+  return samples;
+}
+
+double Summary::residentGrowthPercent() const {
+  if (trials.size() <= 100 || trials[99].rss_kb <= 0 || trials.back().rss_kb <= 0) {
+    return 0.0;
+  }
+  return 100.0 * static_cast<double>(trials.back().rss_kb - trials[99].rss_kb) / static_cast<double>(trials[99].rss_kb);
+}
+
 nlohmann::json Summary::toJson() const {
   nlohmann::json json;
   json["plan"] = options.plan.string();
+  json["workcell"] = options.workcell;
   json["scene"] = options.scene.string();
   json["judge"] = options.judge;
   json["trials"] = trials.size();
@@ -278,13 +332,23 @@ nlohmann::json Summary::toJson() const {
     failures.push_back({{"reason", reason}, {"count", count}});
   }
   json["failures"] = failures;
+  if (!options.disturb.empty()) {
+    json["disturb"] = options.disturb;
+  }
+  nlohmann::json memory = nlohmann::json::array();
+  for (const auto& [count, kb] : residentMemory()) {
+    memory.push_back({{"trials", count}, {"rss_kb", kb}});
+  }
+  json["resident_memory"] = memory;
+  json["resident_growth_from_trial_100_percent"] = residentGrowthPercent();
   nlohmann::json list = nlohmann::json::array();
   for (const TrialResult& trial : trials) {
-    nlohmann::json item = {{"index", trial.index},
-                           {"seed", trial.seed},
-                           {"success", trial.success},
-                           {"cycle_time_s", trial.cycle_time_s},
-                           {"wall_s", trial.wall_s}};
+    nlohmann::json item = {{"index", trial.index},     {"seed", trial.seed},
+                           {"success", trial.success}, {"cycle_time_s", trial.cycle_time_s},
+                           {"wall_s", trial.wall_s},   {"rss_kb", trial.rss_kb}};
+    if (!trial.disturbances.empty()) {
+      item["disturbances"] = trial.disturbances;
+    }
     if (trial.calibrate_moved_part_m) {
       item["calibrate_moved_part_mm"] = std::round(*trial.calibrate_moved_part_m * 1e4) / 10.0;
     }
@@ -323,11 +387,15 @@ Summary Summary::fromJson(const nlohmann::json& json) {
   Summary summary;
   const std::string where = "trial results";
   summary.options.plan = field<std::string>(json, "plan", where);
+  summary.options.workcell = json.value("workcell", summary.options.workcell);
   summary.options.scene = field<std::string>(json, "scene", where);
   summary.options.judge = field<std::string>(json, "judge", where);
   summary.options.seed = field<std::uint64_t>(json, "seed", where);
   summary.options.count = json.contains("count") ? field<int>(json, "count", where) : field<int>(json, "trials", where);
   summary.options.time_limit_s = json.value("time_limit_s", summary.options.time_limit_s);
+  if (json.contains("disturb")) {
+    summary.options.disturb = field<std::vector<std::string>>(json, "disturb", where);
+  }
   if (json.contains("shard")) {
     summary.options.shard_index = field<int>(json.at("shard"), "index", where + ", shard");
     summary.options.shard_count = field<int>(json.at("shard"), "count", where + ", shard");
@@ -348,6 +416,10 @@ Summary Summary::fromJson(const nlohmann::json& json) {
     trial.success = field<bool>(item, "success", at);
     trial.cycle_time_s = field<double>(item, "cycle_time_s", at);
     trial.wall_s = item.value("wall_s", 0.0);
+    trial.rss_kb = item.value("rss_kb", 0L);
+    if (item.contains("disturbances")) {
+      trial.disturbances = field<std::vector<std::string>>(item, "disturbances", at);
+    }
     if (item.contains("calibrate_moved_part_mm") && item["calibrate_moved_part_mm"].is_number()) {
       trial.calibrate_moved_part_m = item["calibrate_moved_part_mm"].get<double>() / 1000.0;
     }
@@ -380,10 +452,12 @@ Summary mergeShards(const std::vector<Summary>& shards) {
       }
     };
     differs("plan", first.plan.string(), options.plan.string());
+    differs("workcell", first.workcell, options.workcell);
     differs("scene", first.scene.string(), options.scene.string());
     differs("judge", first.judge, options.judge);
     differs("first seed", std::to_string(first.seed), std::to_string(options.seed));
     differs("trial count", std::to_string(first.count), std::to_string(options.count));
+    differs("disturbances", nlohmann::json(first.disturb).dump(), nlohmann::json(options.disturb).dump());
     for (const TrialResult& trial : shards[s].trials) {
       if (trial.index < 0 || trial.index >= first.count) {
         throw std::runtime_error("results " + std::to_string(s + 1) + ": trial " + std::to_string(trial.index) +
@@ -428,6 +502,29 @@ std::string Summary::text() const {
     std::snprintf(line, sizeof line,
                   "cycle time (simulated s): median %.1f, 95th percentile %.1f, min %.1f, max %.1f\n",
                   times.at("median"), times.at("p95"), times.at("min"), times.at("max"));
+    out += line;
+  }
+  if (!options.disturb.empty()) {
+    std::string kinds;
+    for (const std::string& d : options.disturb) {
+      kinds += (kinds.empty() ? "" : ", ") + d;
+    }
+    // A trial counts as disturbed when one of its disturbances was applied.
+    const auto applied = [](const std::string& event) { return event.find(": no") == std::string::npos; };
+    const auto disturbed = std::count_if(trials.begin(), trials.end(), [&](const TrialResult& trial) {
+      return std::any_of(trial.disturbances.begin(), trial.disturbances.end(), applied);
+    });
+    std::snprintf(line, sizeof line, "disturbed (%s): %zu of %zu trials\n", kinds.c_str(),
+                  static_cast<std::size_t>(disturbed), trials.size());
+    out += line;
+  }
+  if (const auto memory = residentMemory(); memory.size() > 1) {
+    out += "resident memory (MB) after trials:";
+    for (const auto& [count, kb] : memory) {
+      std::snprintf(line, sizeof line, " %d: %.1f;", count, kb / 1024.0);
+      out += line;
+    }
+    std::snprintf(line, sizeof line, " growth from trial 100: %+.2f %%\n", residentGrowthPercent());
     out += line;
   }
   const auto histogram = failureHistogram();

@@ -18,6 +18,8 @@ namespace costar::trials {
 
 struct TrialOptions {
   std::filesystem::path plan;
+  /// The simulated workcell the trials run in (workcells/NAME.json).
+  std::string workcell = "ur5-sim";
   std::filesystem::path scene;
   std::string judge;
   int count = 10;
@@ -41,6 +43,9 @@ struct TrialOptions {
   /// Faults to inject in every trial (faults/fault.h grammar); random moments are drawn from
   /// the trial's seed.
   std::vector<std::string> inject;
+  /// Disturbances of the simulated world in every trial (trials/disturbance.h grammar: nudge,
+  /// take-away, drop-frame), drawn from the trial's seed.
+  std::vector<std::string> disturb;
 };
 
 struct TrialResult {
@@ -52,6 +57,10 @@ struct TrialResult {
   std::string reason;
   double cycle_time_s = 0.0;  // simulated
   double wall_s = 0.0;
+  /// What the disturbances did (trials/disturbance.h), one line each.
+  std::vector<std::string> disturbances;
+  /// The process's resident memory (kB) when the trial ended (0: unknown), for soak runs.
+  long rss_kb = 0;
   /// With --calibrate: the farthest any part moved while Calibrate ran (m; the arm knows no
   /// part before the camera is calibrated, so this is how much it disturbed the table).
   std::optional<double> calibrate_moved_part_m;
@@ -66,6 +75,10 @@ struct Summary {
   std::vector<std::pair<std::string, int>> failureHistogram() const;
   /// Cycle times of the successful trials: min, median, p95, max, mean.
   std::map<std::string, double> cycleTimes() const;
+  /// Resident memory (kB) after every 100th trial (index 99, 199, ...) and after the last one,
+  /// by trial count; growth from trial 100 to the last, in per cent (0 with fewer than 101).
+  std::vector<std::pair<int, long>> residentMemory() const;
+  double residentGrowthPercent() const;
   nlohmann::json toJson() const;
   std::string text() const;
   /// Reads what toJson wrote. @throws std::runtime_error naming the field and the problem.

@@ -1,7 +1,11 @@
 // makeWorkcell: the light cells from costar_workcell_base, the robot cells from here.
 
+#include <stdexcept>
+
 #include "faults/injector.h"
-#include "workcell/ur5_sim_workcell.h"
+#include "workcell/grippers.h"
+#include "workcell/sim_cell_description.h"
+#include "workcell/sim_workcell.h"
 #include "workcell/workcell.h"
 
 namespace costar::workcell {
@@ -28,7 +32,14 @@ std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& given) {
   if (auto cell = makeLightWorkcell(light)) {
     return cell;
   }
-  return makeUr5SimWorkcell(options);  // the one robot cell makeLightWorkcell knows by name
+  // A robot cell makeLightWorkcell knows by name: a simulated cell of workcells/NAME.json.
+  const SimCellDescription cell = loadSimCellDescription(simCellFile(options.name));
+  try {
+    gripperModel(cell.gripper);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("workcell description '" + cell.file.string() + "': gripper: " + e.what());
+  }
+  return makeSimWorkcell(cell, options);
 }
 
 }  // namespace costar::workcell

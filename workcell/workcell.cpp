@@ -1,10 +1,11 @@
 #include "workcell/workcell.h"
 
+#include <algorithm>
+#include <cstdlib>
 #include <stdexcept>
 
-#include <cstdlib>
-
 #include "testing/test_components.h"
+#include "workcell/sim_cell_description.h"
 
 namespace costar::workcell {
 
@@ -79,8 +80,6 @@ std::filesystem::path defaultWaypointFile(const std::string& workcell) {
 
 namespace {
 
-constexpr const char* kUr5SimSummary =
-    "simulated UR5 with a 2-finger gripper and an RGB-D camera (MuJoCo); the default";
 constexpr const char* kTestSummary =
     "TEST ONLY: test components (logger, scripted actions, counter, an arm without a robot)";
 constexpr const char* kNoneSummary = "no components: built-in nodes only";
@@ -118,7 +117,15 @@ class TestWorkcell final : public Workcell {
 }  // namespace
 
 std::vector<WorkcellInfo> knownWorkcells() {
-  return {{"ur5-sim", kUr5SimSummary}, {"test", kTestSummary}, {"none", kNoneSummary}};
+  // The simulated cells of workcells/*.json, the default (ur5-sim) first.
+  std::vector<WorkcellInfo> cells;
+  for (const auto& [name, label] : simCells()) {
+    cells.push_back({name, label});
+  }
+  std::stable_partition(cells.begin(), cells.end(), [](const WorkcellInfo& cell) { return cell.name == "ur5-sim"; });
+  cells.push_back({"test", kTestSummary});
+  cells.push_back({"none", kNoneSummary});
+  return cells;
 }
 
 std::unique_ptr<Workcell> makeTestWorkcell(const ComponentWrapper& wrap,

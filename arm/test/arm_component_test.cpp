@@ -53,7 +53,9 @@ world::Pose toolDown(double x, double y, double z, double yaw = 0.0) {
 class ArmTest : public ::testing::Test {
  protected:
   ArmTest()
-      : robot(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp")),
+      : robot(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5_arm.urdf",
+                                             dataRoot() / "sim/models/gripper_parallel-2f.urdf", "tool0", "base_link",
+                                             "tcp")),
         collisions(robot, kBase, {.padding = 0.005}, {kHome.eigen()}),
         driver(clock, kHome),
         arm(

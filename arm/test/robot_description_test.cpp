@@ -35,7 +35,9 @@ TEST(RobotDescription, TheUr5FileHoldsTheUr5) {
   EXPECT_EQ(ur5.limits.max_acceleration, limits.max_acceleration);
   const JointVector home = {0.0, -2.3, 1.9, -std::numbers::pi / 2 + 0.4, -std::numbers::pi / 2, 0.0};
   EXPECT_EQ(ur5.home, home);
-  EXPECT_TRUE(ur5.tool_in_flange.isApprox(world::Pose(Eigen::Translation3d(0, 0, 0.14)), 0.0));
+  // No tool of its own: the gripper's tool centre point is the workcell's (workcells/*.json).
+  EXPECT_TRUE(ur5.tool_in_flange.isApprox(world::Pose::Identity(), 0.0));
+  EXPECT_EQ(ur5.urdf_tool_link, "tool0");
   EXPECT_EQ(ur5.gripper_links, (std::vector<std::string>{"tool0", "wrist_3_link", "fingers"}));
   EXPECT_EQ(ur5.base_link, "base_link");
   EXPECT_TRUE(std::filesystem::is_regular_file(ur5.mjcf));
@@ -56,7 +58,7 @@ TEST(RobotDescription, ItsKinematicsAreTheUrClosedFormWithItsDhTable) {
     }
     EXPECT_TRUE(kinematics->forward(q).isApprox(reference.forward(q), 0.0)) << "trial " << trial;
   }
-  EXPECT_EQ(kinematicsSolvers(), std::vector<std::string>{"ur"});
+  EXPECT_EQ(kinematicsSolvers(), (std::vector<std::string>{"srs", "ur"}));
 }
 
 class BadRobotFile : public ::testing::Test {
@@ -123,7 +125,7 @@ TEST_F(BadRobotFile, EachProblemNamesItsField) {
   EXPECT_EQ(problem(j).rfind("models.mjcf: no such file '", 0), 0u) << problem(j);
   j = good_;
   j["kinematics"]["solver"] = "kuka";
-  EXPECT_EQ(problem(j), "kinematics.solver: unknown solver 'kuka' (known: ur)");
+  EXPECT_EQ(problem(j), "kinematics.solver: unknown solver 'kuka' (known: srs, ur)");
   j = good_;
   j["kinematics"]["d"] = {0.1, 0.2};
   EXPECT_EQ(problem(j), "kinematics.d: must be 6 numbers, not 2");
@@ -136,6 +138,92 @@ TEST_F(BadRobotFile, EachProblemNamesItsField) {
   EXPECT_EQ(problem(std::string("{\"name\": ")).rfind("not valid JSON: ", 0), 0u);
   EXPECT_EQ(problem(std::string("[1, 2]")),
             "(top level): must be an object {\"name\": ..., \"joints\": [...], ...}, not [1,2]");
+}
+
+// The LBR iiwa 14: the runtime reads the file the model generator reads
+// (format costar-robot-description/1), degrees turned into radians.
+TEST(RobotDescription, TheIiwaFileIsTheGeneratorsFile) {
+  const RobotDescription iiwa = loadRobotDescription(robotDescriptionFile("iiwa14"));
+  EXPECT_EQ(iiwa.name, "iiwa14");
+  EXPECT_EQ(iiwa.type, "LBRiiwa");
+  EXPECT_EQ(iiwa.solver, "srs");
+  ASSERT_EQ(iiwa.jointCount(), 7);
+  EXPECT_EQ(iiwa.joint_names.front(), "iiwa_joint_1");
+  EXPECT_EQ(iiwa.joint_labels.back(), "A7");
+  constexpr double kDegree = std::numbers::pi / 180.0;
+  EXPECT_DOUBLE_EQ(iiwa.limits.max_position[1], 120 * kDegree);
+  EXPECT_DOUBLE_EQ(iiwa.limits.min_position[6], -175 * kDegree);
+  EXPECT_DOUBLE_EQ(iiwa.limits.max_velocity[3], 75 * kDegree);
+  EXPECT_DOUBLE_EQ(iiwa.limits.max_acceleration[0], 200 * kDegree);
+  EXPECT_DOUBLE_EQ(iiwa.home[3], -108 * kDegree);
+  EXPECT_EQ(iiwa.base_link, "iiwa_link_0");
+  EXPECT_EQ(iiwa.first_moving_link, "iiwa_link_1");
+  EXPECT_EQ(iiwa.urdf_tool_link, "tool0");
+  EXPECT_TRUE(std::filesystem::is_regular_file(iiwa.mjcf)) << iiwa.mjcf;
+  EXPECT_TRUE(std::filesystem::is_regular_file(iiwa.urdf)) << iiwa.urdf;
+  EXPECT_EQ(makeKinematics(iiwa)->jointCount(), 7);
+}
+
+class BadIiwaFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = std::filesystem::temp_directory_path() /
+              ("costar_iiwa_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+               ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(folder_);
+    std::ifstream in(robotDescriptionFile("iiwa14"));
+    good_ = json::parse(in);
+  }
+  void TearDown() override { std::filesystem::remove_all(folder_); }
+
+  /// The error loading `content` (as iiwa14.json, so that its generated models are found),
+  /// without the "robot description 'PATH': " prefix.
+  std::string problem(const json& content) {
+    const auto file = folder_ / "iiwa14.json";
+    std::ofstream(file) << content.dump(2);
+    const std::string prefix = "robot description '" + file.string() + "': ";
+    try {
+      makeKinematics(loadRobotDescription(file));
+    } catch (const std::runtime_error& e) {
+      const std::string message = e.what();
+      return message.rfind(prefix, 0) == 0 ? message.substr(prefix.size()) : "(no file named) " + message;
+    }
+    return "no error";
+  }
+
+  std::filesystem::path folder_;
+  json good_;
+};
+
+TEST_F(BadIiwaFile, EachProblemNamesItsField) {
+  EXPECT_EQ(problem(good_), "no error");
+  json j = good_;
+  j["format"] = "costar-robot-description/2";
+  EXPECT_EQ(problem(j), "format: must be \"costar-robot-description/1\", not \"costar-robot-description/2\"");
+  j = good_;
+  j.erase("type");
+  EXPECT_EQ(problem(j), "type: missing");
+  j = good_;
+  j["joints"][2].erase("acceleration_deg_s2");
+  EXPECT_EQ(problem(j), "joints[2].acceleration_deg_s2: missing");
+  j = good_;
+  j["joints"][4]["acceleration_deg_s2"] = 0;
+  EXPECT_EQ(problem(j), "joints[4].acceleration_deg_s2: must be positive, not 0");
+  j = good_;
+  j["joints"][0]["speed"] = 1;
+  EXPECT_EQ(problem(j).rfind("joints[0].speed: unknown field (known: ", 0), 0u) << problem(j);
+  j = good_;
+  j["home_deg"][1] = 150;
+  EXPECT_EQ(problem(j), "home_deg[1]: is outside joint 2's limits");
+  j = good_;
+  j["gripper_links"] = "tool0";
+  EXPECT_EQ(problem(j), "gripper_links: must be a list of link names, not \"tool0\"");
+  j = good_;
+  j["kinematics"]["d"] = {0.1};
+  EXPECT_EQ(problem(j), "kinematics.d: solver 'srs' takes no parameters (its geometry comes from the joints)");
+  j = good_;
+  j["name"] = "iiwa7";  // no model generated for it
+  EXPECT_EQ(problem(j).rfind("name: the model generated from this file, '", 0), 0u) << problem(j);
 }
 
 TEST(RobotDescription, AMissingFileIsNamed) {

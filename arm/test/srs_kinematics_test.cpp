@@ -12,6 +12,7 @@
 #include <numbers>
 #include <random>
 
+#include "arm/robot_description.h"
 #include "planning/robot_model.h"
 
 namespace costar::arm {
@@ -63,7 +64,7 @@ TEST(SrsDescription, FileMatchesTheBuiltInIiwa14) {
   EXPECT_TRUE(description.limits.lower.isApprox(SrsLimits::iiwa14().lower, 1e-12));
   EXPECT_TRUE(description.limits.upper.isApprox(SrsLimits::iiwa14().upper, 1e-12));
   EXPECT_TRUE(description.max_velocity.isApprox(degrees({85, 85, 100, 75, 130, 135, 135}), 1e-12));
-  EXPECT_TRUE(description.home.isApprox(degrees({0, 30, 0, -80, 0, 70, 0}), 1e-12));
+  EXPECT_TRUE(description.home.isApprox(degrees({0, 6, 0, -108, 0, 66, -90}), 1e-12));
 }
 
 class SrsDescriptionErrors : public ::testing::Test {
@@ -103,12 +104,12 @@ TEST_F(SrsDescriptionErrors, NameTheFileAndTheField) {
   expectError(variant("\"lower_deg\": -120, \"upper_deg\": 120, \"velocity_deg_s\": 75",
                       "\"lower_deg\": 120, \"upper_deg\": -120, \"velocity_deg_s\": 75"),
               "joints[3]");
-  expectError(variant("\"home_deg\": [0, 30, 0, -80, 0, 70, 0]", "\"home_deg\": [0, 30, 0, -80, 0, 70]"), "home_deg");
-  expectError(variant("\"home_deg\": [0, 30, 0, -80, 0, 70, 0]", "\"home_deg\": [0, 130, 0, -80, 0, 70, 0]"),
+  expectError(variant("\"home_deg\": [0, 6, 0, -108, 0, 66, -90]", "\"home_deg\": [0, 30, 0, -80, 0, 70]"), "home_deg");
+  expectError(variant("\"home_deg\": [0, 6, 0, -108, 0, 66, -90]", "\"home_deg\": [0, 130, 0, -80, 0, 70, 0]"),
               "home_deg");
-  expectError(
-      variant("\"velocity_deg_s\": 85, \"effort_nm\": 320}", "\"velocity_deg_s\": \"fast\", \"effort_nm\": 320}"),
-      "joints[0].velocity_deg_s");
+  expectError(variant("\"velocity_deg_s\": 85, \"acceleration_deg_s2\"",
+                      "\"velocity_deg_s\": \"fast\", \"acceleration_deg_s2\""),
+              "joints[0].velocity_deg_s");
   expectError(variant("\"tool\": {", "\"tool\": {} , \"x\": {"), "tool");
   expectError(variant("\"format\"", "\"format\" ]"), "not valid JSON");
   EXPECT_THROW(readSrsArmDescription("/nonexistent/robot.json"), std::runtime_error);
@@ -418,6 +419,91 @@ TEST(SrsKinematics, RejectsBadGeometry) {
   geometry = SrsGeometry::iiwa14();
   geometry.wrist_to_flange.linear() *= 2.0;
   EXPECT_THROW(SrsKinematics{geometry}, std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// SrsArmKinematics: the solver as the arm's Kinematics (arm/kinematics.h)
+
+class SrsAdapter : public ::testing::Test {
+ protected:
+  SrsAdapter() : kinematics_(makeKinematics(loadRobotDescription(COSTAR_IIWA14_DESCRIPTION))) {}
+  static JointVector toVector(const Joints7& q) { return JointVector::fromEigen(q); }
+  std::shared_ptr<const Kinematics> kinematics_;
+};
+
+TEST_F(SrsAdapter, TheFactoryMakesItFromTheDescription) {
+  ASSERT_NE(dynamic_cast<const SrsArmKinematics*>(kinematics_.get()), nullptr);
+  EXPECT_EQ(kinematics_->jointCount(), 7);
+  EXPECT_DOUBLE_EQ(kinematics_->limits().max_position[6], 175 * kDegree);
+  EXPECT_DOUBLE_EQ(kinematics_->limits().max_velocity[0], 85 * kDegree);
+  const SrsKinematics reference;
+  std::mt19937_64 random(11);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Joints7 q = randomWithin(SrsLimits::iiwa14(), random);
+    EXPECT_TRUE(kinematics_->forward(toVector(q)).isApprox(reference.forward(q), 1e-15)) << trial;
+  }
+}
+
+// Every solution inverse() gives reaches the pose within the limits, sorted nearest the seed by
+// solutionsNear(); the seed itself is the first when it solves the pose; poses of random
+// configurations always have solutions.
+TEST_F(SrsAdapter, SolutionsNearTheSeedReachThePoseWithinLimits) {
+  std::mt19937_64 random(2026);
+  const SrsLimits limits = SrsLimits::iiwa14();
+  int total = 0;
+  for (int trial = 0; trial < 500; ++trial) {
+    const Joints7 target = randomWithin(limits, random, 0.05);
+    const world::Pose pose = kinematics_->forward(toVector(target));
+    const JointVector seed = toVector(randomWithin(limits, random, 0.05));
+    IkSolutions solutions;
+    kinematics_->solutionsNear(pose, seed, solutions);
+    ASSERT_FALSE(solutions.empty()) << "trial " << trial;
+    total += solutions.size();
+    double previous = 0.0;
+    for (const JointVector& q : solutions) {
+      expectSamePose(kinematics_->forward(q), pose, 1e-9);
+      for (int j = 0; j < 7; ++j) {
+        EXPECT_GE(q[j], kinematics_->limits().min_position[j]);
+        EXPECT_LE(q[j], kinematics_->limits().max_position[j]);
+      }
+      double distance = 0.0;
+      for (int j = 0; j < 7; ++j) {
+        distance += (q[j] - seed[j]) * (q[j] - seed[j]);
+      }
+      EXPECT_GE(distance, previous);
+      previous = distance;
+    }
+    // Seeded with the configuration itself: it comes first.
+    kinematics_->solutionsNear(pose, toVector(target), solutions);
+    ASSERT_FALSE(solutions.empty());
+    for (int j = 0; j < 7; ++j) {
+      EXPECT_NEAR(solutions[0][j], target[j], 1e-9) << "trial " << trial << " joint " << j;
+    }
+  }
+  EXPECT_GT(total, 500 * 4);  // several branches and arm angles per pose, not only one
+}
+
+TEST_F(SrsAdapter, InverseNearestAsksTheCallersPredicate) {
+  const Joints7 home = degrees({0, 6, 0, -108, 0, 66, -90});
+  const world::Pose pose = kinematics_->forward(toVector(home));
+  const auto nearest = kinematics_->inverseNearest(pose, toVector(home));
+  ASSERT_TRUE(nearest.has_value());
+  EXPECT_NEAR((*nearest)[3], home[3], 1e-9);
+  // Refusing every solution with the elbow's arm angle of the seed: another one is found.
+  int asked = 0;
+  const auto other = kinematics_->inverseNearest(pose, toVector(home), [&](const JointVector& q) {
+    ++asked;
+    return std::abs(q[0] - home[0]) > 0.1;
+  });
+  ASSERT_TRUE(other.has_value());
+  EXPECT_GT(asked, 1);
+  EXPECT_GT(std::abs((*other)[0] - home[0]), 0.1);
+  expectSamePose(kinematics_->forward(*other), pose, 1e-9);
+  // Unreachable: nothing, and a wrong seed is refused.
+  world::Pose far = pose;
+  far.translation() = Eigen::Vector3d(2.0, 0, 0.5);
+  EXPECT_FALSE(kinematics_->inverseNearest(far, toVector(home)).has_value());
+  EXPECT_THROW(kinematics_->inverseNearest(pose, JointVector::zero(6)), std::invalid_argument);
 }
 
 }  // namespace

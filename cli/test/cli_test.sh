@@ -33,6 +33,9 @@ check "unknown workcell"    2 "unknown workcell 'moon'" -- "$costar" run example
 check "missing file"        2 'File does not exist' -- "$costar" run nope.xml
 check "nodes model"         0 '<Action ID="Move">' -- "$costar" nodes -w test
 check "nodes json"          0 '"category": "knowledge"' -- "$costar" nodes -w test --format json
+check "workcells: iiwa"     0 '^iiwa-sim ' -- "$costar" workcells
+check "validate on iiwa"    0 'valid for workcell .iiwa-sim.' -- "$costar" validate examples/ur5/assemble_structure.xml -w iiwa-sim
+check "nodes of iiwa"       0 '<Action ID="SmartGrasp">' -- "$costar" nodes -w iiwa-sim
 check "help"                0 'Exit code: 0 SUCCESS' -- "$costar" run --help
 check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit 0.1
 check "inject: bad spec"    2 "fault 'melt:arm@t=1': unknown kind 'melt'" \

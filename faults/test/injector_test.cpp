@@ -97,6 +97,19 @@ TEST(Injector, BreaksCameraFramesAtTheChosenFrame) {
   EXPECT_EQ(nan->wrap(good2).capture().validCount(), 0u);
 }
 
+// Issue 12: a frame lost on the way is one empty frame; the stream goes on after it.
+TEST(Injector, ADroppedFrameIsOneEmptyFrameThenTheStreamGoesOn) {
+  SimClock clock;
+  GoodCamera good(clock);
+  auto faults = injector({"drop-frame:camera@op=2"}, clock);
+  camera::RgbdCamera& camera = faults->wrap(good);
+  EXPECT_EQ(camera.capture().validCount(), 48u);
+  EXPECT_TRUE(camera.capture().points.empty());  // the 2nd frame is lost
+  EXPECT_EQ(camera.capture().validCount(), 48u);
+  EXPECT_EQ(camera.capture().validCount(), 48u);
+  ASSERT_TRUE(faults->records()[0].first_effect.has_value());
+}
+
 component::OperationResult runToEnd(component::Component& component) {
   const component::OperationId id = component.start("Work", {});
   for (int i = 0; i < 10; ++i) {

@@ -10,7 +10,10 @@
 namespace costar::planning {
 namespace {
 
-RobotModel ur5() { return RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp"); }
+RobotModel ur5() {
+  return RobotModel::fromUrdf(dataRoot() / "sim/models/ur5_arm.urdf",
+                              dataRoot() / "sim/models/gripper_parallel-2f.urdf", "tool0", "base_link", "tcp");
+}
 
 /// Independent standard-DH model of the UR5 with the 0.14 m tool centre point.
 world::Pose dhForward(const Eigen::VectorXd& q) {

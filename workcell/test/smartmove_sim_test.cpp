@@ -151,6 +151,36 @@ TEST_F(SmartMoveSim, TakesALinkOffItsMiddleWhenNeighboursLeaveNoRoomThereAndPlac
   EXPECT_LT((part("node_1").pose.translation() - Eigen::Vector3d(0.44, -0.2475, 0.025)).norm(), 0.003);
 }
 
+// Issue 12: two links lying side by side 15 mm apart leave no room for a pad between them:
+// no grasp is feasible. SmartPush slides one along its neighbour with the closed fingers until
+// its middle is clear; then it is taken by the middle.
+TEST_F(SmartMoveSim, PushesALinkClearOfItsNeighbourWhenNoGraspIsFeasibleThenGraspsIt) {
+  open(R"x({"parts": [{"class": "link", "at": [0.50, -0.20, 0]},
+                     {"class": "link", "at": [0.50, -0.24, 0]}]})x");
+  const bt::RunResult blocked = run(R"x(<SmartGrasp object_class="link" grasp="middle"/>)x");
+  ASSERT_EQ(blocked.status, bt::Status::kFailure);
+  EXPECT_NE(blocked.failure_reason.find("no feasible link"), std::string::npos) << blocked.failure_reason;
+  std::map<std::string, Eigen::Vector3d> before;
+  for (const auto& state : cell->simulation()->parts()) {
+    before[state.name] = state.pose.translation();
+  }
+  const bt::RunResult pushed = run(R"x(<SmartPush object_class="link" distance="0.1"/>)x");
+  ASSERT_EQ(pushed.status, bt::Status::kSuccess) << pushed.failure_path << ": " << pushed.failure_reason;
+  cell->simulation()->stepTo(cell->simulation()->time() + std::chrono::milliseconds(500));
+  // One link slid along (at least 5 cm), still lying flat; the other barely moved.
+  const double moved_0 = (part("link_0").pose.translation() - before["link_0"]).head<2>().norm();
+  const double moved_1 = (part("link_1").pose.translation() - before["link_1"]).head<2>().norm();
+  EXPECT_GT(std::max(moved_0, moved_1), 0.05) << moved_0 << " " << moved_1;
+  EXPECT_LT(std::min(moved_0, moved_1), 0.005) << moved_0 << " " << moved_1;
+  for (const char* link : {"link_0", "link_1"}) {
+    EXPECT_NEAR(part(link).pose.translation().z(), 0.0125, 0.003) << link;
+  }
+  const bt::RunResult grasped =
+      run(R"x(<Sequence><Home/><Open/><SmartGrasp object_class="link" grasp="middle"/></Sequence>)x");
+  ASSERT_EQ(grasped.status, bt::Status::kSuccess) << grasped.failure_path << ": " << grasped.failure_reason;
+  EXPECT_GT(std::max(part("link_0").pose.translation().z(), part("link_1").pose.translation().z()), 0.08);
+}
+
 TEST_F(SmartMoveSim, NoMatchingPartFailsWithTheReasonsOfEveryCandidate) {
   open(R"x({"parts": [{"class": "node", "color": "red", "at": [0.45, -0.2, 0]},
                      {"class": "node", "color": "blue", "at": [0.95, 0.45, 0]}]})x");

@@ -20,7 +20,9 @@ namespace {
 const world::Pose kBaseInWorld(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
 
 TEST(Ur5SimWorkcell, TheMujocoModelAndTheUrdfAgreeToATenthOfAMillimetre) {
-  const auto robot = planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5.urdf", "base_link", "tcp");
+  const auto robot =
+      planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5_arm.urdf",
+                                     dataRoot() / "sim/models/gripper_parallel-2f.urdf", "tool0", "base_link", "tcp");
   std::mt19937 random(11);
   std::uniform_real_distribution<double> angle(-M_PI, M_PI);
   const sim::Scene empty = sim::parseScene(R"({"parts": []})", "empty");

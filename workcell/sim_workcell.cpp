@@ -1,4 +1,4 @@
-#include "workcell/ur5_sim_workcell.h"
+#include "workcell/sim_workcell.h"
 
 #include <limits>
 
@@ -8,7 +8,6 @@
 #include "core/paths.h"
 #include "faults/injector.h"
 #include "gripper/finger_geometry.h"
-#include "gripper/parallel_gripper.h"
 #include "perception/perception_component.h"
 #include "perception/pipeline.h"
 #include "planning/collision_world.h"
@@ -18,6 +17,8 @@
 #include "sim/drivers.h"
 #include "sim/simulation.h"
 #include "smartmove/smartmove.h"
+#include "workcell/grippers.h"
+#include "workcell/sim_cell_description.h"
 
 namespace costar::workcell {
 
@@ -95,27 +96,45 @@ const world::Pose& tableCenter() {
   return pose;
 }
 
-const world::Pose kBaseInWorld(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
+/// The robot's planning model: its URDF with the gripper's mounted on the flange.
+planning::RobotModel planningModel(const arm::RobotDescription& robot, const GripperModel& gripper) {
+  return planning::RobotModel::fromUrdf(robot.urdf, dataRoot() / gripper.urdf, robot.urdf_tool_link,
+                                        robot.urdf_base_link, gripper.tcp_link);
+}
 
-class Ur5SimWorkcell final : public Workcell {
+/// The gripper's links that may touch a part being grasped, after the robot's, each once.
+std::vector<std::string> gripperLinks(const arm::RobotDescription& robot, const GripperModel& gripper) {
+  std::vector<std::string> links = robot.gripper_links;
+  for (const std::string& link : gripper.links) {
+    if (std::find(links.begin(), links.end(), link) == links.end()) {
+      links.push_back(link);
+    }
+  }
+  return links;
+}
+
+/// The generic simulated workcell: everything comes from the cell's description.
+class SimWorkcell final : public Workcell {
  public:
-  explicit Ur5SimWorkcell(const WorkcellOptions& options)
+  SimWorkcell(SimCellDescription cell, const WorkcellOptions& options)
       : Workcell(std::make_unique<SimClock>()),
-        robot_description_(arm::loadRobotDescription(arm::robotDescriptionFile("ur5"))),
-        scene_(sim::loadScene(options.scene.empty() ? dataRoot() / "sim/scenes/assembly.json" : options.scene)),
-        simulation_(sim::Simulation::create(scene_, simOptions(options, robot_description_))),
+        cell_(std::move(cell)),
+        gripper_model_(gripperModel(cell_.gripper)),
+        robot_description_(arm::loadRobotDescription(arm::robotDescriptionFile(cell_.robot))),
+        scene_(sim::loadScene(options.scene.empty() ? cell_.scene : options.scene)),
+        simulation_(sim::Simulation::create(scene_, simOptions(options, robot_description_, cell_, gripper_model_))),
         arm_driver_(*simulation_),
         gripper_driver_(*simulation_),
         camera_(*simulation_, options.seed.value_or(scene_.seed)),
-        robot_(planning::RobotModel::fromUrdf(robot_description_.urdf, robot_description_.urdf_base_link,
-                                              robot_description_.urdf_tool_link)),
-        collisions_(robot_, kBaseInWorld, {.padding = 0.005, .resolution = 0.01}, {toEigen(robot_description_.home)}),
+        robot_(planningModel(robot_description_, gripper_model_)),
+        collisions_(robot_, cell_.robot_base, {.padding = 0.005, .resolution = 0.01},
+                    {toEigen(robot_description_.home)}),
         waypoints_(!options.waypoints.empty()
                        ? options.waypoints
-                       : (options.memory_only ? std::filesystem::path() : defaultWaypointFile("ur5-sim")),
+                       : (options.memory_only ? cell_.waypoints : defaultWaypointFile(cell_.name)),
                    /*persist=*/!options.memory_only, robot_description_.jointCount()),
         grasps_(dataRoot() / "data/grasps.json",
-                options.memory_only ? std::filesystem::path() : defaultGraspFile("ur5-sim")),
+                options.memory_only ? std::filesystem::path() : defaultGraspFile(cell_.name)),
         faults_(options.faults) {
     simulation_->attach(static_cast<SimClock&>(clock()));
     if (faults_) {
@@ -129,16 +148,16 @@ class Ur5SimWorkcell final : public Workcell {
     const auto add = [this](std::shared_ptr<component::Component> component) {
       components().add(faults_ ? faults_->wrap(std::move(component)) : std::move(component));
     };
-    collisions_.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
+    collisions_.setBox("table", world::Pose(Eigen::Translation3d(cell_.table_centre)), cell_.table_size);
     collisions_.allow(robot_description_.base_link, "table");  // the robot stands on it
     // The tool stays above the table top, within the cell.
-    collisions_.setWorkspace(Eigen::AlignedBox3d(Eigen::Vector3d(-0.45, -0.65, 0.0), Eigen::Vector3d(1.05, 0.65, 1.2)));
+    collisions_.setWorkspace(cell_.workspace);
 
     arm::ArmConfig arm_config;
     arm_config.type = robot_description_.type;
-    arm_config.base_in_world = kBaseInWorld;
+    arm_config.base_in_world = cell_.robot_base;
     arm_config.home = robot_description_.home;
-    arm_config.tcp_in_flange = robot_description_.tool_in_flange;
+    arm_config.tcp_in_flange = robot_description_.tool_in_flange * gripper_model_.tcp_in_flange;
     arm_config.joint_names = robot_description_.joint_names;
     arm_config.joint_labels = robot_description_.joint_labels;
     auto arm = std::make_shared<arm::ArmComponent>(
@@ -147,7 +166,7 @@ class Ur5SimWorkcell final : public Workcell {
         arm::makeKinematics(robot_description_), arm_config);
     // SmartMove reaches the gripper through its operations, as the tree does: the same (possibly
     // fault-injected) component the registry holds.
-    std::shared_ptr<component::Component> gripper = std::make_shared<gripper::ParallelGripper>(gripper_driver, clock());
+    std::shared_ptr<component::Component> gripper = gripper_model_.make_component(gripper_driver, clock());
     if (faults_) {
       gripper = faults_->wrap(std::move(gripper));
     }
@@ -156,8 +175,8 @@ class Ur5SimWorkcell final : public Workcell {
     // HandEyeCalibration: the camera's pose comes from it (the drawings until calibrated).
     calibration_ = makeCalibration(options, *arm, camera);
     add(calibration_);
-    add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{{"table_center", tableCenter()},
-                                                                                       {"robot_base", kBaseInWorld}}));
+    add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
+        {"table_center", tableCenter()}, {"robot_base", cell_.robot_base}}));
     if (options.test_oracle_perception) {
       add(std::make_shared<TestOraclePerception>(*simulation_));
     } else {
@@ -169,8 +188,8 @@ class Ur5SimWorkcell final : public Workcell {
                                                             perception_config));
     }
     smartmove::SmartMoveConfig smartmove_config;
-    smartmove_config.gripper_links = robot_description_.gripper_links;
-    smartmove_config.fingers = gripper::twoFingerGripper();
+    smartmove_config.gripper_links = gripperLinks(robot_description_, gripper_model_);
+    smartmove_config.fingers = gripper_model_.fingers;
     smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(
         *arm, *gripper, components().world(), collisions_, simulation_->objectClasses(), grasps_, smartmove_config);
     add(smartmove_);
@@ -219,16 +238,18 @@ class Ur5SimWorkcell final : public Workcell {
     });
   }
 
-  std::string name() const override { return "ur5-sim"; }
-  std::string description() const override {
-    return "simulated UR5 with a 2-finger gripper and an RGB-D camera (MuJoCo), scene '" + scene_.label + "'";
-  }
+  std::string name() const override { return cell_.name; }
+  std::string description() const override { return cell_.label + ", scene '" + scene_.label + "'"; }
   sim::Simulation* simulation() override { return simulation_.get(); }
 
  private:
-  static sim::SimulationOptions simOptions(const WorkcellOptions& options, const arm::RobotDescription& robot) {
+  static sim::SimulationOptions simOptions(const WorkcellOptions& options, const arm::RobotDescription& robot,
+                                           const SimCellDescription& cell, const GripperModel& gripper) {
     sim::SimulationOptions sim_options;
     sim_options.robot = robot;
+    sim_options.cell_model = cell.cell_model;
+    sim_options.gripper_model = dataRoot() / gripper.mjcf;
+    sim_options.robot_base = cell.robot_base;
     sim_options.placement_seed = options.seed;
     if (options.camera_move) {
       sim::CameraOffset offset;
@@ -249,10 +270,10 @@ class Ur5SimWorkcell final : public Workcell {
     const std::filesystem::path file =
         !options.calibration.empty()
             ? options.calibration
-            : (options.memory_only ? std::filesystem::path() : defaultCalibrationFile("ur5-sim"));
+            : (options.memory_only ? std::filesystem::path() : defaultCalibrationFile(cell_.name));
     calibration::CellCalibration initial = calibration::loadCalibration(file).value_or(calibration::CellCalibration{});
     if (!initial.marker_in_flange) {
-      if (const auto shipped = calibration::loadCalibration(dataRoot() / "data/calibration/ur5-sim.json")) {
+      if (const auto shipped = calibration::loadCalibration(cell_.calibration)) {
         initial.marker_in_flange = shipped->marker_in_flange;
         initial.marker_method = shipped->marker_method;
         initial.marker_residuals = shipped->marker_residuals;
@@ -262,8 +283,8 @@ class Ur5SimWorkcell final : public Workcell {
     calibration::CalibrationConfig config;
     config.file = options.memory_only ? std::filesystem::path() : file;
     config.seed = options.seed.value_or(scene_.seed);
-    // The drawings: the marker on the gripper body's +x face, 7.5 cm from the flange.
-    config.marker_in_flange_guess = world::poseFromXyzRpy(0.035, 0, 0.075, -M_PI / 2, 0, -M_PI / 2);
+    // The drawings of the gripper.
+    config.marker_in_flange_guess = gripper_model_.marker_in_flange_guess;
     config.solve.marker_size = sim::Simulation::kGripperMarkerSize;
     config.marker_id = sim::Simulation::kGripperMarkerId;
     return std::make_shared<calibration::CalibrationComponent>(arm, camera, clock(), simulation_->rgbdNominalPose(),
@@ -271,6 +292,8 @@ class Ur5SimWorkcell final : public Workcell {
   }
   static Eigen::VectorXd toEigen(const sim::ArmJoints& q) { return q.eigen(); }
 
+  SimCellDescription cell_;
+  const GripperModel& gripper_model_;
   arm::RobotDescription robot_description_;
   sim::Scene scene_;
   std::unique_ptr<sim::Simulation> simulation_;
@@ -289,8 +312,8 @@ class Ur5SimWorkcell final : public Workcell {
 
 }  // namespace
 
-std::unique_ptr<Workcell> makeUr5SimWorkcell(const WorkcellOptions& options) {
-  return std::make_unique<Ur5SimWorkcell>(options);
+std::unique_ptr<Workcell> makeSimWorkcell(const SimCellDescription& cell, const WorkcellOptions& options) {
+  return std::make_unique<SimWorkcell>(cell, options);
 }
 
 }  // namespace costar::workcell

@@ -1,0 +1,210 @@
+#include "trials/disturbance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+
+#include <Eigen/Geometry>
+
+#include "sim/simulation.h"
+#include "smartmove/footprint.h"
+
+namespace costar::trials {
+
+namespace {
+
+constexpr double kApproachRadius = 0.03;  // m, tool centre from the part's centre, in x and y
+constexpr double kApproachLow = 0.04;     // m above the part's centre
+constexpr double kApproachHigh = 0.09;
+constexpr double kOnTable = 0.06;  // m: a part's centre below this rests on the table
+constexpr double kNudgeMin = 0.01;
+constexpr double kNudgeMax = 0.03;
+constexpr double kTurnMaxDeg = 15.0;
+constexpr double kNudgeGap = 0.002;  // m kept between the nudged part's footprint and others'
+constexpr int kNudgeDraws = 32;
+
+std::string format(const char* pattern, auto... values) {
+  char text[256];
+  std::snprintf(text, sizeof text, pattern, values...);
+  return text;
+}
+
+const world::ObjectClass* classOf(const sim::Simulation& simulation, const std::string& name) {
+  for (const auto& object_class : simulation.objectClasses()) {
+    if (object_class.name == name) {
+      return &object_class;
+    }
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+DisturbanceSpec parseDisturbance(std::string_view text) {
+  DisturbanceSpec spec;
+  spec.text = std::string(text);
+  const std::string where = "disturbance '" + spec.text + "': ";
+  const std::size_t at = text.find('@');
+  const std::string_view kind = text.substr(0, at);
+  if (kind == "nudge") {
+    spec.kind = DisturbanceKind::kNudge;
+  } else if (kind == "take-away") {
+    spec.kind = DisturbanceKind::kTakeAway;
+  } else if (kind == "drop-frame") {
+    spec.kind = DisturbanceKind::kDropFrame;
+  } else {
+    throw std::invalid_argument(where + "unknown kind '" + std::string(kind) +
+                                "' (known: nudge, take-away, drop-frame)");
+  }
+  if (at != std::string_view::npos) {
+    const std::string_view when = text.substr(at + 1);
+    if (spec.kind == DisturbanceKind::kDropFrame) {
+      throw std::invalid_argument(where + "drop-frame takes no @ (its frame is drawn from the seed)");
+    }
+    constexpr std::string_view kGrasp = "grasp=";
+    if (when.substr(0, kGrasp.size()) != kGrasp) {
+      throw std::invalid_argument(where + "expected @grasp=N after the kind, not '@" + std::string(when) + "'");
+    }
+    const std::string number(when.substr(kGrasp.size()));
+    std::size_t used = 0;
+    int value = 0;
+    try {
+      value = std::stoi(number, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (number.empty() || used != number.size() || value < 1 || value > 100) {
+      throw std::invalid_argument(where + "grasp=N needs a whole number from 1 to 100, not '" + number + "'");
+    }
+    spec.grasp = value;
+  }
+  return spec;
+}
+
+std::string disturbanceGrammar() {
+  return "KIND[@grasp=N], drawn from each trial's seed:\n"
+         "  nudge       the part about to be grasped is pushed 1-3 cm and turned up to 15 deg as the gripper goes "
+         "down\n"
+         "  take-away   the part about to be grasped is taken off the table\n"
+         "  drop-frame  one camera frame of a DetectObjects comes empty\n"
+         "  @grasp=N    the N-th approach to a part (default: the 1st to 3rd, drawn)";
+}
+
+Disturber::Disturber(std::vector<DisturbanceSpec> specs, std::uint64_t seed)
+    : random_(seed * 0x9E3779B97F4A7C15ULL + 0x5EEDD15ULL) {
+  for (DisturbanceSpec& spec : specs) {
+    if (spec.kind == DisturbanceKind::kDropFrame) {
+      const int frame = std::uniform_int_distribution<int>(1, kFramesDrawn)(random_);
+      faults_.push_back("drop-frame:camera@op=" + std::to_string(frame));
+      continue;
+    }
+    Pending pending;
+    pending.approach = spec.grasp > 0 ? spec.grasp : std::uniform_int_distribution<int>(1, 3)(random_);
+    pending.spec = std::move(spec);
+    pending_.push_back(std::move(pending));
+  }
+}
+
+void Disturber::watch(sim::Simulation& simulation) {
+  if (pending_.empty()) {
+    return;
+  }
+  const world::Pose tcp = simulation.tcpPose();
+  const sim::FingerState fingers = simulation.fingers();
+  const bool descending = tcp.translation().z() < last_tcp_z_ - 1e-5;
+  last_tcp_z_ = tcp.translation().z();
+  std::string approached;
+  if (descending && !fingers.pads_in_contact && fingers.opening > 0.005) {
+    for (const sim::PartState& part : simulation.parts()) {
+      const Eigen::Vector3d offset = tcp.translation() - part.pose.translation();
+      if (part.pose.translation().z() < kOnTable && part.linear_velocity.norm() < 0.01 &&
+          offset.head<2>().norm() < kApproachRadius && offset.z() > kApproachLow && offset.z() < kApproachHigh) {
+        approached = part.name;
+        break;
+      }
+    }
+  }
+  if (!approached.empty() && approached != approaching_) {
+    ++approaches_;
+    for (Pending& pending : pending_) {
+      if (!pending.done && pending.approach == approaches_) {
+        pending.done = true;
+        if (pending.spec.kind == DisturbanceKind::kNudge) {
+          nudge(simulation, pending, approached);
+        } else {
+          takeAway(simulation, pending, approached);
+        }
+      }
+    }
+  }
+  approaching_ = approached;
+}
+
+void Disturber::nudge(sim::Simulation& simulation, Pending& pending, const std::string& name) {
+  const std::vector<sim::PartState> parts = simulation.parts();
+  const auto part = std::find_if(parts.begin(), parts.end(), [&](const auto& p) { return p.name == name; });
+  const world::ObjectClass* object_class = classOf(simulation, part->object_class);
+  std::uniform_real_distribution<double> distance(kNudgeMin, kNudgeMax);
+  std::uniform_real_distribution<double> direction(-std::numbers::pi, std::numbers::pi);
+  std::uniform_real_distribution<double> turn(-kTurnMaxDeg, kTurnMaxDeg);
+  // The first draw that keeps clear of every other part (a person nudges a part into free
+  // space, not onto a neighbour).
+  for (int draw = 0; draw < kNudgeDraws; ++draw) {
+    const double d = distance(random_);
+    const double angle = direction(random_);
+    const double degrees = turn(random_);
+    world::Pose moved = part->pose;
+    moved.linear() = Eigen::AngleAxisd(degrees * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()) * moved.linear();
+    moved.translation() += Eigen::Vector3d(d * std::cos(angle), d * std::sin(angle), 0.0);
+    bool clear = true;
+    if (object_class != nullptr) {
+      for (const sim::PartState& other : parts) {
+        const world::ObjectClass* other_class = classOf(simulation, other.object_class);
+        if (other.name == name || other_class == nullptr || other.pose.translation().z() > 0.2) {
+          continue;
+        }
+        if (smartmove::footprintGap(*object_class, moved, *other_class, other.pose) < kNudgeGap) {
+          clear = false;
+          break;
+        }
+      }
+    }
+    if (clear) {
+      simulation.movePart(name, moved);
+      pending.event = format("nudge %s: %.0f mm, %+.0f deg at %.1f s (approach %d)", name.c_str(), d * 1000.0, degrees,
+                             toSeconds(simulation.time().time_since_epoch()), pending.approach);
+      return;
+    }
+  }
+  pending.event = format("nudge %s: no free spot 1-3 cm away (approach %d)", name.c_str(), pending.approach);
+}
+
+void Disturber::takeAway(sim::Simulation& simulation, Pending& pending, const std::string& name) {
+  // Off the table, out of the robot's reach and the camera's view.
+  const double y = -1.2 - 0.15 * taken_++;
+  const auto parts = simulation.parts();
+  const auto part = std::find_if(parts.begin(), parts.end(), [&](const auto& p) { return p.name == name; });
+  world::Pose away = part->pose;
+  away.translation() = Eigen::Vector3d(0.4, y, part->pose.translation().z());
+  simulation.movePart(name, away);
+  pending.event = format("take-away %s at %.1f s (approach %d)", name.c_str(),
+                         toSeconds(simulation.time().time_since_epoch()), pending.approach);
+}
+
+std::vector<std::string> Disturber::events() const {
+  std::vector<std::string> lines;
+  for (const Pending& pending : pending_) {
+    lines.push_back(pending.done
+                        ? pending.event
+                        : pending.spec.text + ": not applied: no approach " + std::to_string(pending.approach) + " (" +
+                              std::to_string(approaches_) + " approach(es) to a part)");
+  }
+  for (const std::string& fault : faults_) {
+    lines.push_back(fault);
+  }
+  return lines;
+}
+
+}  // namespace costar::trials

@@ -1,0 +1,162 @@
+// Disturbances during a trial (issue 12): the simulated world changed under a running plan,
+// seeded, and a plan that looks again and retries recovering from them. Judged from the
+// simulator's true state.
+
+#include "trials/disturbance.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+
+#include <unistd.h>
+
+#include "trials/trials.h"
+
+namespace costar::trials {
+namespace {
+
+std::string errorOf(const std::string& text) {
+  try {
+    parseDisturbance(text);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Disturbance, SpecsAreParsedAndBadOnesNamed) {
+  EXPECT_EQ(parseDisturbance("nudge").kind, DisturbanceKind::kNudge);
+  EXPECT_EQ(parseDisturbance("nudge").grasp, 0);
+  EXPECT_EQ(parseDisturbance("take-away@grasp=2").kind, DisturbanceKind::kTakeAway);
+  EXPECT_EQ(parseDisturbance("take-away@grasp=2").grasp, 2);
+  EXPECT_EQ(parseDisturbance("drop-frame").kind, DisturbanceKind::kDropFrame);
+  EXPECT_NE(errorOf("shove").find("unknown kind 'shove'"), std::string::npos) << errorOf("shove");
+  EXPECT_NE(errorOf("nudge@grasp=0").find("from 1 to 100, not '0'"), std::string::npos);
+  EXPECT_NE(errorOf("nudge@grasp=2x").find("not '2x'"), std::string::npos);
+  EXPECT_NE(errorOf("nudge@t=3").find("expected @grasp=N"), std::string::npos);
+  EXPECT_NE(errorOf("drop-frame@grasp=1").find("takes no @"), std::string::npos);
+}
+
+TEST(Disturbance, ADroppedFrameIsDrawnFromTheSeedAmongThePlansFrames) {
+  const auto frames = [](std::uint64_t seed) { return Disturber({parseDisturbance("drop-frame")}, seed).faultSpecs(); };
+  ASSERT_EQ(frames(7).size(), 1u);
+  EXPECT_EQ(frames(7), frames(7));
+  const std::regex spec(R"(drop-frame:camera@op=(\d+))");
+  std::set<int> drawn;
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    std::smatch match;
+    const std::string text = frames(seed)[0];
+    ASSERT_TRUE(std::regex_match(text, match, spec)) << text;
+    const int frame = std::stoi(match[1]);
+    EXPECT_GE(frame, 1);
+    EXPECT_LE(frame, Disturber::kFramesDrawn);
+    drawn.insert(frame);
+  }
+  EXPECT_GT(drawn.size(), 10u);  // not one frame for every seed
+}
+
+class DisturbedTrials : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder = std::filesystem::temp_directory_path() / ("costar_disturbed_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(folder);
+    // Two nodes apart on the right: the first grasp goes for one; the other is left.
+    std::ofstream(folder / "scene.json") << R"({"seed": 5, "parts": [
+        {"class": "node", "color": "red", "at": [0.45, -0.22, 30]},
+        {"class": "node", "color": "blue", "at": [0.58, -0.32, 0]}]})";
+  }
+  void TearDown() override { std::filesystem::remove_all(folder); }
+
+  TrialOptions options(const std::string& body, const std::string& disturb) {
+    std::ofstream(folder / "plan.xml") << R"(<root BTCPP_format="4"><BehaviorTree ID="main">)" << body
+                                       << "</BehaviorTree></root>";
+    TrialOptions trial;
+    trial.plan = folder / "plan.xml";
+    trial.scene = folder / "scene.json";
+    trial.judge = "lift";
+    trial.count = 1;
+    trial.seed = 21;
+    trial.time_limit_s = 120;
+    trial.disturb = {disturb};
+    return trial;
+  }
+
+  static constexpr const char* kPickUp = R"(<Sequence><Home/><Open/><DetectObjects/>
+      <SmartGrasp name="grasp a node" object_class="node" grasp="top"/>
+      <MoveRelative name="lift" offset="0;0;0.15"/></Sequence>)";
+  static constexpr const char* kPickUpRetrying = R"(<Sequence>
+      <RetryUntilSuccessful num_attempts="3"><Sequence><Home/><Open/><DetectObjects/>
+        <SmartGrasp name="grasp a node" object_class="node" grasp="top"/></Sequence></RetryUntilSuccessful>
+      <MoveRelative name="lift" offset="0;0;0.15"/></Sequence>)";
+
+  std::filesystem::path folder;
+};
+
+TEST_F(DisturbedTrials, APartNudgedAsTheGripperGoesDownMovesOneToThreeCentimetres) {
+  const Summary summary = runTrials(options(kPickUpRetrying, "nudge@grasp=1"));
+  ASSERT_EQ(summary.trials.size(), 1u);
+  const TrialResult& trial = summary.trials[0];
+  ASSERT_EQ(trial.disturbances.size(), 1u);
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(trial.disturbances[0], match,
+                                std::regex(R"(nudge node_\d: (\d+) mm, ([-+]\d+) deg at [\d.]+ s \(approach 1\))")))
+      << trial.disturbances[0];
+  EXPECT_GE(std::stoi(match[1]), 10);
+  EXPECT_LE(std::stoi(match[1]), 30);
+  EXPECT_LE(std::abs(std::stoi(match[2])), 15);
+  // Looking again and grasping where the part is now: a node is lifted.
+  EXPECT_TRUE(trial.success) << trial.failure_path << ": " << trial.reason;
+  EXPECT_GT(trial.rss_kb, 0);
+  // The same seed, the same nudge.
+  EXPECT_EQ(runTrials(options(kPickUpRetrying, "nudge@grasp=1")).trials[0].disturbances, trial.disturbances);
+}
+
+TEST_F(DisturbedTrials, APartTakenAwayFailsTheGraspAndARetryTakesTheOther) {
+  const Summary plain = runTrials(options(kPickUp, "take-away@grasp=1"));
+  ASSERT_EQ(plain.trials[0].disturbances.size(), 1u);
+  EXPECT_NE(plain.trials[0].disturbances[0].find("take-away node_"), std::string::npos)
+      << plain.trials[0].disturbances[0];
+  EXPECT_FALSE(plain.trials[0].success);
+  EXPECT_NE(plain.trials[0].failure_path.find("grasp a node"), std::string::npos) << plain.trials[0].failure_path;
+  EXPECT_NE(plain.text().find("disturbed (take-away@grasp=1): 1 of 1 trials"), std::string::npos) << plain.text();
+
+  const Summary retrying = runTrials(options(kPickUpRetrying, "take-away@grasp=1"));
+  EXPECT_TRUE(retrying.trials[0].success) << retrying.trials[0].failure_path << ": " << retrying.trials[0].reason;
+}
+
+TEST_F(DisturbedTrials, ADisturbanceNeverDueIsListedAsNotApplied) {
+  const Summary summary = runTrials(options(kPickUp, "nudge@grasp=2"));
+  ASSERT_EQ(summary.trials[0].disturbances.size(), 1u);
+  EXPECT_NE(summary.trials[0].disturbances[0].find("not applied: no approach 2 (1 approach(es)"), std::string::npos)
+      << summary.trials[0].disturbances[0];
+  EXPECT_TRUE(summary.trials[0].success);
+  EXPECT_NE(summary.text().find("disturbed (nudge@grasp=2): 0 of 1 trials"), std::string::npos) << summary.text();
+  // The record survives the JSON a shard writes.
+  const Summary read = Summary::fromJson(summary.toJson());
+  EXPECT_EQ(read.trials[0].disturbances, summary.trials[0].disturbances);
+  EXPECT_EQ(read.options.disturb, summary.options.disturb);
+}
+
+TEST(Trials, ResidentMemoryIsSampledEveryHundredTrials) {
+  Summary summary;
+  for (int i = 0; i < 250; ++i) {
+    TrialResult trial;
+    trial.index = i;
+    trial.rss_kb = 100000 + i * 10;
+    summary.trials.push_back(trial);
+  }
+  const auto memory = summary.residentMemory();
+  ASSERT_EQ(memory.size(), 3u);
+  EXPECT_EQ(memory[0], std::make_pair(100, 100990L));
+  EXPECT_EQ(memory[2], std::make_pair(250, 102490L));
+  EXPECT_NEAR(summary.residentGrowthPercent(), 100.0 * 1500 / 100990, 1e-9);
+  EXPECT_EQ(summary.toJson().at("resident_memory").size(), 3u);
+  EXPECT_EQ(Summary::fromJson(summary.toJson()).trials[249].rss_kb, 102490);
+}
+
+}  // namespace
+}  // namespace costar::trials

@@ -1,0 +1,177 @@
+#include "workcell/sim_cell_description.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/paths.h"
+
+namespace costar::workcell {
+
+namespace {
+
+using nlohmann::json;
+
+[[noreturn]] void fail(const std::string& field, const std::string& problem) {
+  throw std::runtime_error(field + ": " + problem);
+}
+
+std::string shown(const json& value) {
+  std::string text = value.dump();
+  return text.size() <= 60 ? text : text.substr(0, 57) + "...";
+}
+
+void onlyKnown(const json& object, const std::string& field, const std::set<std::string>& known) {
+  for (const auto& [key, value] : object.items()) {
+    if (!known.contains(key)) {
+      std::string list;
+      for (const std::string& name : known) {
+        list += (list.empty() ? "" : ", ") + name;
+      }
+      fail(field.empty() ? key : field + "." + key, "unknown field (known: " + list + ")");
+    }
+  }
+}
+
+std::string join(const std::string& field, const std::string& key) { return field.empty() ? key : field + "." + key; }
+
+const json& member(const json& object, const std::string& field, const std::string& key) {
+  if (!object.contains(key)) {
+    fail(join(field, key), "missing");
+  }
+  return object.at(key);
+}
+
+const json& objectAt(const json& object, const std::string& field, const std::string& key) {
+  const json& value = member(object, field, key);
+  if (!value.is_object()) {
+    fail(join(field, key), "must be an object {...}, not " + shown(value));
+  }
+  return value;
+}
+
+std::string text(const json& object, const std::string& field, const std::string& key) {
+  const json& value = member(object, field, key);
+  if (!value.is_string() || value.get<std::string>().empty()) {
+    fail(join(field, key), "must be a non-empty string, not " + shown(value));
+  }
+  return value.get<std::string>();
+}
+
+Eigen::Vector3d vec3(const json& object, const std::string& field, const std::string& key) {
+  const json& value = member(object, field, key);
+  if (!value.is_array() || value.size() != 3 || !std::all_of(value.begin(), value.end(), [](const json& x) {
+        return x.is_number() && std::isfinite(x.get<double>());
+      })) {
+    fail(join(field, key), "must be 3 finite numbers [x, y, z], not " + shown(value));
+  }
+  return {value[0].get<double>(), value[1].get<double>(), value[2].get<double>()};
+}
+
+std::filesystem::path file(const json& object, const std::string& key, const std::filesystem::path& root) {
+  const std::filesystem::path path = root / text(object, "", key);
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) {
+    fail(key, "no such file '" + path.string() + "' (paths are relative to the data root)");
+  }
+  return path;
+}
+
+SimCellDescription parse(const json& root, const std::filesystem::path& data_root) {
+  if (!root.is_object()) {
+    fail("(top level)", "must be an object {\"name\": ..., \"robot\": ..., ...}, not " + shown(root));
+  }
+  onlyKnown(root, "",
+            {"name", "label", "notes", "robot", "gripper", "robot_base", "cell_model", "scene", "waypoints", "table",
+             "workspace", "calibration"});
+  SimCellDescription cell;
+  cell.name = text(root, "", "name");
+  cell.label = text(root, "", "label");
+  cell.robot = text(root, "", "robot");
+  cell.gripper = text(root, "", "gripper");
+  const json& base = objectAt(root, "", "robot_base");
+  onlyKnown(base, "robot_base", {"position", "rpy"});
+  const Eigen::Vector3d position = vec3(base, "robot_base", "position");
+  const Eigen::Vector3d rpy = vec3(base, "robot_base", "rpy");
+  cell.robot_base = world::poseFromXyzRpy(position.x(), position.y(), position.z(), rpy.x(), rpy.y(), rpy.z());
+  cell.cell_model = file(root, "cell_model", data_root);
+  cell.scene = file(root, "scene", data_root);
+  if (root.contains("waypoints")) {
+    cell.waypoints = file(root, "waypoints", data_root);
+  }
+  cell.calibration = file(root, "calibration", data_root);
+  const json& table = objectAt(root, "", "table");
+  onlyKnown(table, "table", {"centre", "size"});
+  cell.table_centre = vec3(table, "table", "centre");
+  cell.table_size = vec3(table, "table", "size");
+  if ((cell.table_size.array() <= 0.0).any()) {
+    fail("table.size", "must be positive (m), not " + shown(table.at("size")));
+  }
+  const json& workspace = objectAt(root, "", "workspace");
+  onlyKnown(workspace, "workspace", {"min", "max"});
+  cell.workspace = Eigen::AlignedBox3d(vec3(workspace, "workspace", "min"), vec3(workspace, "workspace", "max"));
+  if ((cell.workspace.min().array() >= cell.workspace.max().array()).any()) {
+    fail("workspace", "min must be below max on every axis");
+  }
+  return cell;
+}
+
+}  // namespace
+
+std::filesystem::path simCellFile(const std::string& name, const std::filesystem::path& data_root) {
+  return (data_root.empty() ? dataRoot() : data_root) / "workcells" / (name + ".json");
+}
+
+SimCellDescription loadSimCellDescription(const std::filesystem::path& path, const std::filesystem::path& data_root) {
+  const std::string label = "workcell description '" + path.string() + "'";
+  std::ifstream in(path);
+  if (!in) {
+    throw std::runtime_error("cannot read " + label + ": no such file or not readable");
+  }
+  std::stringstream content;
+  content << in.rdbuf();
+  try {
+    json parsed;
+    try {
+      parsed = json::parse(content.str());
+    } catch (const json::parse_error& e) {
+      throw std::runtime_error(std::string("not valid JSON: ") + e.what());
+    }
+    SimCellDescription cell = parse(parsed, data_root.empty() ? dataRoot() : data_root);
+    cell.file = path;
+    if (cell.name != path.stem().string()) {
+      fail("name", "'" + cell.name + "' must be the file's name without .json ('" + path.stem().string() + "')");
+    }
+    return cell;
+  } catch (const std::exception& e) {
+    throw std::runtime_error(label + ": " + e.what());
+  }
+}
+
+std::vector<std::pair<std::string, std::string>> simCells(const std::filesystem::path& data_root) {
+  std::vector<std::pair<std::string, std::string>> cells;
+  const std::filesystem::path folder = (data_root.empty() ? dataRoot() : data_root) / "workcells";
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+    if (entry.path().extension() != ".json") {
+      continue;
+    }
+    std::string label;
+    try {
+      std::ifstream in(entry.path());
+      const json parsed = json::parse(in);
+      label = parsed.value("label", std::string("simulated workcell"));
+    } catch (const std::exception& e) {
+      label = std::string("(cannot be read: ") + e.what() + ")";
+    }
+    cells.emplace_back(entry.path().stem().string(), label);
+  }
+  std::sort(cells.begin(), cells.end());
+  return cells;
+}
+
+}  // namespace costar::workcell

@@ -1,0 +1,62 @@
+#pragma once
+// A simulated workcell as data: one JSON file per cell (workcells/NAME.json) names the robot,
+// the gripper on its flange, where the robot stands, the cell model around it and the scene;
+// workcell/sim_workcell.h builds the one generic simulated cell from it. `ur5-sim` and
+// `iiwa-sim` are two such files.
+//
+//   name, label      the cell's name (`--workcell NAME`) and a line for `costar workcells`
+//   notes            free text
+//   robot            the robot description robots/ROBOT/ROBOT.json (arm/robot_description.h)
+//   gripper          the gripper on the flange, a key of the gripper table (workcell/grippers.h:
+//                    "parallel-2f")
+//   robot_base       {position [x, y, z] (m), rpy [roll, pitch, yaw] (rad)}: the robot's base
+//                    in the world (the simulator checks that the model agrees)
+//   cell_model       MJCF of the cell around the robot (sim/cell_model.h)
+//   scene            the default scene (sim/scenes/*.json)
+//   waypoints        optional: a waypoint file the cell reads (never writes) when it keeps no
+//                    waypoints of its own (tests, trials) and none is given
+//   table            {centre [x, y, z], size [x, y, z]} (m): the table as the planner's box
+//   workspace        {min [x, y, z], max [x, y, z]} (m): where the tool may go
+//   calibration      the shipped hand-eye calibration of the gripper's marker
+//
+// Paths are relative to the data root (core/paths.h). Unknown fields are refused.
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "world/pose.h"
+
+namespace costar::workcell {
+
+struct SimCellDescription {
+  std::filesystem::path file;  // where it was read from (for messages)
+  std::string name;
+  std::string label;
+  std::string robot;
+  std::string gripper;
+  world::Pose robot_base = world::Pose::Identity();
+  std::filesystem::path cell_model;   // absolute
+  std::filesystem::path scene;        // absolute
+  std::filesystem::path waypoints;    // absolute, or empty
+  std::filesystem::path calibration;  // absolute
+  Eigen::Vector3d table_centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d table_size = Eigen::Vector3d::Zero();
+  Eigen::AlignedBox3d workspace;
+};
+
+/// Reads a workcell description. @throws std::runtime_error "workcell description 'FILE':
+/// FIELD: PROBLEM" for a missing or unreadable file, bad JSON, a missing, unknown or ill-typed
+/// field, or a file it names that does not exist.
+SimCellDescription loadSimCellDescription(const std::filesystem::path& file,
+                                          const std::filesystem::path& data_root = {});
+
+/// The description file of a simulated cell: DATA_ROOT/workcells/NAME.json.
+std::filesystem::path simCellFile(const std::string& name, const std::filesystem::path& data_root = {});
+
+/// The simulated cells of this data root (workcells/*.json): name and label, sorted by name;
+/// a file that cannot be read is listed with the problem as its label.
+std::vector<std::pair<std::string, std::string>> simCells(const std::filesystem::path& data_root = {});
+
+}  // namespace costar::workcell

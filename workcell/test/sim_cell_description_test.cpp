@@ -1,0 +1,108 @@
+// The workcell description files: both cells load, bad files are refused naming the file, the
+// field and the problem.
+
+#include "workcell/sim_cell_description.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "workcell/workcell.h"
+
+namespace costar::workcell {
+namespace {
+
+using nlohmann::json;
+
+TEST(SimCellDescription, BothCellsLoadAndAreListed) {
+  const SimCellDescription ur5 = loadSimCellDescription(simCellFile("ur5-sim"));
+  EXPECT_EQ(ur5.robot, "ur5");
+  EXPECT_EQ(ur5.gripper, "parallel-2f");
+  // Bit for bit the base the UR5 cell always had: turned 180 degrees about z.
+  EXPECT_TRUE(ur5.robot_base.isApprox(world::Pose(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ())), 0.0));
+  const SimCellDescription iiwa = loadSimCellDescription(simCellFile("iiwa-sim"));
+  EXPECT_EQ(iiwa.robot, "iiwa14");
+  EXPECT_TRUE(std::filesystem::is_regular_file(iiwa.cell_model));
+  std::vector<std::string> names;
+  for (const auto& info : knownWorkcells()) {
+    names.push_back(info.name);
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"ur5-sim", "iiwa-sim", "test", "none"}));
+}
+
+class BadCellFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = std::filesystem::temp_directory_path() /
+              ("costar_cell_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+               ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(folder_);
+    std::ifstream in(simCellFile("iiwa-sim"));
+    good_ = json::parse(in);
+  }
+  void TearDown() override { std::filesystem::remove_all(folder_); }
+
+  /// The error loading `content` as iiwa-sim.json, without "workcell description 'PATH': ".
+  std::string problem(const std::string& content) {
+    const auto file = folder_ / "iiwa-sim.json";
+    std::ofstream(file) << content;
+    const std::string prefix = "workcell description '" + file.string() + "': ";
+    try {
+      loadSimCellDescription(file);
+    } catch (const std::runtime_error& e) {
+      const std::string message = e.what();
+      return message.rfind(prefix, 0) == 0 ? message.substr(prefix.size()) : "(no file named) " + message;
+    }
+    return "no error";
+  }
+  std::string problem(const json& content) { return problem(content.dump(2)); }
+
+  std::filesystem::path folder_;
+  json good_;
+};
+
+TEST_F(BadCellFile, EachProblemNamesItsField) {
+  EXPECT_EQ(problem(good_), "no error");
+  json j = good_;
+  j.erase("robot");
+  EXPECT_EQ(problem(j), "robot: missing");
+  j = good_;
+  j["gripper"] = 3;
+  EXPECT_EQ(problem(j), "gripper: must be a non-empty string, not 3");
+  j = good_;
+  j["robot_base"]["rpy"] = {0, 0};
+  EXPECT_EQ(problem(j), "robot_base.rpy: must be 3 finite numbers [x, y, z], not [0,0]");
+  j = good_;
+  j["table"]["size"] = {1, -1, 1};
+  EXPECT_EQ(problem(j), "table.size: must be positive (m), not [1,-1,1]");
+  j = good_;
+  j["workspace"]["min"] = {2, 0, 0};
+  EXPECT_EQ(problem(j), "workspace: min must be below max on every axis");
+  j = good_;
+  j["scene"] = "sim/scenes/no_such_scene.json";
+  EXPECT_EQ(problem(j).rfind("scene: no such file '", 0), 0u) << problem(j);
+  j = good_;
+  j["waypoints"] = "examples/ur5/blind_waypoints.json";
+  EXPECT_EQ(problem(j), "no error");
+  j = good_;
+  j["camera"] = "rgbd";
+  EXPECT_EQ(problem(j).rfind("camera: unknown field (known: ", 0), 0u) << problem(j);
+  j = good_;
+  j["name"] = "other";
+  EXPECT_EQ(problem(j), "name: 'other' must be the file's name without .json ('iiwa-sim')");
+  EXPECT_EQ(problem(std::string("{\"name\": ")).rfind("not valid JSON: ", 0), 0u);
+}
+
+TEST(SimCellDescription, AMissingFileIsNamed) {
+  try {
+    loadSimCellDescription("/nonexistent/cell.json");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "cannot read workcell description '/nonexistent/cell.json': no such file or not readable");
+  }
+}
+
+}  // namespace
+}  // namespace costar::workcell
