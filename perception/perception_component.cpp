@@ -34,6 +34,12 @@ nlohmann::json poseJson(const world::Pose& pose) {
           {"rpy_deg", {round(rpy.x(), 1e-3), round(rpy.y(), 1e-3), round(rpy.z(), 1e-3)}}};
 }
 
+/// RGB in [0, 1], to 3 decimals.
+nlohmann::json colorJson(const Eigen::Vector3f& rgb) {
+  const auto round = [](float value) { return std::round(value * 1000.0) / 1000.0; };
+  return {round(rgb.x()), round(rgb.y()), round(rgb.z())};
+}
+
 }  // namespace
 
 /// Captures frames at the camera's rate across polls, then processes them.
@@ -168,6 +174,9 @@ OperationResult PerceptionComponent::process(const std::vector<camera::RgbdFrame
                     {"pose", poseJson(object.pose)},
                     {"confidence", std::round(object.confidence * 1000.0) / 1000.0},
                     {"visible", object.missed == 0}});
+    if (object.color) {
+      list.back()["color"] = colorJson(*object.color);
+    }
     if (std::find(before.begin(), before.end(), object.name) == before.end()) {
       fresh.push_back(object.name);
     }
@@ -241,6 +250,9 @@ world::Report PerceptionComponent::report() const {
     symbol.name = object.name;
     symbol.stamp = last_stamp_;
     symbol.value = world::FrameValue{"world", object.pose};
+    if (object.color) {
+      symbol.color = object.color->cast<double>();
+    }
     report.symbols.push_back(std::move(symbol));
     if (object.missed == 0) {
       report.predicates.push_back({"is_a", {object.name, object.object_class}, true, ""});

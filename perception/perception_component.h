@@ -5,8 +5,9 @@
 // the last frame, runs the pipeline (perception/pipeline.h), setCanonicalOrientation and
 // persistenceUpdate, and replaces its report:
 //   symbols     one frame per object ("node_3", parent "world", pose of the object frame in
-//               the robot base frame: camera calibration x camera pose), and one object-class
-//               symbol per class ("node", "link")
+//               the robot base frame: camera calibration x camera pose; its `color` the mean
+//               RGB of the object's points), and one object-class symbol per class ("node",
+//               "link")
 //   predicates  is_a(object, class)    the object is of that class, and
 //               visible(object)        it was seen by the latest DetectObjects (objects kept
 //                                      by keep_for without being re-seen have neither: only

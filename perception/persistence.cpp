@@ -115,11 +115,15 @@ const std::vector<TrackedObject>& PersistenceFilter::update(const std::vector<De
     object.object_class = detection.object_class;
     object.confidence = detection.confidence;
     object.pose = detection.pose;
+    object.color = detection.color;
     Eigen::Matrix3d reference = options_.new_object_reference;
     if (match[d]) {
       const TrackedObject& before = previous[*match[d]];
       object.name = before.name;
       object.seen = before.seen + 1;
+      if (!object.color) {
+        object.color = before.color;
+      }
       reference = before.pose.linear();
     } else {
       auto counter = std::find_if(counters_.begin(), counters_.end(),

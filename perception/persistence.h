@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,8 @@ struct TrackedObject {
   /// Object frame in the world, in canonical orientation.
   world::Pose pose = world::Pose::Identity();
   double confidence = 0.0;
+  /// Mean colour seen on it (RGB in [0, 1]; the latest detection's, else the one before).
+  std::optional<Eigen::Vector3f> color;
   /// Detections since it was last seen (0: seen in the latest).
   int missed = 0;
   /// Number of detections it has been seen in.

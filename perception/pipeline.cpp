@@ -25,6 +25,46 @@ PipelineFiles PipelineFiles::under(const std::filesystem::path& root) {
           base / "data" / "perception" / "svm_model.json", base / "data" / "perception" / "workspace.json"};
 }
 
+void measureColors(const std::vector<ObjectModel>& models, const std::vector<Cloud>& class_points,
+                   std::vector<Detection>& detections, double margin) {
+  for (Detection& detection : detections) {
+    detection.color.reset();
+    const auto model = std::find_if(models.begin(), models.end(),
+                                    [&](const ObjectModel& m) { return m.name() == detection.object_class; });
+    const auto m = static_cast<std::size_t>(model - models.begin());
+    if (model == models.end() || m >= class_points.size()) {
+      continue;
+    }
+    const Cloud& points = class_points[m];
+    if (points.colors.size() != points.size()) {
+      continue;
+    }
+    const Eigen::Isometry3d to_object = detection.pose_in_camera.inverse();
+    const double reach = model->radius + margin;
+    const Eigen::Vector3d origin = detection.pose_in_camera.translation();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int count = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Eigen::Vector3d p = points.points[i].cast<double>();
+      if ((p - origin).squaredNorm() > reach * reach) {
+        continue;
+      }
+      const Eigen::Vector3d q = to_object * p;
+      const bool inside = std::any_of(
+          model->object_class.boxes.begin(), model->object_class.boxes.end(),
+          [&](const world::Box& box) { return ((q - box.center).cwiseAbs() - box.half_size).maxCoeff() <= margin; });
+      if (inside) {
+        const Rgb& c = points.colors[i];
+        sum += Eigen::Vector3d(c[0], c[1], c[2]);
+        ++count;
+      }
+    }
+    if (count > 0) {
+      detection.color = (sum / (255.0 * count)).cast<float>();
+    }
+  }
+}
+
 /// One ClassPoseEstimator per class and worker thread.
 struct Pipeline::Workers {
   std::vector<std::vector<std::unique_ptr<ClassPoseEstimator>>> estimators;  // [thread][model]
@@ -216,6 +256,7 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
     };
     return index(a.object_class) < index(b.object_class);
   });
+  measureColors(models_, class_points, found, options_.color_margin);
   for (Detection& detection : found) {
     detection.pose = frame.camera_pose * detection.pose_in_camera;
   }

@@ -3,7 +3,8 @@
 //   1. median filter over N organized frames            (median_filter.h)
 //   2. workspace crop: box around table_center, table plane fit, height band (workspace.h)
 //   3. surface normals, then SVM segmentation into classes and background (segmentation.h)
-//   4. per class: ObjRecRANSAC on each cluster, ICP, depth check (pose_estimation.h)
+//   4. per class: ObjRecRANSAC on each cluster, ICP, depth check (pose_estimation.h); each
+//      found object's mean colour from the class's points inside it (measureColors)
 // and the poses into the world frame through the frames' camera_pose. Canonical orientation
 // and persistence (stages 5 and 6) keep state across detections: PersistenceFilter.
 //
@@ -47,6 +48,9 @@ struct PipelineOptions {
   /// Normal estimation window (pixels around each point) and neighbour distance (m).
   int normal_window = 3;
   double normal_max_distance = 0.012;
+  /// A detection's colour is the mean of its class's points within this distance of its
+  /// boxes (m).
+  double color_margin = 0.004;
   /// Worker threads of the median filter and the pose estimation (results do not depend on it).
   int threads = 2;
 };
@@ -84,6 +88,13 @@ struct PipelineResult {
   /// The median-filtered frame the stages worked on (for pictures and evaluation).
   std::shared_ptr<const camera::RgbdFrame> filtered;
 };
+
+/// Sets each detection's `color`: the mean RGB of the points of `class_points` (one cloud per
+/// model, optical frame, with colours) that lie within `margin` (m) of the detection's boxes
+/// under its pose_in_camera. A detection of a class not in `models`, or with no such point,
+/// gets none. Linear in points x detections of their class.
+void measureColors(const std::vector<ObjectModel>& models, const std::vector<Cloud>& class_points,
+                   std::vector<Detection>& detections, double margin);
 
 class Pipeline {
  public:

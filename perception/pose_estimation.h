@@ -71,6 +71,9 @@ struct Detection {
   /// RMS point-to-plane residual of ICP's inliers (m) and their number.
   double fit_rms = 0.0;
   int support = 0;
+  /// Mean colour of the points it explains (its class's points inside its boxes, from the
+  /// frame's RGB), RGB in [0, 1]; filled by the pipeline, absent when no point had colour.
+  std::optional<Eigen::Vector3f> color;
 };
 
 /// Result of refining a pose.

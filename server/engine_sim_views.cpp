@@ -19,6 +19,7 @@ std::optional<json> Engine::groundTruth() {
       json item = poseJson(part.pose);
       item["name"] = part.name;
       item["class"] = part.object_class;
+      item["color"] = part.color;  // the material's name in the class file
       parts.push_back(std::move(item));
     }
     const sim::FingerState fingers = simulation->fingers();

@@ -163,6 +163,10 @@ json Engine::buildState() const {
     item["name"] = predicate->args[0];
     item["class"] = predicate->args[1];
     item["source"] = predicate->source;
+    if (const world::Symbol* symbol = world.symbol(predicate->args[0]); symbol != nullptr && symbol->color) {
+      const Eigen::Vector3d& rgb = *symbol->color;
+      item["color"] = {rounded(rgb.x(), 1e3), rounded(rgb.y(), 1e3), rounded(rgb.z(), 1e3)};
+    }
     objects_json.push_back(std::move(item));
   }
   state["objects"] = std::move(objects_json);

@@ -85,8 +85,15 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
     const auto cell = built ? std::move(built) : trialWorkcell(options, index);
     sim::Simulation& simulation = *cell->simulation();
     if (options.calibrate) {
+      const std::vector<sim::PartState> before = simulation.parts();
       const component::OperationResult calibrated =
           workcell::runOperation(*cell, "Calibrate", {}, std::chrono::seconds(120));
+      double moved = 0.0;
+      const std::vector<sim::PartState> after = simulation.parts();
+      for (std::size_t i = 0; i < before.size() && i < after.size(); ++i) {
+        moved = std::max(moved, (after[i].pose.translation() - before[i].pose.translation()).norm());
+      }
+      result.calibrate_moved_part_m = moved;
       if (calibrated.state != component::OperationState::kSuccess) {
         result.failure_path = "Calibrate";
         result.reason = calibrated.reason;
@@ -342,6 +349,9 @@ nlohmann::json Summary::toJson() const {
     if (!trial.disturbances.empty()) {
       item["disturbances"] = trial.disturbances;
     }
+    if (trial.calibrate_moved_part_m) {
+      item["calibrate_moved_part_mm"] = std::round(*trial.calibrate_moved_part_m * 1e4) / 10.0;
+    }
     if (!trial.success) {
       item["failure_path"] = trial.failure_path;
       item["reason"] = trial.reason;
@@ -409,6 +419,9 @@ Summary Summary::fromJson(const nlohmann::json& json) {
     trial.rss_kb = item.value("rss_kb", 0L);
     if (item.contains("disturbances")) {
       trial.disturbances = field<std::vector<std::string>>(item, "disturbances", at);
+    }
+    if (item.contains("calibrate_moved_part_mm") && item["calibrate_moved_part_mm"].is_number()) {
+      trial.calibrate_moved_part_m = item["calibrate_moved_part_mm"].get<double>() / 1000.0;
     }
     if (!trial.success) {
       trial.failure_path = field<std::string>(item, "failure_path", at);

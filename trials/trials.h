@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,9 @@ struct TrialResult {
   std::vector<std::string> disturbances;
   /// The process's resident memory (kB) when the trial ended (0: unknown), for soak runs.
   long rss_kb = 0;
+  /// With --calibrate: the farthest any part moved while Calibrate ran (m; the arm knows no
+  /// part before the camera is calibrated, so this is how much it disturbed the table).
+  std::optional<double> calibrate_moved_part_m;
 };
 
 struct Summary {

@@ -44,6 +44,9 @@ struct Symbol {
   std::string source;  // the component that reports it
   TimePoint stamp{};
   std::variant<FrameValue, JointsValue, ObjectClassValue> value;
+  /// The colour seen on the object a frame stands for (perception: the mean RGB of its points,
+  /// in [0, 1]); absent for other symbols.
+  std::optional<Eigen::Vector3d> color;
 
   SymbolKind kind() const { return static_cast<SymbolKind>(value.index()); }
   const FrameValue* frame() const { return std::get_if<FrameValue>(&value); }

@@ -474,6 +474,39 @@ TEST(Ur5Cell, CheckCatchesWhatWouldFailAtOnce) {
   EXPECT_TRUE(check(R"x(<SmartRelease target="table_center"/>)x")["valid"]);
 }
 
+// The state the page draws from: after DetectObjects each object carries the colour perception
+// saw on it, near the red node's material (0.8, 0.1, 0.1) and nearer to red than to the class's
+// other colours (the page names it so).
+TEST(Ur5Cell, TheStateCarriesEachPartsSeenColour) {
+  Harness h(blindCell());
+  EXPECT_TRUE(h.get("/api/state")["objects"].empty());
+  const HttpResponse started = h.call("POST", "/api/operations", {{"node", "DetectObjects"}});
+  ASSERT_EQ(started.status, 202) << started.body;
+  ASSERT_EQ(h.waitForRun(json::parse(started.body)["run"])["result"], "SUCCESS");
+  h.waitTicks(2);  // the next snapshot
+  const json objects = h.get("/api/state")["objects"];
+  ASSERT_EQ(objects.size(), 1u) << objects.dump();
+  const json& node = objects[0];
+  EXPECT_EQ(node["class"], "node");
+  ASSERT_TRUE(node.contains("color")) << node.dump();
+  ASSERT_EQ(node["color"].size(), 3u);
+  const Eigen::Vector3d seen(node["color"][0].get<double>(), node["color"][1].get<double>(),
+                             node["color"][2].get<double>());
+  EXPECT_LT((seen - Eigen::Vector3d(0.8, 0.1, 0.1)).cwiseAbs().maxCoeff(), 0.2) << seen.transpose();
+  const json choices = h.get("/api/choices");
+  std::string nearest;
+  double nearest_distance = 1e9;
+  for (const json& color : choices["object_shape"]["node"]["colors"]) {
+    const Eigen::Vector3d rgb(color["rgb"][0].get<double>(), color["rgb"][1].get<double>(),
+                              color["rgb"][2].get<double>());
+    if ((rgb - seen).norm() < nearest_distance) {
+      nearest_distance = (rgb - seen).norm();
+      nearest = color["name"];
+    }
+  }
+  EXPECT_EQ(nearest, "red") << seen.transpose();
+}
+
 TEST(Ur5Cell, GroundTruthIsOnlyForTests) {
   Harness h(blindCell());
   EXPECT_EQ(h.call("GET", "/api/test/ground_truth").status, 404);

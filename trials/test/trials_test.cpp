@@ -189,6 +189,27 @@ TEST(Trials, ShardsRunTheirSliceAndMergeIntoTheWholeBatch) {
   EXPECT_THROW(runTrials(options), std::invalid_argument);
 }
 
+// How far Calibrate moved a part (--calibrate) goes into the JSON in millimetres and comes back;
+// a trial without Calibrate has none.
+TEST(Trials, HowFarCalibrateMovedAPartSurvivesTheJson) {
+  Summary summary;
+  summary.options.plan = "p.xml";
+  summary.options.judge = "assembly";
+  summary.options.count = 2;
+  summary.trials.resize(2);
+  summary.trials[0].index = 0;
+  summary.trials[0].calibrate_moved_part_m = 0.0123;
+  summary.trials[1].index = 1;
+  const nlohmann::json json = nlohmann::json::parse(summary.toJson().dump());
+  EXPECT_DOUBLE_EQ(json.at("results")[0].at("calibrate_moved_part_mm").get<double>(), 12.3);
+  EXPECT_FALSE(json.at("results")[1].contains("calibrate_moved_part_mm"));
+  const Summary back = Summary::fromJson(json);
+  ASSERT_EQ(back.trials.size(), 2u);
+  ASSERT_TRUE(back.trials[0].calibrate_moved_part_m.has_value());
+  EXPECT_NEAR(*back.trials[0].calibrate_moved_part_m, 0.0123, 1e-9);
+  EXPECT_FALSE(back.trials[1].calibrate_moved_part_m.has_value());
+}
+
 /// The paper's three UR5 tasks, with perception (DetectObjects on the simulated camera), one
 /// trial each, judged from the simulator's true final state. The 100-trial figures are in
 /// docs/BENCHMARKS.md (`costar trials ... -n 100`).

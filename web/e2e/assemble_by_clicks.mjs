@@ -222,6 +222,18 @@ async function main() {
   const off = Math.min(...believedAt.map((p) => Math.hypot(...p.map((v, i) => v - top.p[i]))));
   check(putDown.length === 1 && off < 0.05, `the Objects pane shows the top part where it was put down, ${(off * 100).toFixed(1)} cm from where it is: ${putDown.join('; ')}`);
 
+  // Each part drawn in the colour perception saw on it: the Objects pane's swatches name the
+  // nearest of the class's colours, which must be the simulator's material of each part.
+  const swatches = await page.$$eval('.objects-table tbody tr', (rows) =>
+    rows.map((r) => ({ cls: r.children[1]?.textContent?.trim() ?? '', title: r.querySelector('.swatch')?.getAttribute('title') ?? '' })),
+  );
+  const seenColours = swatches.map((s) => `${/^the colour DetectObjects saw on it \(nearest of the class's colours: (\w+)\)$/.exec(s.title)?.[1] ?? '?'} ${s.cls}`).sort();
+  const trueColours = second.parts.map((p) => `${p.color} ${p.class}`).sort();
+  check(
+    JSON.stringify(seenColours) === JSON.stringify(trueColours),
+    `each part is drawn in the colour seen on it: ${seenColours.join(', ')} (the simulator's: ${trueColours.join(', ')})`,
+  );
+
   // Screenshots of the finished run at both sizes: select a SmartRelease to show its candidates.
   await node('SmartRelease', 1).click();
   await page.waitForTimeout(600);

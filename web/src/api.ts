@@ -63,7 +63,8 @@ export interface CellState {
   mode: 'idle' | 'running' | 'paused';
   arm: { joints?: number[]; endpoint?: Pose; moving?: boolean };
   gripper: { open: boolean; closed: boolean; holding: boolean; mode?: string };
-  objects: (Pose & { name: string; class: string })[];
+  /** color: the mean RGB ([0, 1]) DetectObjects saw on the part, when it reported one. */
+  objects: (Pose & { name: string; class: string; color?: [number, number, number] })[];
   waypoints: (Partial<Pose> & { name: string; kind: 'pose' | 'joints'; frame?: string })[];
   frames: (Pose & { name: string; parent: string })[];
   predicates: string[];

@@ -92,11 +92,14 @@ function CandidateTable({ data, known }: { data: SmartMoveData; known: Set<strin
   );
 }
 
-/** The colour a part is drawn in (pane 2): its class's, as perception reports no part's own. */
+/** The colour a part is drawn in (pane 2): the one perception saw on it, else its class's. */
 function Swatch({ look }: { look: PartLook }) {
-  const title = look.colorName
-    ? `drawn in the class's colour ${look.colorName} (the class comes in ${look.colorNames.join(', ')}; perception reports a part's class, not its colour)`
-    : 'the server did not describe this class: drawn grey';
+  const title =
+    look.colorFrom === 'seen'
+      ? `the colour DetectObjects saw on it${look.colorName ? ` (nearest of the class's colours: ${look.colorName})` : ''}`
+      : look.colorFrom === 'class'
+        ? `drawn in the class's colour ${look.colorName} (the class comes in ${look.colorNames.join(', ')}; no colour was reported for this part)`
+        : 'the server did not describe this class: drawn grey';
   return <span className="swatch" style={{ background: cssColour(look.rgb) }} title={title} />;
 }
 
@@ -124,7 +127,7 @@ export function ObjectsPane({ state, selectedType, data, shapes, believed }: Pro
               <tr key={o.name}>
                 <td>{o.name}</td>
                 <td>
-                  <Swatch look={partLook(o.class, shapes)} />
+                  <Swatch look={partLook(o.class, shapes, o.color)} />
                   {o.class}
                 </td>
                 <td>

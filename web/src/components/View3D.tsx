@@ -73,9 +73,9 @@ function clear(group: THREE.Group) {
 /** Where the 3D view looks from: close enough to tell the parts apart, the arm in view. */
 const HOME_VIEW: [number, number, number] = [1.05, -0.95, 0.7];
 
-/** A part: its class's boxes in the object frame, in the class's colour. */
-function partMesh(objectClass: string, shapes: Record<string, ObjectShape> | undefined) {
-  const look = partLook(objectClass, shapes);
+/** A part: its class's boxes in the object frame, in the colour perception saw on it (else its class's). */
+function partMesh(objectClass: string, shapes: Record<string, ObjectShape> | undefined, seen: unknown) {
+  const look = partLook(objectClass, shapes, seen);
   const material = new THREE.MeshLambertMaterial({ color: new THREE.Color(...look.rgb) });
   const group = new THREE.Group();
   for (const box of look.boxes) {
@@ -191,7 +191,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     clear(s.parts);
     for (const object of state.objects) {
       const pose = believed?.poses.get(object.name) ?? object;
-      const mesh = partMesh(object.class, shapes);
+      const mesh = partMesh(object.class, shapes, object.color);
       mesh.position.set(...pose.p);
       mesh.quaternion.set(...pose.q);
       s.parts.add(mesh);
