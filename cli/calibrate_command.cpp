@@ -18,6 +18,7 @@ struct CalibrateOptions {
   std::string scene;
   std::uint64_t seed = 1;
   bool seed_given = false;
+  std::string workcell = "ur5-sim";
   std::string camera_move;  // "DIST,DEG"
   std::string calibration;
   int views = 0;
@@ -44,6 +45,7 @@ std::pair<double, double> parseMove(const std::string& text) {
 
 workcell::WorkcellOptions cellOptions(const CalibrateOptions& options) {
   workcell::WorkcellOptions cell;
+  cell.name = options.workcell;
   cell.scene = options.scene;
   if (options.seed_given) {
     cell.seed = options.seed;
@@ -168,6 +170,8 @@ int evaluate(EvalOptions options) {
 }
 
 void addCellOptions(CLI::App* command, CalibrateOptions& options) {
+  command->add_option("-w,--workcell", options.workcell, "simulated workcell (workcells/NAME.json: ur5-sim, iiwa-sim)")
+      ->capture_default_str();
   command->add_option("--scene", options.scene, "scene file (default sim/scenes/assembly.json)")
       ->check(CLI::ExistingFile);
   command->add_option("--seed", options.seed, "seed of the cell (placement, noise, the camera's move)")

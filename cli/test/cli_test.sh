@@ -36,6 +36,7 @@ check "nodes json"          0 '"category": "knowledge"' -- "$costar" nodes -w te
 check "workcells: iiwa"     0 '^iiwa-sim ' -- "$costar" workcells
 check "validate on iiwa"    0 'valid for workcell .iiwa-sim.' -- "$costar" validate examples/ur5/assemble_structure.xml -w iiwa-sim
 check "nodes of iiwa"       0 '<Action ID="SmartGrasp">' -- "$costar" nodes -w iiwa-sim
+check "calibrate: bad cell" 2 "unknown workcell .nosuch." -- "$costar" calibrate -w nosuch
 check "help"                0 'Exit code: 0 SUCCESS' -- "$costar" run --help
 check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit 0.1
 check "inject: bad spec"    2 "fault 'melt:arm@t=1': unknown kind 'melt'" \
