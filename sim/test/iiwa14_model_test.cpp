@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
+#include <nlohmann/json.hpp>
+
 #include <array>
+#include <fstream>
 #include <memory>
 #include <numbers>
 #include <random>
@@ -98,9 +101,16 @@ TEST_F(Iiwa14Model, HasTheDescribedJointsActuatorsAndHome) {
   const int home = mj_name2id(model_.get(), mjOBJ_KEY, "home");
   ASSERT_GE(home, 0);
   const Joints7 expected = Joints7(Eigen::Map<const Joints7>(model_->key_qpos + home * model_->nq));
+  // The keyframe is the description's home_deg (read from the file the model was generated from).
+  std::ifstream description_file(COSTAR_IIWA14_DESCRIPTION);
+  ASSERT_TRUE(description_file.good()) << COSTAR_IIWA14_DESCRIPTION;
+  const nlohmann::json home_deg = nlohmann::json::parse(description_file).at("home_deg");
+  ASSERT_EQ(home_deg.size(), 7U);
   Joints7 described;
-  described << 0, 30, 0, -80, 0, 70, 0;
-  EXPECT_TRUE(expected.isApprox(described * kDegree, 1e-9));
+  for (int i = 0; i < 7; ++i) {
+    described[i] = home_deg[static_cast<std::size_t>(i)].get<double>();
+  }
+  EXPECT_TRUE(expected.isApprox(described * kDegree, 1e-9)) << expected.transpose() / kDegree;
   // The published mass of the LBR iiwa 14 R820 (29.9 kg) with the estimated link masses.
   double mass = 0.0;
   for (int b = 1; b < model_->nbody; ++b) {
