@@ -8,36 +8,18 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/json_fields.h"
 #include "core/paths.h"
 
 namespace costar::workcell {
 
 namespace {
 
+using core::json_fields::fail;
+using core::json_fields::join;
+using core::json_fields::onlyKnown;
+using core::json_fields::shown;
 using nlohmann::json;
-
-[[noreturn]] void fail(const std::string& field, const std::string& problem) {
-  throw std::runtime_error(field + ": " + problem);
-}
-
-std::string shown(const json& value) {
-  std::string text = value.dump();
-  return text.size() <= 60 ? text : text.substr(0, 57) + "...";
-}
-
-void onlyKnown(const json& object, const std::string& field, const std::set<std::string>& known) {
-  for (const auto& [key, value] : object.items()) {
-    if (!known.contains(key)) {
-      std::string list;
-      for (const std::string& name : known) {
-        list += (list.empty() ? "" : ", ") + name;
-      }
-      fail(field.empty() ? key : field + "." + key, "unknown field (known: " + list + ")");
-    }
-  }
-}
-
-std::string join(const std::string& field, const std::string& key) { return field.empty() ? key : field + "." + key; }
 
 const json& member(const json& object, const std::string& field, const std::string& key) {
   if (!object.contains(key)) {
