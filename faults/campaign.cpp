@@ -1,21 +1,19 @@
 #include "faults/campaign.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <mutex>
 #include <random>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 
 #include "arm/waypoints.h"
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
+#include "core/parallel.h"
 #include "core/paths.h"
 #include "faults/injector.h"
 #include "sim/simulation.h"
@@ -216,33 +214,19 @@ CampaignSummary runCampaign(const CampaignOptions& options,
   }
   CampaignSummary summary;
   summary.options = options;
-  summary.trials.resize(static_cast<std::size_t>(options.count));
-  std::atomic<int> next{0};
-  int done = 0;
-  std::mutex mutex;
-  const auto worker = [&] {
-    for (int index = next++; index < options.count; index = next++) {
-      // Every task meets every fault: task cycles fastest, then the fault.
-      const std::size_t tasks = options.tasks.size();
-      const std::size_t t = static_cast<std::size_t>(index) % tasks;
-      const std::size_t f = (static_cast<std::size_t>(index) / tasks) % faults.size();
-      FaultTrial trial = runOne(options, options.tasks[t], plans[t], faults[f], waypoints_before, index);
-      std::lock_guard lock(mutex);
-      summary.trials[static_cast<std::size_t>(index)] = trial;
-      ++done;
-      if (progress) {
-        progress(trial, done);
-      }
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int j = 1; j < std::max(1, options.jobs); ++j) {
-    threads.emplace_back(worker);
-  }
-  worker();
-  for (auto& thread : threads) {
-    thread.join();
-  }
+  // Every task meets every fault: task cycles fastest, then the fault.
+  summary.trials = runIndexed(
+      static_cast<std::size_t>(options.count), options.jobs,
+      [&](std::size_t index) {
+        const std::size_t t = index % options.tasks.size();
+        const std::size_t f = (index / options.tasks.size()) % faults.size();
+        return runOne(options, options.tasks[t], plans[t], faults[f], waypoints_before, static_cast<int>(index));
+      },
+      [&](const FaultTrial& trial, std::size_t, int done) {
+        if (progress) {
+          progress(trial, done);
+        }
+      });
   return summary;
 }
 

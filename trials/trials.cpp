@@ -3,21 +3,19 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <mutex>
 #include <regex>
 #include <stdexcept>
-#include <thread>
 
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
 #include "core/files.h"
+#include "core/parallel.h"
 #include "faults/injector.h"
 #include "sim/simulation.h"
 #include "trials/disturbance.h"
@@ -232,31 +230,18 @@ Summary runTrials(const TrialOptions& options, const std::function<void(const Tr
   }
   Summary summary;
   summary.options = options;
-  summary.trials.resize(indices.size());
-  // Slot 0 is this thread's, in first_cell: a workcell shares the perception pipeline of the
+  // Slot 0 runs on this thread, in first_cell: a workcell shares the perception pipeline of the
   // thread that built it (workcell/sim_workcell.cpp), so it must run on that thread.
-  std::atomic<std::size_t> next{1};
-  int done = 0;
-  std::mutex mutex;
-  const auto worker = [&](std::size_t first_slot) {
-    for (std::size_t slot = first_slot; slot < indices.size(); slot = next++) {
-      TrialResult result = runOne(options, plan, judge, indices[slot], slot == 0 ? std::move(first_cell) : nullptr);
-      std::lock_guard lock(mutex);
-      summary.trials[slot] = result;
-      ++done;
-      if (progress) {
-        progress(result, done);
-      }
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int j = 1; j < std::max(1, options.jobs); ++j) {
-    threads.emplace_back([&worker, &next] { worker(next++); });
-  }
-  worker(0);
-  for (auto& thread : threads) {
-    thread.join();
-  }
+  summary.trials = runIndexed(
+      indices.size(), options.jobs,
+      [&](std::size_t slot) {
+        return runOne(options, plan, judge, indices[slot], slot == 0 ? std::move(first_cell) : nullptr);
+      },
+      [&](const TrialResult& result, std::size_t, int done) {
+        if (progress) {
+          progress(result, done);
+        }
+      });
   return summary;
 }
 

@@ -20,8 +20,13 @@ TEST(FaultCampaign, EveryFaultStopsTheTaskInTimeWithTheArmAtRest) {
   options.seed = 11;
   options.window_s = 4.0;  // task 1 takes about 6 s: every fault is due while it runs
   options.waypoints = dataRoot() / "examples/ur5/blind_waypoints.json";
+  options.jobs = 2;  // two runs at once; the results still in run order
   const CampaignSummary summary = runCampaign(options);
   ASSERT_EQ(summary.trials.size(), options.faults.size());
+  for (std::size_t i = 0; i < summary.trials.size(); ++i) {
+    EXPECT_EQ(summary.trials[i].index, static_cast<int>(i));
+    EXPECT_TRUE(summary.trials[i].fault.starts_with(options.faults[i] + "@")) << summary.trials[i].fault;
+  }
   for (const FaultTrial& trial : summary.trials) {
     SCOPED_TRACE(trial.fault + ": " + trial.outcome + " at " + trial.failure_path + ": " + trial.reason);
     if (trial.outcome == "no-effect") {
