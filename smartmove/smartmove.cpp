@@ -61,7 +61,10 @@ class Script final : public RunningOperation {
         try {
           current_ = steps_[next_].start();
         } catch (const std::exception& e) {
-          return fail(steps_[next_].what + ": " + e.what());
+          // A step that could not even start (a component that threw, a broken driver) is a
+          // fault, not a miss: reported at once, without backing off (the arm stays at rest),
+          // as when a poll throws.
+          return fail(steps_[next_].what + ": " + e.what(), /*may_back_off=*/false);
         }
       }
       OperationResult result = current_->poll();
@@ -95,9 +98,10 @@ class Script final : public RunningOperation {
 
  private:
   /// Steps that run once the script has failed (backing off), then the failure.
-  OperationResult fail(std::string reason) {
+  OperationResult fail(std::string reason, bool may_back_off = true) {
     const std::size_t failed_step = next_ - 1;  // poll() has moved past it
-    if (!failure_ && next_ > 0 && failed_step >= back_off_from_ && failed_step <= back_off_to_ && !back_off_.empty()) {
+    if (may_back_off && !failure_ && next_ > 0 && failed_step >= back_off_from_ && failed_step <= back_off_to_ &&
+        !back_off_.empty()) {
       failure_ = std::move(reason);
       steps_ = std::move(back_off_);
       back_off_.clear();

@@ -66,5 +66,28 @@ TEST(FaultCampaign, ACameraThatBreaksBetweenDetectionsStopsTheTask) {
   }
 }
 
+TEST(FaultCampaign, AGripperThatThrowsAsItClosesEndsTheGraspAtOnce) {
+  // Task 1's SmartGrasp closes the gripper at about 3.5 s. A gripper component that throws on
+  // that Close used to make the grasp back off (open, lift clear: 1.3-1.5 s of motion) before
+  // its FAILURE, as after a miss; a fault ends it at once, the arm at rest.
+  CampaignOptions options;
+  options.tasks = {paperTasks().front()};
+  options.faults = {"throw:gripper@t=3s"};
+  options.count = 1;
+  options.seed = 40;
+  options.waypoints = dataRoot() / "examples/ur5/blind_waypoints.json";
+  const CampaignSummary summary = runCampaign(options);
+  ASSERT_EQ(summary.trials.size(), 1u);
+  const FaultTrial& trial = summary.trials.front();
+  SCOPED_TRACE(trial.fault + ": " + trial.outcome + " at " + trial.failure_path + ": " + trial.reason);
+  EXPECT_EQ(trial.outcome, "stopped");
+  EXPECT_NE(trial.failure_path.find("SmartGrasp"), std::string::npos);
+  EXPECT_NE(trial.reason.find("close on"), std::string::npos);
+  EXPECT_EQ(trial.reason.find("backed off"), std::string::npos);
+  EXPECT_LE(trial.latency_s, 0.1);
+  EXPECT_LT(trial.final_speed, 0.01);
+  EXPECT_TRUE(trial.waypoints_intact);
+}
+
 }  // namespace
 }  // namespace costar::faults
