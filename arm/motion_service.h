@@ -12,9 +12,8 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <vector>
-
 #include <string_view>
+#include <vector>
 
 #include "arm/joints.h"
 #include "arm/trajectory.h"
