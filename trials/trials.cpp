@@ -17,6 +17,7 @@
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
+#include "bt/trace.h"
 #include "core/files.h"
 #include "faults/injector.h"
 #include "sim/simulation.h"
@@ -103,6 +104,17 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
     }
     const std::vector<sim::PartState> initial = simulation.parts();
     bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
+    std::ofstream trace_file;
+    std::optional<bt::JsonLinesTrace> trace;
+    if (!options.trace_dir.empty()) {
+      const std::filesystem::path file = options.trace_dir / ("trial_" + std::to_string(result.seed) + ".jsonl");
+      trace_file.open(file, std::ios::trunc);
+      if (!trace_file) {
+        throw std::runtime_error("cannot write the trace '" + file.string() + "'");
+      }
+      trace.emplace(trace_file);
+      tree.addObserver(&*trace);
+    }
     bt::Executor executor(tree, cell->clock(), {.time_limit = fromSeconds(options.time_limit_s)});
     executor.setBeforeTick([&cell, &disturber, &simulation] {
       disturber.watch(simulation);
