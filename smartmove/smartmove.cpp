@@ -788,15 +788,22 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
       };
       const double rise = centring->rise;
       const world::Pose turn = centring->turn;
-      // Fully open: the part may sit up to the pads' half-width plus its own off their centre.
+      // Let go only as far as the grasp opened (wider, a finger could push a neighbour), rise
+      // clear, then open fully: the part may sit up to the pads' half-width plus its own off
+      // their centre.
       steps.push_back({"let go of " + object + " to square it up",
+                       [this, opening] {
+                         return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening));
+                       },
+                       nullptr});
+      steps.push_back({"rise above " + object, line([rise](const world::Pose& tcp) { return up(rise) * tcp; }, "rise"),
+                       nullptr});
+      steps.push_back({"open fully above " + object,
                        [this] {
                          return std::make_unique<ComponentStep>(gripper_, "Open",
                                                                 openParams(config_.fingers->max_opening));
                        },
                        nullptr});
-      steps.push_back(
-          {"rise above " + object, line([rise](const world::Pose& tcp) { return up(rise) * tcp; }, "rise"), nullptr});
       steps.push_back({"turn a quarter above " + object,
                        line([turn](const world::Pose& tcp) { return tcp * turn; }, "turn"), nullptr});
       steps.push_back({"go down round " + object,

@@ -19,6 +19,7 @@
 #include "bt/plan_xml.h"
 #include "bt/trace.h"
 #include "core/files.h"
+#include "core/paths.h"
 #include "faults/injector.h"
 #include "sim/simulation.h"
 #include "trials/disturbance.h"
@@ -61,8 +62,15 @@ std::unique_ptr<workcell::Workcell> trialWorkcell(const TrialOptions& options, i
   // The faults asked for, and those the trial's disturbances need (drawn from the same seed as
   // the Disturber that runOne makes).
   std::vector<std::string> inject = options.inject;
-  for (const std::string& fault : Disturber(parseDisturbances(options.disturb), seed).faultSpecs()) {
+  const Disturber disturber(parseDisturbances(options.disturb), seed);
+  for (const std::string& fault : disturber.faultSpecs()) {
     inject.push_back(fault);
+  }
+  // Parts a disturbance adds: one spare of every class per addition, parked off the table.
+  for (int i = 0; i < disturber.additions(); ++i) {
+    for (const world::ObjectClass& object_class : world::loadObjectClasses(dataRoot() / "data" / "objects")) {
+      cell_options.spare_parts.push_back(object_class.name);
+    }
   }
   if (!inject.empty()) {
     cell_options.faults = faults::Injector::fromText(inject, seed);
