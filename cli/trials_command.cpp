@@ -246,6 +246,11 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
           },
           "KIND[@grasp=N]"));
   command->add_option("--json", options->json, "write the summary and every trial as JSON");
+  command
+      ->add_option("--trace", options->trials.trace_dir,
+                   "write every trial's status transitions to DIR/trial_SEED.jsonl (JSON lines, as costar run "
+                   "--trace: the reasons of failures a retry recovered too)")
+      ->check(CLI::ExistingDirectory);
   command->add_option("--plot", options->plot, "write a PNG: success rate, failures, cycle times");
   command->add_option("--require", options->require, "exit 1 when the success rate is below this (0..1)")
       ->check(numberIn(0.0, 1.0, false, ""));

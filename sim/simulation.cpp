@@ -276,6 +276,25 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   const std::filesystem::path root = options.data_root.empty() ? dataRoot() : options.data_root;
   impl->classes = world::loadObjectClasses(root / "data" / "objects");
   impl->placements = placeParts(scene, impl->classes, options.placement_seed);
+  // Spares: parked 1.6 m out on the robot's left, 20 cm apart, resting on the table top's
+  // plane (a plane is endless to MuJoCo: below it a part would be thrown up).
+  for (std::size_t i = 0; i < options.spare_classes.size(); ++i) {
+    const std::string& name = options.spare_classes[i];
+    const auto object = std::find_if(impl->classes.begin(), impl->classes.end(),
+                                     [&](const world::ObjectClass& c) { return c.name == name; });
+    if (object == impl->classes.end() || object->colors.empty()) {
+      throw std::runtime_error("spare part: unknown object class '" + name + "'");
+    }
+    const auto same = std::count_if(impl->placements.begin(), impl->placements.end(),
+                                    [&](const PartPlacement& p) { return p.object_class == name; });
+    PartPlacement spare;
+    spare.name = name + "_" + std::to_string(same);
+    spare.object_class = name;
+    spare.color = object->colors.front().first;
+    spare.pose = world::Pose::Identity();
+    spare.pose.translation() = Eigen::Vector3d(0.4 + 0.2 * static_cast<double>(i), 1.6, object->rest_height);
+    impl->placements.push_back(std::move(spare));
+  }
   impl->noise = options.depth_noise;
 
   // The robot: its description names the model, the joints, home and links. The default

@@ -76,6 +76,12 @@ struct SimulationOptions {
   /// mounted as drawn. Absent: the scene's camera_offset (seeded by the placement seed), if
   /// any. Components never learn it; only calibration recovers it.
   std::optional<world::Pose> camera_offset;
+  /// Spare parts, one of each class named here: built into the model (its bodies are fixed
+  /// once loaded) but parked beside the table on the robot's left (1.6 m out, on the plane of
+  /// the table top, which MuJoCo makes endless), out of the camera's view and the arm's reach, for a disturbance that
+  /// puts a part on the table mid-task (movePart). Named after the scene's parts (node_3 after node_0..2), in the
+  /// class's first colour.
+  std::vector<std::string> spare_classes;
 };
 
 /// A part's true state, for tests and the trial judge.
@@ -149,6 +155,12 @@ class Simulation {
 
   // --- ground truth (tests and the trial judge only) ----------------------------------------
   std::vector<PartState> parts() const;
+  /// True for a part parked off the table top (a spare, or a part taken away).
+  static bool parked(const PartState& part) {
+    const Region table = tableTop();
+    const Eigen::Vector3d& p = part.pose.translation();
+    return p.x() < table.min.x() || p.x() > table.max.x() || p.y() < table.min.y() || p.y() > table.max.y();
+  }
   /// The calibration marker fixed to the gripper (DICT_4X4_50 id kGripperMarkerId, black
   /// square kGripperMarkerSize wide): its frame (x to the image's right, y up, z out of it) in
   /// the world, and in the flange frame (tool0), true values.

@@ -41,6 +41,9 @@ class Script final : public RunningOperation {
     std::function<std::unique_ptr<RunningOperation>()> start;
     /// Checks the step's result; empty when the script may go on.
     std::function<std::string(const OperationResult&)> check;
+    /// A failure of this step is noted in the script's reason and the next step runs (a step
+    /// of backing off that helps but is not needed, e.g. opening fingers that a part blocks).
+    bool may_fail = false;
   };
 
   Script(std::vector<Step> steps, nlohmann::json data, std::function<void(bool)> on_end)
@@ -73,6 +76,10 @@ class Script final : public RunningOperation {
       }
       current_.reset();
       const Step& step = steps_[next_++];
+      if (result.state == OperationState::kFailure && step.may_fail) {
+        notes_ += "; " + step.what + " failed (" + result.reason + ")";
+        continue;
+      }
       if (result.state == OperationState::kFailure) {
         return fail(step.what + ": " + result.reason);
       }
@@ -116,7 +123,7 @@ class Script final : public RunningOperation {
 
   OperationResult finish(OperationResult result) {
     if (failure_ && result.state == OperationState::kSuccess) {
-      result = OperationResult::failure(*failure_ + " (" + back_off_note_ + ")", data_);
+      result = OperationResult::failure(*failure_ + " (" + back_off_note_ + notes_ + ")", data_);
     }
     if (on_end_) {
       on_end_(result.state == OperationState::kSuccess);
@@ -135,6 +142,7 @@ class Script final : public RunningOperation {
   std::vector<Step> back_off_;
   std::string back_off_note_;
   std::optional<std::string> failure_;
+  std::string notes_;  // failures of steps that may fail
 };
 
 std::unique_ptr<RunningOperation> failed(std::string reason, nlohmann::json data = {}) {
@@ -215,6 +223,11 @@ SmartMoveComponent::SmartMoveComponent(const arm::MotionService& motion, compone
   ParamSpec speed{"speed", ValueType::kDouble, "fraction of the arm's top speed", config_.default_speed};
   speed.min = 0.01;
   speed.max = 1.0;
+  ParamSpec centre{"centre", ValueType::kBool,
+                   "after closing, square the part up between the fingers both ways (let go, rise, open fully, turn a "
+                   "quarter, go down, close again), so that where it sits in the hand is known even if it moved after "
+                   "it was seen; for parts that fit the fingers both ways (a node), else skipped",
+                   false};
   ParamSpec push_distance{"distance", ValueType::kDouble, "how far the part is pushed (m)", 0.03};
   push_distance.min = 0.01;
   push_distance.max = 0.1;
@@ -269,7 +282,7 @@ SmartMoveComponent::SmartMoveComponent(const arm::MotionService& motion, compone
                  [this](const Params& params) { return beginMoveOrGrasp(false, params); });
   operations.add({"SmartGrasp",
                   "Picks up the best reachable part that satisfies the conditions.",
-                  {object_class, predicates, grasp, approach, speed},
+                  {object_class, predicates, grasp, approach, speed, centre},
                   component::OperationKind::kRobotAction,
                   check_grasp},
                  [this](const Params& params) { return beginMoveOrGrasp(true, params); });
@@ -605,6 +618,56 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::moveToFreeConfiguration(co
                 what);
 }
 
+std::optional<SmartMoveComponent::Centring> SmartMoveComponent::planCentring(const Candidate& chosen,
+                                                                             const world::Pose& object_pose,
+                                                                             const world::ObjectClass& object_class,
+                                                                             std::string& why) {
+  if (!config_.fingers) {
+    why = "the fingers are not modelled";
+    return std::nullopt;
+  }
+  // Only a grasp on the part's centre line: a shifted grasp would be undone by squaring up.
+  const Eigen::Vector3d centre = chosen.goal.inverse() * object_pose * object_class.bounds().center();
+  if (centre.head<2>().norm() > 0.001) {
+    why = "the grasp is off the part's centre (no room there)";
+    return std::nullopt;
+  }
+  // How far the pads rise to clear the part's top: the part's extent toward the gripper
+  // above the tool centre, the pads' reach below it, a margin.
+  double top = 0.0;
+  const Eigen::AlignedBox3d box = object_class.bounds();
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d point = box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+    top = std::max(top, -(chosen.goal.inverse() * object_pose * point).z());
+  }
+  const double rise = top + config_.finger_reach + 0.01;
+  syncObstacles();
+  const PlannedFingers fingers(*this);
+  const arm::AllowedContacts allowed = touching({chosen.object});
+  for (const double degrees : {90.0, -90.0}) {
+    Centring centring;
+    centring.turn = world::Pose(Eigen::AngleAxisd(degrees * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()));
+    centring.rise = rise;
+    const world::Pose turned = chosen.goal * centring.turn;
+    const auto opening = graspOpening(turned, object_pose, object_class);
+    if (!opening) {
+      why = "the part is too wide for the fingers turned a quarter";
+      return std::nullopt;
+    }
+    centring.opening = *opening;
+    fingers.at(config_.fingers->max_opening);  // it goes down round the part fully open
+    std::string reason;
+    const auto down = motion_.firstFree(motion_.solutions(turned, chosen.solutions.front()), allowed, reason);
+    const auto above =
+        down ? motion_.firstFree(motion_.solutions(up(rise) * turned, *down), allowed, reason) : std::nullopt;
+    if (down && above) {
+      return centring;
+    }
+    why = "turned a quarter the fingers would touch a neighbour: " + (reason.empty() ? "no IK solution" : reason);
+  }
+  return std::nullopt;
+}
+
 std::unique_ptr<RunningOperation> SmartMoveComponent::follow(const arm::MotionPlan& plan, const std::string& what) {
   if (!plan.ok()) {
     return failed(what + ": " + plan.failure);
@@ -673,6 +736,12 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
   }
   const world::Pose pregrasp = chosen.goal * world::Pose(Eigen::Translation3d(0, 0, -approach));
   const std::string object = chosen.object;
+  std::optional<Centring> centring;
+  if (params.at("centre").asBool()) {
+    std::string why;
+    centring = planCentring(chosen, object_pose, *objectClass(object_class), why);
+    data["centring"] = centring ? "squared up a quarter turn" : "skipped: " + why;
+  }
   std::vector<Script::Step> steps;
   steps.push_back({"open the gripper",
                    [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); },
@@ -690,23 +759,74 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
                          "approach");
                    },
                    nullptr});
-  steps.push_back(
-      {"close on " + object,
-       [this] {
-         return std::make_unique<ComponentStep>(gripper_, "Close",
-                                                component::ParamMap{{"speed", 0.1}, {"force", 40.0}});
-       },
-       [this, object, object_class, object_pose, chosen, opening](const OperationResult& result) -> std::string {
-         if (!result.data.value("holding", false)) {
-           return "the fingers closed on nothing: " + object + " was not where it was seen";
-         }
-         held_ = object;
-         held_class_ = object_class;
-         held_grasp_ = object_pose.inverse() * chosen.goal;
-         held_opening_ = opening;
-         collisions_.remove(partObstacle(object));
-         return {};
-       }});
+  steps.push_back({"close on " + object,
+                   [this] {
+                     return std::make_unique<ComponentStep>(gripper_, "Close",
+                                                            component::ParamMap{{"speed", 0.1}, {"force", 40.0}});
+                   },
+                   [this, object, object_class, object_pose, chosen, opening,
+                    centring](const OperationResult& result) -> std::string {
+                     if (!result.data.value("holding", false)) {
+                       return "the fingers closed on nothing: " + object + " was not where it was seen";
+                     }
+                     if (centring) {
+                       return {};  // held once squared up
+                     }
+                     held_ = object;
+                     held_class_ = object_class;
+                     held_grasp_ = object_pose.inverse() * chosen.goal;
+                     held_opening_ = opening;
+                     collisions_.remove(partObstacle(object));
+                     return {};
+                   }});
+  if (centring) {
+    // The fingers centred the part across them and turned it square with the pads; along the
+    // pads it may sit anywhere they still touch it. Closing again a quarter turn round centres
+    // it that way too: then it sits where the grasp was planned, wherever it was.
+    const auto line = [this, object](std::function<world::Pose(const world::Pose&)> to, const char* what) {
+      return [this, object, to = std::move(to), what] {
+        const arm::JointVector now = motion_.joints();
+        return follow(motion_.planLine(now, to(motion_.toolAt(now)), config_.approach_speed, touching({object})), what);
+      };
+    };
+    const double rise = centring->rise;
+    const world::Pose turn = centring->turn;
+    // Let go only as far as the grasp opened (wider, a finger could push a neighbour), rise
+    // clear, then open fully: the part may sit up to the pads' half-width plus its own off
+    // their centre.
+    steps.push_back({"let go of " + object + " to square it up",
+                     [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); },
+                     nullptr});
+    steps.push_back(
+        {"rise above " + object, line([rise](const world::Pose& tcp) { return up(rise) * tcp; }, "rise"), nullptr});
+    steps.push_back(
+        {"open fully above " + object,
+         [this] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(config_.fingers->max_opening)); },
+         nullptr});
+    steps.push_back({"turn a quarter above " + object,
+                     line([turn](const world::Pose& tcp) { return tcp * turn; }, "turn"), nullptr});
+    steps.push_back({"go down round " + object,
+                     line([rise](const world::Pose& tcp) { return up(-rise) * tcp; }, "approach"), nullptr});
+    steps.push_back(
+        {"close again on " + object,
+         [this] {
+           return std::make_unique<ComponentStep>(gripper_, "Close",
+                                                  component::ParamMap{{"speed", 0.1}, {"force", 40.0}});
+         },
+         [this, object, object_class, object_pose, chosen, centring](const OperationResult& result) -> std::string {
+           if (!result.data.value("holding", false)) {
+             return "the fingers closed on nothing: " + object + " was lost while squaring it up";
+           }
+           held_ = object;
+           held_class_ = object_class;
+           // Centred both ways and square with the pads: as planned, turned.
+           held_grasp_ = object_pose.inverse() * chosen.goal * centring->turn;
+           held_opening_ = centring->opening;
+           collisions_.remove(partObstacle(object));
+           return {};
+         }});
+  }
+  const std::size_t last_close = steps.size() - 1;
   steps.push_back({"lift " + object,
                    [this, object] {
                      const arm::JointVector now = motion_.joints();
@@ -721,13 +841,15 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
   // because the part moved) opens and lifts straight up before it reports the failure, so
   // that the tool is clear of where the part was seen and a plan that looks again can go on
   // (from down there every motion would start in collision with the part as it was seen).
+  // Opening may fail (a finger that landed on the moved part, pressed against it); lifting
+  // straight up is what gets the tool clear, so it runs all the same.
   const std::size_t approach_step = 2;
-  const std::size_t close_step = 3;
   auto script = std::make_unique<Script>(std::move(steps), data, nullptr);
   script->backOff(
-      approach_step, close_step,
+      approach_step, last_close,
       {{"open the gripper",
-        [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); }, nullptr},
+        [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); }, nullptr,
+        true},
        {"lift clear",
         [this, object] {
           // Straight up from wherever the miss left the fingers, even beside a neighbour (a

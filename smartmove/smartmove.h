@@ -87,6 +87,10 @@ struct SmartMoveConfig {
   double grasp_shift_step = 0.01;
   double grasp_shift_max = 0.04;
   double grasp_shift_keep = 0.003;
+  /// m the finger pads reach past the tool centre point along the approach (the simulated
+  /// 2-finger gripper's 40 mm pads are centred on it): how far they rise to clear a part before
+  /// SmartGrasp centre="true" turns them.
+  double finger_reach = 0.02;
   CostWeights weights;
 };
 
@@ -179,6 +183,18 @@ class SmartMoveComponent final : public component::TableComponent {
   std::vector<planning::CollisionShape> fingerShapes(double opening) const;
   /// The Open operation's parameters: at `opening` when the fingers are modelled, else fully.
   component::ParamMap openParams(double opening) const;
+  /// SmartGrasp centre="true": after the close, open fully, rise `rise` m, turn by `turn` about
+  /// the tool axis, go down and close, which centres the part along the pads too; `opening` (m)
+  /// is the turned grasp's, to release it.
+  struct Centring {
+    world::Pose turn = world::Pose::Identity();
+    double rise = 0.0;
+    double opening = 0.0;
+  };
+  /// How to square up the part of the `chosen` grasp, or nullopt and why not (the grasp is off
+  /// the part's centre, the part does not fit the fingers turned, a neighbour is in the way).
+  std::optional<Centring> planCentring(const Candidate& chosen, const world::Pose& object_pose,
+                                       const world::ObjectClass& object_class, std::string& why);
   /// Starts a joint-space motion to the collision-free IK solution for `pose` nearest `seed`
   /// (the arm's operation named `what`), or an operation that fails with `none` and the reason.
   std::unique_ptr<component::RunningOperation> moveToFreeConfiguration(const world::Pose& pose,

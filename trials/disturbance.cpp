@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include "sim/scene.h"
 #include "sim/simulation.h"
 #include "smartmove/footprint.h"
 
@@ -24,6 +25,9 @@ constexpr double kNudgeMax = 0.03;
 constexpr double kTurnMaxDeg = 15.0;
 constexpr double kNudgeGap = 0.002;  // m kept between the nudged part's footprint and others'
 constexpr int kNudgeDraws = 32;
+constexpr double kAddGap = 0.03;            // m between an added part's footprint and others'
+constexpr double kAddToolClearance = 0.12;  // m from the tool's centre, in x and y
+constexpr int kAddDraws = 64;
 
 std::string format(const char* pattern, auto... values) {
   char text[256];
@@ -54,9 +58,11 @@ DisturbanceSpec parseDisturbance(std::string_view text) {
     spec.kind = DisturbanceKind::kTakeAway;
   } else if (kind == "drop-frame") {
     spec.kind = DisturbanceKind::kDropFrame;
+  } else if (kind == "add") {
+    spec.kind = DisturbanceKind::kAdd;
   } else {
     throw std::invalid_argument(where + "unknown kind '" + std::string(kind) +
-                                "' (known: nudge, take-away, drop-frame)");
+                                "' (known: nudge, take-away, drop-frame, add)");
   }
   if (at != std::string_view::npos) {
     const std::string_view when = text.substr(at + 1);
@@ -89,6 +95,8 @@ std::string disturbanceGrammar() {
          "down\n"
          "  take-away   the part about to be grasped is taken off the table\n"
          "  drop-frame  one camera frame of a DetectObjects comes empty\n"
+         "  add         a part (node or link, drawn) is put on the table at a free place as the gripper goes down to "
+         "another\n"
          "  @grasp=N    the N-th approach to a part (default: the 1st to 3rd, drawn)";
 }
 
@@ -133,6 +141,8 @@ void Disturber::watch(sim::Simulation& simulation) {
         pending.done = true;
         if (pending.spec.kind == DisturbanceKind::kNudge) {
           nudge(simulation, pending, approached);
+        } else if (pending.spec.kind == DisturbanceKind::kAdd) {
+          add(simulation, pending);
         } else {
           takeAway(simulation, pending, approached);
         }
@@ -191,6 +201,58 @@ void Disturber::takeAway(sim::Simulation& simulation, Pending& pending, const st
   simulation.movePart(name, away);
   pending.event = format("take-away %s at %.1f s (approach %d)", name.c_str(),
                          toSeconds(simulation.time().time_since_epoch()), pending.approach);
+}
+
+int Disturber::additions() const {
+  return static_cast<int>(std::count_if(pending_.begin(), pending_.end(), [](const Pending& pending) {
+    return pending.spec.kind == DisturbanceKind::kAdd;
+  }));
+}
+
+void Disturber::add(sim::Simulation& simulation, Pending& pending) {
+  const std::vector<sim::PartState> parts = simulation.parts();
+  std::vector<const sim::PartState*> spares;
+  for (const sim::PartState& part : parts) {
+    if (sim::Simulation::parked(part) && classOf(simulation, part.object_class) != nullptr) {
+      spares.push_back(&part);
+    }
+  }
+  if (spares.empty()) {
+    pending.event = format("add: no spare part is parked off the table (approach %d)", pending.approach);
+    return;
+  }
+  const sim::PartState& spare = *spares[std::uniform_int_distribution<std::size_t>(0, spares.size() - 1)(random_)];
+  const world::ObjectClass& object_class = *classOf(simulation, spare.object_class);
+  // Anywhere on the reachable table the camera sees, clear of every part on it and of the
+  // gripper going down (a person puts a part where there is room, not under the robot).
+  const sim::Region table = sim::defaultRegions().at("table");
+  const Eigen::Vector2d tool = simulation.tcpPose().translation().head<2>();
+  std::uniform_real_distribution<double> x(table.min.x(), table.max.x());
+  std::uniform_real_distribution<double> y(table.min.y(), table.max.y());
+  std::uniform_real_distribution<double> yaw(-std::numbers::pi, std::numbers::pi);
+  for (int draw = 0; draw < kAddDraws; ++draw) {
+    world::Pose placed = world::Pose::Identity();
+    const double degrees = yaw(random_) * 180.0 / std::numbers::pi;
+    placed.linear() =
+        Eigen::AngleAxisd(degrees * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    placed.translation() = Eigen::Vector3d(x(random_), y(random_), object_class.rest_height);
+    bool clear = (placed.translation().head<2>() - tool).norm() > kAddToolClearance;
+    for (const sim::PartState& other : parts) {
+      const world::ObjectClass* other_class = classOf(simulation, other.object_class);
+      if (!clear || other.name == spare.name || other_class == nullptr || sim::Simulation::parked(other)) {
+        continue;
+      }
+      clear = smartmove::footprintGap(object_class, placed, *other_class, other.pose) >= kAddGap;
+    }
+    if (clear) {
+      simulation.movePart(spare.name, placed);
+      pending.event = format("add %s at (%.2f, %.2f) m, %+.0f deg at %.1f s (approach %d)", spare.name.c_str(),
+                             placed.translation().x(), placed.translation().y(), degrees,
+                             toSeconds(simulation.time().time_since_epoch()), pending.approach);
+      return;
+    }
+  }
+  pending.event = format("add %s: no free place on the table (approach %d)", spare.name.c_str(), pending.approach);
 }
 
 std::vector<std::string> Disturber::events() const {

@@ -9,6 +9,9 @@
 //   take-away   the part about to be grasped is taken off the table at that moment
 //   drop-frame  one camera frame of one DetectObjects comes empty (the fault injector's
 //               drop-frame:camera@op=N, N drawn from the seed among the plan's first frames)
+//   add         a part is put on the table at a free place, as the gripper starts down toward
+//               another (its class drawn from the seed among the cell's spare parts, parked
+//               off the table from the start: the simulator's bodies are fixed once loaded)
 // "@grasp=N" picks the N-th approach to a part (default: 1 to 3, drawn from the seed).
 // An approach is the tool going down over a part resting on the table with the fingers open
 // and empty, within 3 cm of its centre, 4 to 9 cm above it (just past the pre-grasp pose).
@@ -26,7 +29,7 @@ class Simulation;
 
 namespace costar::trials {
 
-enum class DisturbanceKind { kNudge, kTakeAway, kDropFrame };
+enum class DisturbanceKind { kNudge, kTakeAway, kDropFrame, kAdd };
 
 struct DisturbanceSpec {
   DisturbanceKind kind = DisturbanceKind::kNudge;
@@ -49,6 +52,9 @@ class Disturber {
   /// Fault specs (faults/fault.h grammar) the trial's cell must inject for the camera's
   /// disturbances (drop-frame), drawn from the seed.
   std::vector<std::string> faultSpecs() const { return faults_; }
+  /// How many `add` disturbances there are: the trial's cell needs that many spare parts of
+  /// every class (sim::SimulationOptions::spare_classes).
+  int additions() const;
   /// Looks at the simulation's true state and disturbs it when a disturbance is due.
   void watch(sim::Simulation& simulation);
   /// What was done, one line each ("nudge node_1: 23 mm, -7 deg at 12.3 s"), for the trial's
@@ -67,6 +73,7 @@ class Disturber {
   };
   void nudge(sim::Simulation& simulation, Pending& pending, const std::string& part);
   void takeAway(sim::Simulation& simulation, Pending& pending, const std::string& part);
+  void add(sim::Simulation& simulation, Pending& pending);
 
   std::vector<Pending> pending_;
   std::vector<std::string> faults_;

@@ -14,8 +14,10 @@
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
+#include "bt/trace.h"
 #include "core/files.h"
 #include "core/parallel.h"
+#include "core/paths.h"
 #include "faults/injector.h"
 #include "sim/simulation.h"
 #include "trials/disturbance.h"
@@ -58,8 +60,15 @@ std::unique_ptr<workcell::Workcell> trialWorkcell(const TrialOptions& options, i
   // The faults asked for, and those the trial's disturbances need (drawn from the same seed as
   // the Disturber that runOne makes).
   std::vector<std::string> inject = options.inject;
-  for (const std::string& fault : Disturber(parseDisturbances(options.disturb), seed).faultSpecs()) {
+  const Disturber disturber(parseDisturbances(options.disturb), seed);
+  for (const std::string& fault : disturber.faultSpecs()) {
     inject.push_back(fault);
+  }
+  // Parts a disturbance adds: one spare of every class per addition, parked off the table.
+  for (int i = 0; i < disturber.additions(); ++i) {
+    for (const world::ObjectClass& object_class : world::loadObjectClasses(dataRoot() / "data" / "objects")) {
+      cell_options.spare_parts.push_back(object_class.name);
+    }
   }
   if (!inject.empty()) {
     cell_options.faults = faults::Injector::fromText(inject, seed);
@@ -101,6 +110,17 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
     }
     const std::vector<sim::PartState> initial = simulation.parts();
     bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
+    std::ofstream trace_file;
+    std::optional<bt::JsonLinesTrace> trace;
+    if (!options.trace_dir.empty()) {
+      const std::filesystem::path file = options.trace_dir / ("trial_" + std::to_string(result.seed) + ".jsonl");
+      trace_file.open(file, std::ios::trunc);
+      if (!trace_file) {
+        throw std::runtime_error("cannot write the trace '" + file.string() + "'");
+      }
+      trace.emplace(trace_file);
+      tree.addObserver(&*trace);
+    }
     bt::Executor executor(tree, cell->clock(), {.time_limit = fromSeconds(options.time_limit_s)});
     executor.setBeforeTick([&cell, &disturber, &simulation] {
       disturber.watch(simulation);

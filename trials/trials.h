@@ -46,6 +46,9 @@ struct TrialOptions {
   /// Disturbances of the simulated world in every trial (trials/disturbance.h grammar: nudge,
   /// take-away, drop-frame), drawn from the trial's seed.
   std::vector<std::string> disturb;
+  /// When set, every trial's status transitions are written to trace_dir/trial_SEED.jsonl
+  /// (bt/trace.h JSON lines: each node's failure reason, also of failures a retry recovered).
+  std::filesystem::path trace_dir;
 };
 
 struct TrialResult {

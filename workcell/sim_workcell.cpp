@@ -251,6 +251,7 @@ class SimWorkcell final : public Workcell {
     sim_options.gripper_model = dataRoot() / gripper.mjcf;
     sim_options.robot_base = cell.robot_base;
     sim_options.placement_seed = options.seed;
+    sim_options.spare_classes = options.spare_parts;
     if (options.camera_move) {
       sim::CameraOffset offset;
       offset.random = true;

@@ -58,6 +58,9 @@ struct WorkcellOptions {
   /// The same as fault specs (faults/fault.h grammar), for the CLI: the executable that builds
   /// the cell makes the injector from them (seeded with `seed`, else 1) when `faults` is null.
   std::vector<std::string> inject;
+  /// Simulated cells: a spare part of each class named here, parked off the table, for a
+  /// disturbance that puts a part on it mid-task (sim::SimulationOptions::spare_classes).
+  std::vector<std::string> spare_parts;
 };
 
 class Workcell {

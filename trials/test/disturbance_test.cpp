@@ -14,6 +14,7 @@
 
 #include <unistd.h>
 
+#include "sim/scene.h"
 #include "trials/trials.h"
 
 namespace costar::trials {
@@ -126,6 +127,30 @@ TEST_F(DisturbedTrials, APartTakenAwayFailsTheGraspAndARetryTakesTheOther) {
 
   const Summary retrying = runTrials(options(kPickUpRetrying, "take-away@grasp=1"));
   EXPECT_TRUE(retrying.trials[0].success) << retrying.trials[0].failure_path << ": " << retrying.trials[0].reason;
+}
+
+// A part added mid-task: a spare parked off the table from the start (the simulator's bodies
+// are fixed once loaded) is put at a free place on the table as the gripper goes down to a
+// node; the plan goes on and lifts a node all the same.
+TEST_F(DisturbedTrials, APartAddedAsTheGripperGoesDownLandsOnTheTableAndThePlanGoesOn) {
+  const Summary summary = runTrials(options(kPickUpRetrying, "add@grasp=1"));
+  const TrialResult& trial = summary.trials[0];
+  ASSERT_EQ(trial.disturbances.size(), 1u);
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(
+      trial.disturbances[0], match,
+      std::regex(R"(add (node|link)_\d at \(([-\d.]+), ([-\d.]+)\) m, [-+]\d+ deg at [\d.]+ s \(approach 1\))")))
+      << trial.disturbances[0];
+  const sim::Region table = sim::defaultRegions().at("table");
+  const double x = std::stod(match[2]);
+  const double y = std::stod(match[3]);
+  EXPECT_GE(x, table.min.x() - 0.005);
+  EXPECT_LE(x, table.max.x() + 0.005);
+  EXPECT_GE(y, table.min.y() - 0.005);
+  EXPECT_LE(y, table.max.y() + 0.005);
+  EXPECT_TRUE(trial.success) << trial.failure_path << ": " << trial.reason;
+  EXPECT_EQ(runTrials(options(kPickUpRetrying, "add@grasp=1")).trials[0].disturbances, trial.disturbances);
+  EXPECT_THROW(parseDisturbance("add@t=3"), std::invalid_argument);
 }
 
 TEST_F(DisturbedTrials, ADisturbanceNeverDueIsListedAsNotApplied) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <functional>
 #include <map>
 
 #include "bt/builder.h"
@@ -26,12 +27,18 @@ class SmartMoveSim : public ::testing::Test {
     cell = makeWorkcell({.name = "ur5-sim", .scene = scene, .memory_only = true, .test_oracle_perception = true});
   }
 
-  bt::RunResult run(const std::string& body) {
+  /// `meddle` runs before every tick (a person moving parts under the running plan).
+  bt::RunResult run(const std::string& body, const std::function<void()>& meddle = {}) {
     const auto plan = bt::loadPlanText(
         R"x(<root BTCPP_format="4"><BehaviorTree ID="main">)x" + body + "</BehaviorTree></root>", "test.xml");
     bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
     bt::Executor executor(tree, cell->clock(), {.time_limit = std::chrono::seconds(60)});
-    executor.setBeforeTick([this] { cell->beforeTick(); });
+    executor.setBeforeTick([this, &meddle] {
+      if (meddle) {
+        meddle();
+      }
+      cell->beforeTick();
+    });
     return executor.run();
   }
 
@@ -166,6 +173,46 @@ TEST_F(SmartMoveSim, GraspsANodeBoxedInByLinksWithTheFingersOpenedOnlyAsFarAsItN
   const sim::FingerState fingers = cell->simulation()->fingers();
   EXPECT_NEAR(fingers.opening, 0.05, 0.004);  // squeezing the node
   EXPECT_EQ(cell->simulation()->armTableContactSteps(), 0u);
+}
+
+// Issue 12: a node slid 15 mm along the pads as the gripper goes down to it is gripped where it
+// now lies, off the pads' centre; put down by where it was seen it lands 15 mm beside the node it
+// goes on. SmartGrasp centre="true" squares it up a quarter turn round, which centres it along
+// the pads too, so it lands centred.
+TEST_F(SmartMoveSim, ANodeSlidAlongThePadsBeforeTheCloseIsSquaredUpAndPlacedCentred) {
+  const auto stack = [this](const char* grasp, double along) {
+    open(R"x({"parts": [{"class": "node", "color": "red", "at": [0.45, -0.2, 20]},
+                       {"class": "node", "color": "blue", "at": [0.5, 0.2, 0]}]})x");
+    bool slid = false;
+    const auto slide = [this, &slid, along] {
+      sim::Simulation& simulation = *cell->simulation();
+      const world::Pose tcp = simulation.tcpPose();
+      const sim::PartState node = part("node_0");
+      const Eigen::Vector3d offset = tcp.translation() - node.pose.translation();
+      if (!slid && along > 0.0 && simulation.fingers().opening > 0.04 && offset.head<2>().norm() < 0.005 &&
+          offset.z() < 0.07) {
+        world::Pose moved = node.pose;
+        moved.translation() += along * tcp.linear().col(0);  // along the pads
+        simulation.movePart("node_0", moved);
+        slid = true;
+      }
+    };
+    const bt::RunResult result =
+        run(std::string("<Sequence>") + grasp + R"x(<SmartRelease target_class="node"/></Sequence>)x", slide);
+    EXPECT_EQ(slid, along > 0.0);
+    EXPECT_EQ(result.status, bt::Status::kSuccess) << result.failure_path << ": " << result.failure_reason;
+    cell->simulation()->stepTo(cell->simulation()->time() + std::chrono::seconds(1));
+    return (part("node_0").pose.translation() - part("node_1").pose.translation()).head<2>().norm();
+  };
+  const char* plain = R"x(<SmartGrasp object_class="node" predicates="right_of(table_center)"/>)x";
+  const char* centred = R"x(<SmartGrasp object_class="node" predicates="right_of(table_center)" centre="true"/>)x";
+  const double undisturbed = stack(plain, 0.0);
+  const double slid = stack(plain, 0.015);
+  const double squared = stack(centred, 0.015);
+  EXPECT_LT(undisturbed, 0.003);
+  EXPECT_GT(slid, 0.01);                                             // put down by where it was seen
+  EXPECT_LT(squared, 0.003);                                         // as if it had not moved
+  EXPECT_NEAR(part("node_0").pose.translation().z(), 0.075, 0.004);  // resting on node_1
 }
 
 // Issue 12: a link with a node 10 mm from either side of its middle. The centred grasp has no
