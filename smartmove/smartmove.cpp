@@ -20,6 +20,21 @@ using component::ValueType;
 
 namespace {
 
+/// Close's parameters: the gripper's declared defaults (its speed is in its own units: m/s for
+/// a 2-finger gripper, strokes/s for the adaptive one) with the grip force `force` (N).
+component::ParamMap closeParams(const component::Component& gripper, double force) {
+  component::ParamMap params;
+  if (const component::OperationSpec* close = gripper.description().operation("Close")) {
+    for (const ParamSpec& spec : close->params) {
+      if (spec.default_value) {
+        params[spec.name] = *spec.default_value;
+      }
+    }
+  }
+  params["force"] = force;
+  return params;
+}
+
 /// An operation of another component, started now, as a step.
 class ComponentStep final : public RunningOperation {
  public:
@@ -685,10 +700,7 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& o
                      nullptr});
     steps.push_back(
         {"close on " + object,
-         [this] {
-           return std::make_unique<ComponentStep>(gripper_, "Close",
-                                                  component::ParamMap{{"speed", 0.1}, {"force", 40.0}});
-         },
+         [this] { return std::make_unique<ComponentStep>(gripper_, "Close", closeParams(gripper_, 40.0)); },
          [this, object, object_class, object_pose, chosen, opening](const OperationResult& result) -> std::string {
            if (!result.data.value("holding", false)) {
              return "the fingers closed on nothing: " + object + " was not where it was seen";

@@ -134,7 +134,7 @@ class SimWorkcell final : public Workcell {
                        : (options.memory_only ? cell_.waypoints : defaultWaypointFile(cell_.name)),
                    /*persist=*/!options.memory_only, robot_description_.jointCount()),
         grasps_(dataRoot() / "data/grasps.json",
-                options.memory_only ? std::filesystem::path() : defaultGraspFile(cell_.name)),
+                options.memory_only ? std::filesystem::path() : defaultGraspFile(cell_.name), gripper_model_.grasps),
         faults_(options.faults) {
     simulation_->attach(static_cast<SimClock&>(clock()));
     if (faults_) {
@@ -142,8 +142,15 @@ class SimWorkcell final : public Workcell {
     }
     // The drivers and components as the cell uses them: wrapped by the fault injector, if any.
     arm::ArmDriver& arm_driver = faults_ ? faults_->wrap(arm_driver_) : arm_driver_;
-    gripper::GripperDriver& gripper_driver = faults_ ? faults_->wrap(gripper_driver_) : gripper_driver_;
-    cell_gripper_driver_ = &gripper_driver;
+    // The gripper's driver: the 2-finger fingers (wrapped by the fault injector, if any) or the
+    // adaptive gripper the simulation drives.
+    GripperDrivers gripper_drivers;
+    if (gripper_model_.adaptive.empty()) {
+      gripper_drivers.parallel = faults_ ? &faults_->wrap(gripper_driver_) : &gripper_driver_;
+    } else {
+      gripper_drivers.adaptive = simulation_->adaptiveGripper();
+    }
+    cell_gripper_driver_ = gripper_drivers.parallel;
     camera::RgbdCamera& camera = faults_ ? faults_->wrap(camera_) : camera_;
     const auto add = [this](std::shared_ptr<component::Component> component) {
       components().add(faults_ ? faults_->wrap(std::move(component)) : std::move(component));
@@ -166,7 +173,7 @@ class SimWorkcell final : public Workcell {
         arm::makeKinematics(robot_description_), arm_config);
     // SmartMove reaches the gripper through its operations, as the tree does: the same (possibly
     // fault-injected) component the registry holds.
-    std::shared_ptr<component::Component> gripper = gripper_model_.make_component(gripper_driver, clock());
+    std::shared_ptr<component::Component> gripper = gripper_model_.make_component(gripper_drivers, clock());
     if (faults_) {
       gripper = faults_->wrap(std::move(gripper));
     }
@@ -216,6 +223,9 @@ class SimWorkcell final : public Workcell {
   /// The fingers' collision shapes at the opening the gripper reads (as the cell sees it, faults
   /// included); a reading that fails counts as unknown: SmartMove takes the whole stroke.
   void syncFingers() {
+    if (cell_gripper_driver_ == nullptr) {
+      return;  // no 2-finger gripper: SmartMove has no finger geometry to move
+    }
     double opening = std::numeric_limits<double>::quiet_NaN();
     try {
       opening = cell_gripper_driver_->read().opening;
@@ -249,6 +259,7 @@ class SimWorkcell final : public Workcell {
     sim_options.robot = robot;
     sim_options.cell_model = cell.cell_model;
     sim_options.gripper_model = dataRoot() / gripper.mjcf;
+    sim_options.adaptive_gripper = gripper.adaptive;
     sim_options.robot_base = cell.robot_base;
     sim_options.placement_seed = options.seed;
     if (options.camera_move) {
@@ -299,7 +310,7 @@ class SimWorkcell final : public Workcell {
   std::unique_ptr<sim::Simulation> simulation_;
   sim::SimArmDriver arm_driver_;
   sim::SimGripperDriver gripper_driver_;
-  gripper::GripperDriver* cell_gripper_driver_ = &gripper_driver_;  // as the cell uses it (faults)
+  gripper::GripperDriver* cell_gripper_driver_ = nullptr;  // the 2-finger's, as the cell uses it (faults)
   sim::SimRgbdCamera camera_;
   planning::RobotModel robot_;
   planning::CollisionWorld collisions_;
