@@ -21,7 +21,7 @@ namespace {
 constexpr const char* kHelp = R"(commands:
   where                               the tool's pose and the joint angles
   list                                taught waypoints
-  jog joint N DEGREES                 turn joint N (JOINTS)
+  jog joint N DEGREES                 turn joint N: JOINTS
   jog x|y|z METRES [tool]             move the tool in a straight line (world axes, or the tool's)
   jog roll|pitch|yaw DEGREES [tool]   turn the tool about an axis
   teach NAME [joints] [in FRAME]      save where the arm is: the tool's pose (relative to FRAME,
@@ -41,8 +41,8 @@ constexpr const char* kHelp = R"(commands:
 /// The help with the joints of `cell`'s arm as its JogJoint operation names them (from the
 /// robot description: "1 (base) to 6 (wrist 3)" on the UR5, "1 (A1) to 7 (A7)" on the iiwa);
 /// without a cell, the arm's joints in general.
-std::string helpText(const workcell::Workcell* cell) {
-  std::string joints = "1 = the base, up to the arm's last joint";
+std::string helpText(workcell::Workcell* cell) {
+  std::string joints = "1 (the base) to the number of the arm's joints";
   if (cell != nullptr) {
     if (const component::Component* arm = cell->components().provider("JogJoint")) {
       for (const auto& operation : arm->description().operations) {

@@ -63,6 +63,7 @@ GripperModel robotiq3f() {
   model.tcp_in_flange.translation() =
       gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile("robotiq3f")).tcp;
   model.links = {"robotiq3f_fingers"};
+  model.finger_link = "robotiq3f_fingers";
   model.marker_in_flange_guess = world::poseFromXyzRpy(0.0653, 0, 0.045, -M_PI / 2, 0, -M_PI / 2);
   model.adaptive = "robotiq3f";
   model.grasps = smartmove::kAdaptiveGripper;

@@ -37,6 +37,9 @@ struct GripperModel {
   world::Pose tcp_in_flange = world::Pose::Identity();
   /// The gripper's links that may touch a part being grasped (SmartMove allows it).
   std::vector<std::string> links;
+  /// An adaptive gripper's fingers' link: the cell puts the open fingers of the current mode
+  /// there (gripper::openFingerBoxes) whenever the mode changes.
+  std::string finger_link;
   /// The fingers' shapes by opening (SmartMove plans grasps with them), if the gripper has some.
   std::optional<gripper::FingerGeometry> fingers;
   /// Where the drawings put the hand-eye calibration marker in the flange frame.

@@ -7,6 +7,7 @@
 #include "calibration/calibration_component.h"
 #include "core/paths.h"
 #include "faults/injector.h"
+#include "gripper/adaptive_gripper_description.h"
 #include "gripper/finger_geometry.h"
 #include "perception/perception_component.h"
 #include "perception/pipeline.h"
@@ -151,6 +152,9 @@ class SimWorkcell final : public Workcell {
       gripper_drivers.adaptive = simulation_->adaptiveGripper();
     }
     cell_gripper_driver_ = gripper_drivers.parallel;
+    if (!gripper_model_.adaptive.empty()) {
+      adaptive_ = gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile(gripper_model_.adaptive));
+    }
     camera::RgbdCamera& camera = faults_ ? faults_->wrap(camera_) : camera_;
     const auto add = [this](std::shared_ptr<component::Component> component) {
       components().add(faults_ ? faults_->wrap(std::move(component)) : std::move(component));
@@ -223,8 +227,9 @@ class SimWorkcell final : public Workcell {
   /// The fingers' collision shapes at the opening the gripper reads (as the cell sees it, faults
   /// included); a reading that fails counts as unknown: SmartMove takes the whole stroke.
   void syncFingers() {
-    if (cell_gripper_driver_ == nullptr) {
-      return;  // no 2-finger gripper: SmartMove has no finger geometry to move
+    if (adaptive_) {
+      syncAdaptiveFingers();
+      return;
     }
     double opening = std::numeric_limits<double>::quiet_NaN();
     try {
@@ -233,6 +238,30 @@ class SimWorkcell final : public Workcell {
       // unknown: see syncFingers
     }
     smartmove_->syncFingers(opening);
+  }
+
+  /// The adaptive gripper's fingers in the collision world: open, as its mode places them (a
+  /// reading that fails leaves them as they were; the component reports the failure).
+  void syncAdaptiveFingers() {
+    gripper::GripperMode mode;
+    try {
+      mode = simulation_->adaptiveGripper()->read().mode;
+    } catch (const std::exception&) {
+      return;
+    }
+    if (synced_mode_ == mode) {
+      return;
+    }
+    std::vector<planning::CollisionShape> shapes;
+    for (const gripper::OrientedBox& box : gripper::openFingerBoxes(*adaptive_, mode)) {
+      planning::CollisionShape shape;
+      shape.kind = planning::CollisionShape::Kind::kBox;
+      shape.size = box.size;
+      shape.origin = box.pose;
+      shapes.push_back(shape);
+    }
+    collisions_.setLinkShapes(gripper_model_.finger_link, shapes);
+    synced_mode_ = mode;
   }
 
   /// A plan's predicate pattern names a declared predicate with the right number of arguments,
@@ -310,7 +339,9 @@ class SimWorkcell final : public Workcell {
   std::unique_ptr<sim::Simulation> simulation_;
   sim::SimArmDriver arm_driver_;
   sim::SimGripperDriver gripper_driver_;
-  gripper::GripperDriver* cell_gripper_driver_ = nullptr;  // the 2-finger's, as the cell uses it (faults)
+  std::optional<gripper::AdaptiveGripperDescription> adaptive_;  // the adaptive gripper's, if it is one
+  std::optional<gripper::GripperMode> synced_mode_;              // its fingers' mode in the collision world
+  gripper::GripperDriver* cell_gripper_driver_ = nullptr;        // the 2-finger's, as the cell uses it (faults)
   sim::SimRgbdCamera camera_;
   planning::RobotModel robot_;
   planning::CollisionWorld collisions_;
