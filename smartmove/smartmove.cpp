@@ -20,17 +20,23 @@ using component::ValueType;
 
 namespace {
 
-/// Close's parameters: the gripper's declared defaults (its speed is in its own units: m/s for
-/// a 2-finger gripper, strokes/s for the adaptive one) with the grip force `force` (N).
-component::ParamMap closeParams(const component::Component& gripper, double force) {
+/// The gripper's declared defaults of `operation`'s parameters: its speeds are in its own units
+/// (m/s for a 2-finger gripper, strokes/s for the adaptive one).
+component::ParamMap gripperDefaults(const component::Component& gripper, const std::string& operation) {
   component::ParamMap params;
-  if (const component::OperationSpec* close = gripper.description().operation("Close")) {
-    for (const ParamSpec& spec : close->params) {
-      if (spec.default_value) {
-        params[spec.name] = *spec.default_value;
+  if (const component::OperationSpec* spec = gripper.description().operation(operation)) {
+    for (const ParamSpec& param : spec->params) {
+      if (param.default_value) {
+        params[param.name] = *param.default_value;
       }
     }
   }
+  return params;
+}
+
+/// Close's parameters: the gripper's defaults with the grip force `force` (N).
+component::ParamMap closeParams(const component::Component& gripper, double force) {
+  component::ParamMap params = gripperDefaults(gripper, "Close");
   params["force"] = force;
   return params;
 }
@@ -369,7 +375,7 @@ void SmartMoveComponent::syncFingers(double opening) {
 }
 
 component::ParamMap SmartMoveComponent::openParams(double opening) const {
-  component::ParamMap params{{"speed", 0.1}};
+  component::ParamMap params = gripperDefaults(gripper_, "Open");  // fully, unless the fingers' geometry says how far
   if (config_.fingers && opening > 0.0) {
     params["opening"] = opening;
   }
