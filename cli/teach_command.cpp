@@ -21,7 +21,7 @@ namespace {
 constexpr const char* kHelp = R"(commands:
   where                               the tool's pose and the joint angles
   list                                taught waypoints
-  jog joint N DEGREES                 turn joint N (1 = base ... 6 = wrist 3)
+  jog joint N DEGREES                 turn joint N: JOINTS
   jog x|y|z METRES [tool]             move the tool in a straight line (world axes, or the tool's)
   jog roll|pitch|yaw DEGREES [tool]   turn the tool about an axis
   teach NAME [joints] [in FRAME]      save where the arm is: the tool's pose (relative to FRAME,
@@ -37,6 +37,27 @@ constexpr const char* kHelp = R"(commands:
   snapshot FILE.png                   a picture of the cell (simulated cells)
   help | quit
 )";
+
+/// The help with the joints of `cell`'s arm as its JogJoint operation names them (from the
+/// robot description: "1 (base) to 6 (wrist 3)" on the UR5, "1 (A1) to 7 (A7)" on the iiwa);
+/// without a cell, the arm's joints in general.
+std::string helpText(workcell::Workcell* cell) {
+  std::string joints = "1 (the base) to the number of the arm's joints";
+  if (cell != nullptr) {
+    if (const component::Component* arm = cell->components().provider("JogJoint")) {
+      for (const auto& operation : arm->description().operations) {
+        for (const auto& param : operation.params) {
+          if (operation.name == "JogJoint" && param.name == "joint") {
+            joints = param.description;
+          }
+        }
+      }
+    }
+  }
+  std::string help = kHelp;
+  help.replace(help.find("JOINTS"), 6, joints);
+  return help;
+}
 
 std::string escape(const std::string& text) {
   std::string out;
@@ -126,7 +147,7 @@ bool handle(workcell::Workcell& cell, const std::string& line) {
     return false;
   }
   if (command == "help") {
-    std::printf("%s", kHelp);
+    std::printf("%s", helpText(&cell).c_str());
   } else if (command == "where") {
     printWhere(cell);
   } else if (command == "list") {
@@ -245,7 +266,7 @@ void addTeachCommand(CLI::App& app, int& exit_code) {
   teach->add_option(
       "--waypoints", options->waypoints,
       "waypoint file to read and write (default " + workcell::defaultWaypointFile("<workcell>").string() + ")");
-  teach->footer(kHelp);
+  teach->footer(helpText(nullptr));
   teach->callback([options, &exit_code] {
     std::unique_ptr<workcell::Workcell> cell;
     try {

@@ -97,6 +97,29 @@ AdaptiveGripperDescription loadAdaptiveGripperDescription(const std::filesystem:
   }
   description.name = name.get<std::string>();
   description.tcp = fields.vec3(root, "tcp", "");
+  const auto& fingers = fields.at(root, "fingers", "");
+  if (!fingers.is_array() || fingers.size() != kFingerCount) {
+    fields.fail("fingers", "must be a list of " + std::to_string(kFingerCount) + " fingers");
+  }
+  for (std::size_t i = 0; i < kFingerCount; ++i) {
+    const std::string field = "fingers[" + std::to_string(i) + "]";
+    AdaptiveFingerPlacement& finger = description.fingers[i];
+    finger.base = fields.vec3(fingers[i], "base", field);
+    finger.yaw_deg = fields.number(fingers[i], "yaw_deg", field);
+    finger.scissor_sign = static_cast<int>(fields.number(fingers[i], "scissor_sign", field));
+  }
+  const auto& phalanges = fields.at(root, "phalanges", "");
+  if (!phalanges.is_array() || phalanges.empty()) {
+    fields.fail("phalanges", "must be a non-empty list");
+  }
+  for (std::size_t i = 0; i < phalanges.size(); ++i) {
+    const std::string field = "phalanges[" + std::to_string(i) + "]";
+    description.finger_length += fields.number(phalanges[i], "length", field);
+    description.finger_width = std::max(description.finger_width, fields.number(phalanges[i], "width", field));
+    description.finger_thickness =
+        std::max(description.finger_thickness, fields.number(phalanges[i], "thickness", field));
+  }
+  description.open_lean_deg = std::max(0.0, -fields.number(phalanges[0], "lower_deg", "phalanges[0]"));
   const auto& actuation = fields.at(root, "actuation", "");
   description.max_force = fields.number(actuation, "max_force_n", "actuation");
   description.lever = fields.number(actuation, "lever_m", "actuation");
@@ -162,6 +185,27 @@ AdaptiveGripperDescription loadAdaptiveGripperDescription(const std::filesystem:
     }
   }
   return description;
+}
+
+std::vector<OrientedBox> openFingerBoxes(const AdaptiveGripperDescription& description, GripperMode mode) {
+  constexpr double kDeg = M_PI / 180.0;
+  constexpr double kKnuckle = 0.012;  // the knuckle's radius, behind the finger's base
+  const double scissor = description.mode(mode).scissor_deg * kDeg;
+  std::vector<OrientedBox> boxes;
+  for (const AdaptiveFingerPlacement& finger : description.fingers) {
+    // Knuckle frame, turned on the scissor axis, then the open finger leaning out (away from
+    // its +y, the side it closes toward: a turn about its -x axis by -lean).
+    const Eigen::Isometry3d frame = Eigen::Translation3d(finger.base) *
+                                    Eigen::AngleAxisd(finger.yaw_deg * kDeg, Eigen::Vector3d::UnitZ()) *
+                                    Eigen::AngleAxisd(finger.scissor_sign * scissor, Eigen::Vector3d::UnitZ()) *
+                                    Eigen::AngleAxisd(description.open_lean_deg * kDeg, Eigen::Vector3d::UnitX());
+    OrientedBox box;
+    const double length = description.finger_length + kKnuckle + 0.001;
+    box.pose = frame * Eigen::Translation3d(0, 0, length / 2 - kKnuckle);
+    box.size = Eigen::Vector3d(std::max(description.finger_width, 2 * kKnuckle), description.finger_thickness, length);
+    boxes.push_back(box);
+  }
+  return boxes;
 }
 
 }  // namespace costar::gripper

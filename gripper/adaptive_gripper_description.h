@@ -5,10 +5,12 @@
 // part sits between the fingers) and its force limit.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "gripper/adaptive_gripper_driver.h"
 
@@ -25,8 +27,26 @@ struct AdaptiveModeDescription {
   Eigen::Vector3d grasp_centre = Eigen::Vector3d::Zero();
 };
 
+/// Where a finger stands on the palm (the generator's "fingers" entries).
+struct AdaptiveFingerPlacement {
+  Eigen::Vector3d base = Eigen::Vector3d::Zero();  // its knuckle, in the flange frame
+  double yaw_deg = 0.0;                            // about the flange's z: the finger closes along its +y
+  int scissor_sign = 0;                            // how it turns on the scissor axis (0: it does not)
+};
+
+/// A box in the flange frame (for collision checking).
+struct OrientedBox {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // its centre and axes
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();          // full side lengths
+};
+
 struct AdaptiveGripperDescription {
   std::string name;
+  std::array<AdaptiveFingerPlacement, kFingerCount> fingers{};  // in kFingerNames order
+  double finger_length = 0.0;                                   // m: the three phalanges, knuckle to fingertip
+  double finger_width = 0.0;                                    // m
+  double finger_thickness = 0.0;                                // m, pad included
+  double open_lean_deg = 0.0;  // how far an open finger leans out (the proximal joint's lower limit, negated)
   std::map<GripperMode, AdaptiveModeDescription> modes;
   double min_force = 0.0;                         // N per finger: the least grip the servos hold steadily
   double max_force = 0.0;                         // N per finger
@@ -44,5 +64,11 @@ std::filesystem::path gripperDescriptionFile(const std::string& name, const std:
 
 /// @throws std::runtime_error naming the file, the field and the problem.
 AdaptiveGripperDescription loadAdaptiveGripperDescription(const std::filesystem::path& file);
+
+/// The open fingers in `mode` (the scissor axis at the mode's angle), one box per finger from
+/// its knuckle to 1 mm past its tip, leaning out as open fingers do: what a planner must keep
+/// clear of neighbours when the gripper comes down open. Closing fingers move inward, into the
+/// grasp.
+std::vector<OrientedBox> openFingerBoxes(const AdaptiveGripperDescription& description, GripperMode mode);
 
 }  // namespace costar::gripper

@@ -22,13 +22,15 @@ std::optional<json> Engine::groundTruth() {
       item["color"] = part.color;  // the material's name in the class file
       parts.push_back(std::move(item));
     }
-    const sim::FingerState fingers = simulation->fingers();
-    return json{{"TEST_ONLY", "the simulator's true state; never used by plans"},
-                {"t", toSeconds(simulation->time())},
-                {"parts", std::move(parts)},
-                {"tcp", poseJson(simulation->tcpPose())},
-                {"finger_opening", fingers.opening},
-                {"arm_table_contact_steps", simulation->armTableContactSteps()}};
+    json truth = {{"TEST_ONLY", "the simulator's true state; never used by plans"},
+                  {"t", toSeconds(simulation->time())},
+                  {"parts", std::move(parts)},
+                  {"tcp", poseJson(simulation->tcpPose())},
+                  {"arm_table_contact_steps", simulation->armTableContactSteps()}};
+    if (simulation->adaptiveGripper() == nullptr) {  // a 2-finger gripper: its opening
+      truth["finger_opening"] = simulation->fingers().opening;
+    }
+    return truth;
   });
 }
 

@@ -12,6 +12,8 @@
 #include <stdexcept>
 
 #include "core/paths.h"
+#include "gripper/adaptive_gripper_description.h"
+#include "sim/adaptive_gripper_sim.h"
 #include "sim/cell_model.h"
 #include "sim/gl_context.h"
 
@@ -84,11 +86,14 @@ struct Simulation::Impl {
   int arm_joints = 0;  // the arm's joints, at most arm::kMaxJoints
   std::array<int, arm::kMaxJoints> arm_qpos{};
   std::array<int, arm::kMaxJoints> arm_dof{};
+  // The 2-finger gripper (when `adaptive` is not set).
   int finger_qpos = 0;
   int finger_dof = 0;
   int finger_actuator = 0;
   int left_pad = 0;
   int right_pad = 0;
+  // The 3-finger adaptive gripper, when the cell has it.
+  std::unique_ptr<SimAdaptiveGripper> adaptive;
   int table_geom = 0;          // the box the arm collides with
   int table_surface_geom = 0;  // the plane parts rest on
   int tcp_site = 0;
@@ -124,6 +129,7 @@ struct Simulation::Impl {
       clock->removeStepListener(listener);
     }
     renderer.reset();
+    adaptive.reset();
     if (data != nullptr) {
       mj_deleteData(data);
     }
@@ -220,6 +226,10 @@ struct Simulation::Impl {
     for (int i = 0; i < arm_joints; ++i) {
       data->ctrl[i] = torque[arm_dof[i]] + data->qfrc_bias[arm_dof[i]];
     }
+    if (adaptive) {
+      adaptive->control();
+      return;
+    }
     // Gripper: the servo setpoint moves toward the target at the commanded speed.
     const double step = finger_speed * model->opt.timestep;
     finger_command += std::clamp(finger_target - finger_command, -step, step);
@@ -248,6 +258,26 @@ struct Simulation::Impl {
     }
     countTableContacts();
     ++steps;
+  }
+
+  /// A geom's label in contacts(): the adaptive gripper's by finger, else its body's.
+  std::string geomLabel(int geom) const {
+    if (geom == table_geom || geom == table_surface_geom) {
+      return "table";
+    }
+    if (adaptive && adaptive->isGripperGeom(geom)) {
+      const int finger = adaptive->fingerOfGeom(geom);
+      return finger >= 0 ? std::string(gripper::kFingerNames[static_cast<std::size_t>(finger)]) : "palm";
+    }
+    return bodyLabel(model->geom_bodyid[geom]);
+  }
+
+  void requireParallel(const char* what) const {
+    if (adaptive) {
+      throw std::logic_error(std::string("Simulation::") + what +
+                             ": this cell's gripper is the 3-finger adaptive gripper '" + adaptive->description().name +
+                             "' (use adaptiveGripper())");
+    }
   }
 
   std::string bodyLabel(int body) const {
@@ -307,6 +337,10 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   const auto under_root = [&root](const std::filesystem::path& path) {
     return path.is_absolute() ? path : root / path;
   };
+  std::optional<gripper::AdaptiveGripperDescription> adaptive;
+  if (!options.adaptive_gripper.empty()) {
+    adaptive = gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile(options.adaptive_gripper, root));
+  }
   std::string xml = composeCellModel({under_root(options.cell_model), robot.mjcf, under_root(options.gripper_model),
                                       robot.urdf_tool_link, options.robot_base});
   std::string assets;
@@ -349,12 +383,18 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
     impl->arm_qpos[i] = m->jnt_qposadr[joint];
     impl->arm_dof[i] = m->jnt_dofadr[joint];
   }
-  const int finger_joint = impl->id(mjOBJ_JOINT, "left_finger_joint");
-  impl->finger_qpos = m->jnt_qposadr[finger_joint];
-  impl->finger_dof = m->jnt_dofadr[finger_joint];
-  impl->finger_actuator = impl->id(mjOBJ_ACTUATOR, "fingers");
-  impl->left_pad = impl->id(mjOBJ_GEOM, "left_pad");
-  impl->right_pad = impl->id(mjOBJ_GEOM, "right_pad");
+  if (adaptive) {
+    Impl* raw = impl.get();
+    impl->adaptive =
+        std::make_unique<SimAdaptiveGripper>(m, impl->data, std::move(*adaptive), [raw] { return raw->now(); });
+  } else {
+    const int finger_joint = impl->id(mjOBJ_JOINT, "left_finger_joint");
+    impl->finger_qpos = m->jnt_qposadr[finger_joint];
+    impl->finger_dof = m->jnt_dofadr[finger_joint];
+    impl->finger_actuator = impl->id(mjOBJ_ACTUATOR, "fingers");
+    impl->left_pad = impl->id(mjOBJ_GEOM, "left_pad");
+    impl->right_pad = impl->id(mjOBJ_GEOM, "right_pad");
+  }
   impl->table_geom = impl->id(mjOBJ_GEOM, "table");
   impl->table_surface_geom = impl->id(mjOBJ_GEOM, "table_surface");
   impl->tcp_site = impl->id(mjOBJ_SITE, "tcp");
@@ -394,8 +434,12 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
     impl->data->qpos[impl->arm_qpos[i]] = initial[i];
   }
   impl->held = {initial, ArmJoints::zero(impl->arm_joints), ArmJoints::zero(impl->arm_joints)};
-  impl->data->qpos[impl->finger_qpos] = kMaxOpening / 2;
-  impl->data->qpos[m->jnt_qposadr[impl->id(mjOBJ_JOINT, "right_finger_joint")]] = kMaxOpening / 2;
+  if (impl->adaptive) {
+    impl->adaptive->reset(gripper::GripperMode::kBasic);
+  } else {
+    impl->data->qpos[impl->finger_qpos] = kMaxOpening / 2;
+    impl->data->qpos[m->jnt_qposadr[impl->id(mjOBJ_JOINT, "right_finger_joint")]] = kMaxOpening / 2;
+  }
   mj_forward(m, impl->data);
   const auto settle = static_cast<std::int64_t>(std::ceil(options.settle_seconds / m->opt.timestep));
   for (std::int64_t i = 0; i < settle; ++i) {
@@ -468,6 +512,7 @@ world::Pose Simulation::tcpPose() const {
 std::uint64_t Simulation::armTableContactSteps() const { return impl_->arm_table_contact_steps; }
 
 FingerState Simulation::fingers() const {
+  impl_->requireParallel("fingers");
   const mjData* d = impl_->data;
   FingerState state;
   state.opening = 2.0 * d->qpos[impl_->finger_qpos];
@@ -488,6 +533,7 @@ FingerState Simulation::fingers() const {
 }
 
 void Simulation::commandFingers(double opening, double speed, double force) {
+  impl_->requireParallel("commandFingers");
   // A new command starts from where the fingers are (not from the previous setpoint).
   impl_->finger_command = impl_->data->qpos[impl_->finger_qpos];
   impl_->finger_target = std::clamp(opening, 0.0, kMaxOpening) / 2.0;
@@ -496,6 +542,8 @@ void Simulation::commandFingers(double opening, double speed, double force) {
   impl_->model->actuator_forcerange[2 * impl_->finger_actuator] = -limit;
   impl_->model->actuator_forcerange[2 * impl_->finger_actuator + 1] = limit;
 }
+
+gripper::AdaptiveGripperDriver* Simulation::adaptiveGripper() { return impl_->adaptive.get(); }
 
 const camera::Intrinsics& Simulation::rgbdIntrinsics() const { return impl_->intrinsics; }
 
@@ -596,15 +644,10 @@ void Simulation::movePart(const std::string& name, const world::Pose& pose) {
 std::vector<std::pair<std::string, std::string>> Simulation::contacts() const {
   std::vector<std::pair<std::string, std::string>> pairs;
   const mjData* d = impl_->data;
-  const mjModel* m = impl_->model;
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& contact = d->contact[i];
-    const auto label = [&](int geom) {
-      return geom == impl_->table_geom || geom == impl_->table_surface_geom ? std::string("table")
-                                                                            : impl_->bodyLabel(m->geom_bodyid[geom]);
-    };
-    std::string a = label(contact.geom1);
-    std::string b = label(contact.geom2);
+    std::string a = impl_->geomLabel(contact.geom1);
+    std::string b = impl_->geomLabel(contact.geom2);
     if (a > b) {
       std::swap(a, b);
     }

@@ -1,12 +1,13 @@
 #pragma once
 // A MuJoCo simulation of a workcell: an arm (the UR5 by default, any arm with a robot
-// description), the 2-finger gripper on its flange, table, parts, RGB-D camera. No MuJoCo type appears here; MuJoCo
-// stays in sim/*.cpp.
+// description), a gripper on its flange (the 2-finger gripper by default, or a 3-finger
+// adaptive gripper: SimulationOptions::adaptive_gripper), table, parts, RGB-D camera. No MuJoCo type appears here;
+// MuJoCo stays in sim/*.cpp.
 //
 // Physics advances in lockstep with a SimClock (attach()): each tick's interval is
 // simulated in fixed steps of the model's timestep (2 ms). The arm follows joint setpoints
 // with computed-torque control within the arm's torque limits; the gripper's fingers close by
-// a force-limited servo, so parts are held only by contact and friction.
+// force-limited servos, so parts are held only by contact and friction.
 //
 // Threads: a Simulation is used by one thread at a time, but belongs to none: it may be made,
 // stepped, rendered and destroyed on different threads, since its GL context is current only
@@ -31,6 +32,7 @@
 #include "camera/rgbd.h"
 #include "core/clock.h"
 #include "core/image.h"
+#include "gripper/adaptive_gripper_driver.h"
 #include "sim/depth_noise.h"
 #include "sim/scene.h"
 #include "world/object_class.h"
@@ -60,6 +62,11 @@ struct SimulationOptions {
   /// composed with the robot's model (sim/cell_model.h). Relative paths are under `data_root`.
   std::filesystem::path cell_model = "sim/models/table_cell.xml";
   std::filesystem::path gripper_model = "sim/models/gripper_parallel-2f.xml";
+  /// The gripper is the 3-finger adaptive gripper of robots/grippers/NAME.json (under
+  /// `data_root`), `gripper_model` its generated workcell piece (NAME_mount.xml,
+  /// robots/generate_gripper.py): the simulation drives it, adaptiveGripper() is its driver.
+  /// Empty: the 2-finger gripper (fingers(), commandFingers()).
+  std::string adaptive_gripper;
   /// Where the robot's base stands in the world; the composed model must agree (checked).
   /// Absent: not checked.
   std::optional<world::Pose> robot_base;
@@ -133,9 +140,15 @@ class Simulation {
   std::uint64_t armTableContactSteps() const;
 
   // --- gripper ---------------------------------------------------------------------------
+  /// The 2-finger gripper's fingers. @throws std::logic_error when the cell has the adaptive
+  /// gripper (use adaptiveGripper()).
   FingerState fingers() const;
   /// Moves the fingers toward `opening` (m) at `speed` (m/s), squeezing with at most `force` (N).
+  /// @throws std::logic_error when the cell has the adaptive gripper.
   void commandFingers(double opening, double speed, double force);
+  /// The 3-finger adaptive gripper's driver (readings stamped with the simulated time), or
+  /// nullptr when the cell has the 2-finger gripper. It lives as long as the simulation.
+  gripper::AdaptiveGripperDriver* adaptiveGripper();
   static constexpr double kMaxOpening = 0.085;
 
   // --- camera ----------------------------------------------------------------------------
@@ -173,7 +186,9 @@ class Simulation {
   /// are recomputed); physics carries on from there.
   /// @throws std::invalid_argument for an unknown part.
   void movePart(const std::string& name, const world::Pose& pose);
-  /// Pairs of bodies in contact: part names, "table", "left_finger", "right_finger", "arm".
+  /// Pairs of bodies in contact: part names, "table", "arm", and the gripper's fingers:
+  /// "left_finger", "right_finger" (2-finger), "finger_middle", "finger_1", "finger_2" and
+  /// "palm" (adaptive gripper).
   std::vector<std::pair<std::string, std::string>> contacts() const;
   const std::vector<world::ObjectClass>& objectClasses() const;
 

@@ -20,6 +20,27 @@ using component::ValueType;
 
 namespace {
 
+/// The gripper's declared defaults of `operation`'s parameters: its speeds are in its own units
+/// (m/s for a 2-finger gripper, strokes/s for the adaptive one).
+component::ParamMap gripperDefaults(const component::Component& gripper, const std::string& operation) {
+  component::ParamMap params;
+  if (const component::OperationSpec* spec = gripper.description().operation(operation)) {
+    for (const ParamSpec& param : spec->params) {
+      if (param.default_value) {
+        params[param.name] = *param.default_value;
+      }
+    }
+  }
+  return params;
+}
+
+/// Close's parameters: the gripper's defaults with the grip force `force` (N).
+component::ParamMap closeParams(const component::Component& gripper, double force) {
+  component::ParamMap params = gripperDefaults(gripper, "Close");
+  params["force"] = force;
+  return params;
+}
+
 /// An operation of another component, started now, as a step.
 class ComponentStep final : public RunningOperation {
  public:
@@ -380,7 +401,7 @@ void SmartMoveComponent::syncFingers(double opening) {
 }
 
 component::ParamMap SmartMoveComponent::openParams(double opening) const {
-  component::ParamMap params{{"speed", 0.1}};
+  component::ParamMap params = gripperDefaults(gripper_, "Open");  // fully, unless the fingers' geometry says how far
   if (config_.fingers && opening > 0.0) {
     params["opening"] = opening;
   }
@@ -761,8 +782,7 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
                    nullptr});
   steps.push_back({"close on " + object,
                    [this] {
-                     return std::make_unique<ComponentStep>(gripper_, "Close",
-                                                            component::ParamMap{{"speed", 0.1}, {"force", 40.0}});
+                     return std::make_unique<ComponentStep>(gripper_, "Close", closeParams(gripper_, 40.0));
                    },
                    [this, object, object_class, object_pose, chosen, opening,
                     centring](const OperationResult& result) -> std::string {
@@ -810,8 +830,7 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
     steps.push_back(
         {"close again on " + object,
          [this] {
-           return std::make_unique<ComponentStep>(gripper_, "Close",
-                                                  component::ParamMap{{"speed", 0.1}, {"force", 40.0}});
+           return std::make_unique<ComponentStep>(gripper_, "Close", closeParams(gripper_, 40.0));
          },
          [this, object, object_class, object_pose, chosen, centring](const OperationResult& result) -> std::string {
            if (!result.data.value("holding", false)) {

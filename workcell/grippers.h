@@ -1,7 +1,8 @@
 #pragma once
 // The grippers a simulated workcell can carry (workcells/NAME.json, "gripper": KEY): one row
 // per gripper in a table (workcell/grippers.cpp) with its models and the numbers the cell's
-// components need. A new gripper adds its MJCF and URDF pieces (sim/models/) and a row.
+// components need. A new gripper adds its MJCF and URDF pieces (sim/models/, or generated from
+// robots/grippers/NAME.json for an adaptive gripper) and a row.
 
 #include <filesystem>
 #include <memory>
@@ -11,16 +12,24 @@
 
 #include "component/component.h"
 #include "core/clock.h"
+#include "gripper/adaptive_gripper_driver.h"
 #include "gripper/finger_geometry.h"
 #include "gripper/gripper_driver.h"
 #include "world/pose.h"
 
 namespace costar::workcell {
 
+/// The drivers a gripper component may sit on: the cell's one for its gripper, the other null.
+struct GripperDrivers {
+  gripper::GripperDriver* parallel = nullptr;          // a 2-finger gripper's fingers
+  gripper::AdaptiveGripperDriver* adaptive = nullptr;  // a 3-finger adaptive gripper
+};
+
 struct GripperModel {
   std::string key;
-  /// MJCF piece (sim/cell_model.h: its body "mount" is the flange) and URDF piece
-  /// (planning::mountUrdf: its link "mount" is the flange); relative to the data root.
+  /// MJCF piece (sim/cell_model.h: its body "mount" is the flange, with the site "tcp" and the
+  /// geom "gripper_marker") and URDF piece (planning::mountUrdf: its link "mount" is the
+  /// flange); relative to the data root, or absolute (generated at build time).
   std::filesystem::path mjcf;
   std::filesystem::path urdf;
   /// The URDF link at the tool centre point, and the tool centre point in the flange frame.
@@ -28,12 +37,21 @@ struct GripperModel {
   world::Pose tcp_in_flange = world::Pose::Identity();
   /// The gripper's links that may touch a part being grasped (SmartMove allows it).
   std::vector<std::string> links;
+  /// An adaptive gripper's fingers' link: the cell puts the open fingers of the current mode
+  /// there (gripper::openFingerBoxes) whenever the mode changes.
+  std::string finger_link;
   /// The fingers' shapes by opening (SmartMove plans grasps with them), if the gripper has some.
   std::optional<gripper::FingerGeometry> fingers;
   /// Where the drawings put the hand-eye calibration marker in the flange frame.
   world::Pose marker_in_flange_guess = world::Pose::Identity();
+  /// A 3-finger adaptive gripper's description (robots/grippers/NAME.json): the simulation
+  /// drives it (sim::SimulationOptions::adaptive_gripper). Empty: a 2-finger gripper.
+  std::string adaptive;
+  /// The key of its grasps in data/grasps.json (smartmove::GraspLibrary).
+  std::string grasps;
   /// The gripper component on its driver (the driver and clock outlive it).
-  std::shared_ptr<component::Component> (*make_component)(gripper::GripperDriver& driver, const Clock& clock) = nullptr;
+  /// @throws std::logic_error when the driver it needs is null.
+  std::shared_ptr<component::Component> (*make_component)(const GripperDrivers& drivers, const Clock& clock) = nullptr;
 };
 
 /// The gripper with key `key`. @throws std::invalid_argument naming the known ones.

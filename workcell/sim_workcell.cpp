@@ -9,6 +9,7 @@
 #include "component/operation_table.h"
 #include "core/paths.h"
 #include "faults/injector.h"
+#include "gripper/adaptive_gripper_description.h"
 #include "gripper/finger_geometry.h"
 #include "perception/perception_component.h"
 #include "perception/pipeline.h"
@@ -130,7 +131,7 @@ class SimWorkcell final : public Workcell {
                        : (options.memory_only ? cell_.waypoints : defaultWaypointFile(cell_.name)),
                    /*persist=*/!options.memory_only, robot_description_.jointCount()),
         grasps_(dataRoot() / "data/grasps.json",
-                options.memory_only ? std::filesystem::path() : defaultGraspFile(cell_.name)),
+                options.memory_only ? std::filesystem::path() : defaultGraspFile(cell_.name), gripper_model_.grasps),
         faults_(options.faults) {
     simulation_->attach(static_cast<SimClock&>(clock()));
     if (faults_) {
@@ -138,8 +139,18 @@ class SimWorkcell final : public Workcell {
     }
     // The drivers and components as the cell uses them: wrapped by the fault injector, if any.
     arm::ArmDriver& arm_driver = faults_ ? faults_->wrap(arm_driver_) : arm_driver_;
-    gripper::GripperDriver& gripper_driver = faults_ ? faults_->wrap(gripper_driver_) : gripper_driver_;
-    cell_gripper_driver_ = &gripper_driver;
+    // The gripper's driver: the 2-finger fingers (wrapped by the fault injector, if any) or the
+    // adaptive gripper the simulation drives.
+    GripperDrivers gripper_drivers;
+    if (gripper_model_.adaptive.empty()) {
+      gripper_drivers.parallel = faults_ ? &faults_->wrap(gripper_driver_) : &gripper_driver_;
+    } else {
+      gripper_drivers.adaptive = simulation_->adaptiveGripper();
+    }
+    cell_gripper_driver_ = gripper_drivers.parallel;
+    if (!gripper_model_.adaptive.empty()) {
+      adaptive_ = gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile(gripper_model_.adaptive));
+    }
     camera::RgbdCamera& camera = faults_ ? faults_->wrap(camera_) : camera_;
     const auto add = [this](std::shared_ptr<component::Component> component) {
       components().add(faults_ ? faults_->wrap(std::move(component)) : std::move(component));
@@ -165,7 +176,7 @@ class SimWorkcell final : public Workcell {
     motion_ = std::make_unique<arm::MotionPlanner>(arm_driver, clock(), collisions_, kinematics, arm_config);
     // SmartMove reaches the gripper through its operations, as the tree does: the same (possibly
     // fault-injected) component the registry holds.
-    std::shared_ptr<component::Component> gripper = gripper_model_.make_component(gripper_driver, clock());
+    std::shared_ptr<component::Component> gripper = gripper_model_.make_component(gripper_drivers, clock());
     if (faults_) {
       gripper = faults_->wrap(std::move(gripper));
     }
@@ -216,6 +227,10 @@ class SimWorkcell final : public Workcell {
   /// The fingers' collision shapes at the opening the gripper reads (as the cell sees it, faults
   /// included); a reading that fails counts as unknown: SmartMove takes the whole stroke.
   void syncFingers() {
+    if (adaptive_) {
+      syncAdaptiveFingers();
+      return;
+    }
     double opening = std::numeric_limits<double>::quiet_NaN();
     try {
       opening = cell_gripper_driver_->read().opening;
@@ -223,6 +238,30 @@ class SimWorkcell final : public Workcell {
       // unknown: see syncFingers
     }
     smartmove_->syncFingers(opening);
+  }
+
+  /// The adaptive gripper's fingers in the collision world: open, as its mode places them (a
+  /// reading that fails leaves them as they were; the component reports the failure).
+  void syncAdaptiveFingers() {
+    gripper::GripperMode mode;
+    try {
+      mode = simulation_->adaptiveGripper()->read().mode;
+    } catch (const std::exception&) {
+      return;
+    }
+    if (synced_mode_ == mode) {
+      return;
+    }
+    std::vector<planning::CollisionShape> shapes;
+    for (const gripper::OrientedBox& box : gripper::openFingerBoxes(*adaptive_, mode)) {
+      planning::CollisionShape shape;
+      shape.kind = planning::CollisionShape::Kind::kBox;
+      shape.size = box.size;
+      shape.origin = box.pose;
+      shapes.push_back(shape);
+    }
+    collisions_.setLinkShapes(gripper_model_.finger_link, shapes);
+    synced_mode_ = mode;
   }
 
   /// A plan's predicate pattern names a declared predicate with the right number of arguments,
@@ -249,6 +288,7 @@ class SimWorkcell final : public Workcell {
     sim_options.robot = robot;
     sim_options.cell_model = cell.cell_model;
     sim_options.gripper_model = dataRoot() / gripper.mjcf;
+    sim_options.adaptive_gripper = gripper.adaptive;
     sim_options.robot_base = cell.robot_base;
     sim_options.placement_seed = options.seed;
     sim_options.spare_classes = options.spare_parts;
@@ -300,7 +340,9 @@ class SimWorkcell final : public Workcell {
   std::unique_ptr<sim::Simulation> simulation_;
   sim::SimArmDriver arm_driver_;
   sim::SimGripperDriver gripper_driver_;
-  gripper::GripperDriver* cell_gripper_driver_ = &gripper_driver_;  // as the cell uses it (faults)
+  std::optional<gripper::AdaptiveGripperDescription> adaptive_;  // the adaptive gripper's, if it is one
+  std::optional<gripper::GripperMode> synced_mode_;              // its fingers' mode in the collision world
+  gripper::GripperDriver* cell_gripper_driver_ = nullptr;        // the 2-finger's, as the cell uses it (faults)
   sim::SimRgbdCamera camera_;
   planning::RobotModel robot_;
   planning::CollisionWorld collisions_;

@@ -77,7 +77,9 @@ TEST(AdaptiveGripperGraspsTest, EachModesGraspPutsThePartNearTheModesGraspCentre
       ASSERT_TRUE(grasp) << part << " " << gripper::toString(mode);
       // The part's origin in the flange frame: tcp * T^-1 applied to the origin.
       const Eigen::Vector3d in_flange = description.tcp + grasp->tcp_in_object.inverse().translation();
-      EXPECT_LT((in_flange - description.mode(mode).grasp_centre).norm(), 0.008)
+      // A node within 8 mm of the mode's grasp centre; a link lying on the table is held up to
+      // 14 mm nearer the palm, so that the open fingertips (1.4 cm beyond the TCP) clear the table.
+      EXPECT_LT((in_flange - description.mode(mode).grasp_centre).norm(), part == "node" ? 0.008 : 0.014)
           << part << " " << gripper::toString(mode) << ": " << in_flange.transpose();
     }
   }

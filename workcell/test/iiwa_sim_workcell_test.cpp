@@ -1,12 +1,15 @@
 // The simulated LBR iiwa 14 cell (workcells/iiwa-sim.json), the second robot of the one generic
-// simulated workcell: the composed MuJoCo model and the composed URDF agree, random motions stay
-// within the iiwa's limits and off the table, and one of the paper's UR5 plans, unchanged, lifts
-// a node (judged from the simulator's true state). One short plan: trial batches are measured
-// with `costar trials` (docs/BENCHMARKS.md), not here.
+// simulated workcell, with the 3-finger adaptive gripper on its flange: the composed MuJoCo
+// model and the composed URDF agree, random motions stay within the iiwa's limits and off the
+// table, the gripper picks a part up in each of its four modes, and one of the paper's UR5
+// plans, unchanged, lifts a node (judged from the simulator's true state). One short plan:
+// trial batches are measured with `costar trials` (docs/BENCHMARKS.md), not here.
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <random>
+#include <set>
 
 #include "arm/robot_description.h"
 #include "bt/builder.h"
@@ -15,6 +18,7 @@
 #include "core/paths.h"
 #include "planning/robot_model.h"
 #include "sim/simulation.h"
+#include "workcell/grippers.h"
 #include "workcell/sim_cell_description.h"
 #include "workcell/workcell.h"
 
@@ -24,8 +28,10 @@ namespace {
 TEST(IiwaSimWorkcell, TheComposedMujocoModelAndUrdfAgree) {
   const SimCellDescription cell = loadSimCellDescription(simCellFile("iiwa-sim"));
   const arm::RobotDescription iiwa = arm::loadRobotDescription(arm::robotDescriptionFile(cell.robot));
-  const auto robot = planning::RobotModel::fromUrdf(iiwa.urdf, dataRoot() / "sim/models/gripper_parallel-2f.urdf",
-                                                    iiwa.urdf_tool_link, iiwa.urdf_base_link, "tcp");
+  EXPECT_EQ(cell.gripper, "robotiq3f");  // the 3-finger adaptive gripper
+  const GripperModel& gripper = gripperModel(cell.gripper);
+  const auto robot = planning::RobotModel::fromUrdf(iiwa.urdf, dataRoot() / gripper.urdf, iiwa.urdf_tool_link,
+                                                    iiwa.urdf_base_link, gripper.tcp_link);
   ASSERT_EQ(robot.dof(), 7u);
   std::mt19937 random(12);
   const sim::Scene empty = sim::parseScene(R"({"parts": []})", "empty");
@@ -37,6 +43,8 @@ TEST(IiwaSimWorkcell, TheComposedMujocoModelAndUrdfAgree) {
     sim::SimulationOptions options;
     options.robot = iiwa;
     options.robot_base = cell.robot_base;
+    options.gripper_model = dataRoot() / gripper.mjcf;
+    options.adaptive_gripper = gripper.adaptive;
     options.initial_arm = q;
     options.settle_seconds = 0.0;
     const auto simulation = sim::Simulation::create(empty, options);
@@ -94,6 +102,60 @@ TEST(IiwaSimWorkcell, RandomMotionsStayWithinTheLimitsAndNeverTouchTheTable) {
   EXPECT_LE(worst_speed_ratio, 1.02);  // joint speed limits (a little tracking overshoot allowed)
   EXPECT_EQ(simulation.armTableContactSteps(), 0u);
 }
+
+// Each mode of the 3-finger gripper picks a node and a link up on the iiwa: SetMode, then
+// SmartGrasp with the class's grasp for that mode (data/grasps.json), the part seen by a TEST
+// ONLY oracle. Judged from the simulator's true state: the part is lifted off the table,
+// touches at least two fingers (in Scissor mode fingers 1 and 2, not finger_middle) and not the
+// table, and stays up for a second, held by contact and friction (the model has no weld).
+class IiwaAdaptiveGripper : public ::testing::TestWithParam<std::tuple<const char*, const char*>> {};
+
+TEST_P(IiwaAdaptiveGripper, PicksAPartUpInEachMode) {
+  const std::string mode = std::get<0>(GetParam());
+  const std::string part_class = std::get<1>(GetParam());
+  const auto scene = std::filesystem::temp_directory_path() / ("costar_iiwa_mode_" + mode + "_" + part_class + ".json");
+  std::ofstream(scene) << R"({"parts": [{"class": ")" << part_class << R"(", "color": ")"
+                       << (part_class == "link" ? "wood" : "red") << R"(", "at": [0.5, -0.15, 30]}]})";
+  const auto cell =
+      makeWorkcell({.name = "iiwa-sim", .scene = scene, .memory_only = true, .test_oracle_perception = true});
+  const std::string body = R"(<Sequence><SetMode mode=")" + mode + R"("/><SmartGrasp object_class=")" + part_class +
+                           R"(" grasp=")" + mode + R"("/><Sleep msec="1000"/></Sequence>)";
+  const auto plan =
+      bt::loadPlanText(R"(<root BTCPP_format="4"><BehaviorTree ID="m">)" + body + "</BehaviorTree></root>", "mode.xml");
+  bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
+  bt::Executor executor(tree, cell->clock(), {.time_limit = std::chrono::seconds(90)});
+  executor.setBeforeTick([&cell] { cell->beforeTick(); });
+  const bt::RunResult result = executor.run();
+  ASSERT_EQ(result.status, bt::Status::kSuccess)
+      << mode << ": " << result.failure_path << ": " << result.failure_reason;
+
+  sim::Simulation& simulation = *cell->simulation();
+  const sim::PartState part = simulation.parts().front();
+  EXPECT_GT(part.pose.translation().z(), 0.08) << mode;  // lifted ~10 cm off the table
+  EXPECT_LT(part.linear_velocity.norm(), 0.01) << mode;  // and still there after a second
+  std::set<std::string> touching;
+  for (const auto& [a, b] : simulation.contacts()) {
+    if (a == part.name || b == part.name) {
+      touching.insert(a == part.name ? b : a);
+    }
+  }
+  EXPECT_FALSE(touching.count("table")) << mode;
+  const int fingers =
+      static_cast<int>(touching.count("finger_middle") + touching.count("finger_1") + touching.count("finger_2"));
+  EXPECT_GE(fingers, 2) << mode;
+  if (mode == "scissor") {
+    EXPECT_TRUE(touching.count("finger_1") && touching.count("finger_2"));
+    EXPECT_FALSE(touching.count("finger_middle"));
+  }
+  cell->beforeTick();
+  EXPECT_TRUE(cell->components().world().holds("gripper_mode", std::vector<std::string>{mode}));
+  EXPECT_TRUE(cell->components().world().holds("holding", std::vector<std::string>{part.name}));
+  EXPECT_EQ(simulation.armTableContactSteps(), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Modes, IiwaAdaptiveGripper,
+                         ::testing::Combine(::testing::Values("basic", "pinch", "wide", "scissor"),
+                                            ::testing::Values("node", "link")));
 
 // The paper's first task, the UR5's plan file unchanged: pick up any feasible node and lift it.
 TEST(IiwaSimWorkcell, ThePapersPickUpPlanLiftsANode) {
