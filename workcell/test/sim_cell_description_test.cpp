@@ -25,6 +25,11 @@ TEST(SimCellDescription, BothCellsLoadAndAreListed) {
   const SimCellDescription iiwa = loadSimCellDescription(simCellFile("iiwa-sim"));
   EXPECT_EQ(iiwa.robot, "iiwa14");
   EXPECT_TRUE(std::filesystem::is_regular_file(iiwa.cell_model));
+  // Both keep Calibrate's arm out of the table's part area (the scenes' "table" region with a
+  // part's reach around it).
+  ASSERT_TRUE(ur5.part_area && iiwa.part_area);
+  EXPECT_TRUE(ur5.part_area->contains(Eigen::Vector3d(0.5, -0.3, 0.05)));
+  EXPECT_FALSE(iiwa.part_area->contains(Eigen::Vector3d(0.5, -0.3, 0.2)));
   std::vector<std::string> names;
   for (const auto& info : knownWorkcells()) {
     names.push_back(info.name);
@@ -80,6 +85,15 @@ TEST_F(BadCellFile, EachProblemNamesItsField) {
   j = good_;
   j["workspace"]["min"] = {2, 0, 0};
   EXPECT_EQ(problem(j), "workspace: min must be below max on every axis");
+  j = good_;
+  j["part_area"]["max"] = {0.8, 0.5, -0.1};
+  EXPECT_EQ(problem(j), "part_area: min must be below max on every axis");
+  j = good_;
+  j["part_area"] = {{"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"height", 1}};
+  EXPECT_EQ(problem(j).rfind("part_area.height: unknown field (known: ", 0), 0u) << problem(j);
+  j = good_;
+  j.erase("part_area");
+  EXPECT_EQ(problem(j), "no error");  // optional: nothing kept out while calibrating
   j = good_;
   j["scene"] = "sim/scenes/no_such_scene.json";
   EXPECT_EQ(problem(j).rfind("scene: no such file '", 0), 0u) << problem(j);
