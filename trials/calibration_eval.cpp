@@ -28,6 +28,7 @@ world::Pose poseOf(const nlohmann::json& json) {
 
 std::unique_ptr<workcell::Workcell> makeCell(const CalibrationEvalOptions& options, std::uint64_t seed) {
   workcell::WorkcellOptions cell;
+  cell.name = options.workcell;
   cell.scene = options.scene.empty() ? dataRoot() / "sim/scenes/assembly.json" : options.scene;
   cell.seed = seed;
   cell.memory_only = true;
@@ -81,6 +82,10 @@ int accurateParts(workcell::Workcell& cell) {
 void runSample(const CalibrationEvalOptions& options, int setup, const std::string& method, CalibrationSample& s) {
   const std::uint64_t seed = options.seed + static_cast<std::uint64_t>(setup);
   const auto cell = makeCell(options, seed);
+  if (cell->simulation() == nullptr) {
+    throw std::invalid_argument("workcell '" + options.workcell +
+                                "' is not simulated: calibrate eval needs the simulator's true camera pose");
+  }
   sim::Simulation& simulation = *cell->simulation();
   const world::Pose truth = simulation.rgbdPose();
   const world::Pose drawn = simulation.rgbdNominalPose();

@@ -15,6 +15,8 @@
 namespace costar::trials {
 
 struct CalibrationEvalOptions {
+  /// The simulated workcell (workcells/NAME.json).
+  std::string workcell = "ur5-sim";
   std::filesystem::path scene;  // default: sim/scenes/assembly.json
   int setups = 20;
   std::uint64_t seed = 100;  // set-up i: seed + i
@@ -33,7 +35,7 @@ struct CalibrationEvalOptions {
   int camera_views = 0;
 };
 
-/// One calibration in one set-up.
+/// One calibration in one set-up (a cell without a simulator: a failed sample saying so).
 struct CalibrationSample {
   int setup = 0;
   std::string method;  // "" for Calibrate with the cell's marker calibration

@@ -20,7 +20,8 @@
 //   part_area        optional {min [x, y, z], max [x, y, z]} (m): where parts may lie or stand
 //                    on the table; the arm keeps out of it while it calibrates the camera
 //                    (calibration/calibration_component.h), when no part's place is known
-//   calibration      the shipped hand-eye calibration of the gripper's marker
+//   calibration      the shipped hand-eye calibration of the gripper's marker (the marker's place
+//                    on the flange: one file per gripper and marker, whichever arm carries it)
 //
 // Paths are relative to the data root (core/paths.h). Unknown fields are refused.
 

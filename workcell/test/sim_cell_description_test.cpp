@@ -30,6 +30,9 @@ TEST(SimCellDescription, BothCellsLoadAndAreListed) {
   ASSERT_TRUE(ur5.part_area && iiwa.part_area);
   EXPECT_TRUE(ur5.part_area->contains(Eigen::Vector3d(0.5, -0.3, 0.05)));
   EXPECT_FALSE(iiwa.part_area->contains(Eigen::Vector3d(0.5, -0.3, 0.2)));
+  // The marker is on the gripper, so the cells with the same gripper share its calibration.
+  EXPECT_EQ(ur5.calibration, iiwa.calibration);
+  EXPECT_EQ(ur5.calibration.filename(), "parallel-2f_marker.json");
   std::vector<std::string> names;
   for (const auto& info : knownWorkcells()) {
     names.push_back(info.name);
