@@ -162,9 +162,10 @@ int evaluate(EvalOptions options) {
         if (s.camera_ok) {
           std::printf(
               "set-up %d %-10s camera %.2f mm %.3f deg (drawn pose was %.1f mm %.2f deg off), marker %.2f mm "
-              "%.3f deg, simulated %.1f + %.1f s\n",
+              "%.3f deg, simulated %.1f + %.1f s, parts moved by Calibrate %.1f mm\n",
               s.setup, s.method.empty() ? "cell" : s.method.c_str(), s.camera_mm, s.camera_deg, s.camera_before_mm,
-              s.camera_before_deg, s.marker_mm, s.marker_deg, s.marker_simulated_s, s.camera_simulated_s);
+              s.camera_before_deg, s.marker_mm, s.marker_deg, s.marker_simulated_s, s.camera_simulated_s,
+              s.parts_moved_mm);
           if (s.parts > 0) {
             std::printf("  DetectObjects: %d/%d parts within 5 mm and 5 deg before Calibrate, %d/%d after\n",
                         s.parts_accurate_before, s.parts, s.parts_accurate_after, s.parts);

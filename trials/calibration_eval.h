@@ -48,6 +48,8 @@ struct CalibrationSample {
   double camera_mm = 0, camera_deg = 0;  // after Calibrate
   double marker_simulated_s = 0, camera_simulated_s = 0;
   double reprojection_rms_px = 0;
+  /// The farthest any part moved while Calibrate ran (mm, the simulator's true poses).
+  double parts_moved_mm = 0;
   /// With `perception`: parts in the scene, and those DetectObjects put within 5 mm and 5
   /// degrees of their true pose, with the drawn camera pose and after Calibrate.
   int parts = 0;
