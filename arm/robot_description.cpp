@@ -83,6 +83,75 @@ std::filesystem::path modelFile(const json& models, const std::string& key, cons
   return path;
 }
 
+/// How a format names a joint's limits and the home, and their unit.
+struct JointFields {
+  const char* min;
+  const char* max;
+  const char* velocity;
+  const char* acceleration;
+  const char* home;
+  double to_radians;              // 1 for radians, pi/180 for degrees
+  const char* unit;               // "radians" or "degrees", for messages
+  const char* velocity_unit;      // after "must be positive" in messages: " (rad/s)" or ""
+  const char* acceleration_unit;  // the same for the acceleration limit
+  std::set<std::string> known;    // a joint object's fields
+};
+
+/// joints[] (names, labels, limits) and the home of `root_object`, into `robot`.
+void readJoints(const json& root_object, const JointFields& format, RobotDescription& robot) {
+  const json& joints = member(root_object, "", "joints");
+  if (!joints.is_array() || joints.empty() || joints.size() > static_cast<std::size_t>(kMaxJoints)) {
+    fail("joints", "must be a list of 1 to " + std::to_string(kMaxJoints) + " joints, not " + shown(joints));
+  }
+  const int count = static_cast<int>(joints.size());
+  robot.limits = {JointVector(count), JointVector(count), JointVector(count), JointVector(count)};
+  std::set<std::string> names;
+  const auto value = [&format](const json& joint, const std::string& field, const char* key) {
+    return number(member(joint, field, key), field + "." + key) * format.to_radians;
+  };
+  for (int j = 0; j < count; ++j) {
+    const std::string field = "joints[" + std::to_string(j) + "]";
+    const json& joint = joints[j];
+    if (!joint.is_object()) {
+      fail(field,
+           "must be an object {\"name\": ..., \"" + std::string(format.min) + "\": ..., ...}, not " + shown(joint));
+    }
+    onlyKnown(joint, field, format.known);
+    const std::string name = text(joint, field, "name");
+    if (!names.insert(name).second) {
+      fail(field + ".name", "'" + name + "' is taken already; joint names must differ");
+    }
+    robot.joint_names.push_back(name);
+    robot.joint_labels.push_back(text(joint, field, "label"));
+    robot.limits.min_position[j] = value(joint, field, format.min);
+    robot.limits.max_position[j] = value(joint, field, format.max);
+    robot.limits.max_velocity[j] = value(joint, field, format.velocity);
+    robot.limits.max_acceleration[j] = value(joint, field, format.acceleration);
+    if (robot.limits.min_position[j] > robot.limits.max_position[j]) {
+      fail(field, std::string(format.min) + " " + shown(joint.at(format.min)) + " is above " + format.max + " " +
+                      shown(joint.at(format.max)));
+    }
+    if (!(robot.limits.max_velocity[j] > 0.0)) {
+      fail(field + "." + format.velocity,
+           "must be positive" + std::string(format.velocity_unit) + ", not " + shown(joint.at(format.velocity)));
+    }
+    if (!(robot.limits.max_acceleration[j] > 0.0)) {
+      fail(field + "." + format.acceleration, "must be positive" + std::string(format.acceleration_unit) + ", not " +
+                                                  shown(joint.at(format.acceleration)));
+    }
+  }
+  const std::vector<double> home = numbers(member(root_object, "", format.home), format.home, joints.size(),
+                                           std::to_string(count) + " angles (" + format.unit + "), one per joint");
+  robot.home = JointVector(count);
+  for (int j = 0; j < count; ++j) {
+    robot.home[j] = home[static_cast<std::size_t>(j)] * format.to_radians;
+    if (robot.home[j] < robot.limits.min_position[j] || robot.home[j] > robot.limits.max_position[j]) {
+      fail(std::string(format.home) + "[" + std::to_string(j) + "]",
+           "is outside joint " + std::to_string(j + 1) + "'s limits");
+    }
+  }
+}
+
 RobotDescription parse(const json& root_object, const std::filesystem::path& data_root) {
   if (!root_object.is_object()) {
     fail("(top level)", "must be an object {\"name\": ..., \"joints\": [...], ...}, not " + shown(root_object));
@@ -109,50 +178,18 @@ RobotDescription parse(const json& root_object, const std::filesystem::path& dat
   robot.urdf_base_link = text(models, "models", "urdf_base_link");
   robot.urdf_tool_link = text(models, "models", "urdf_tool_link");
 
-  const json& joints = member(root_object, "", "joints");
-  if (!joints.is_array() || joints.empty() || joints.size() > static_cast<std::size_t>(kMaxJoints)) {
-    fail("joints", "must be a list of 1 to " + std::to_string(kMaxJoints) + " joints, not " + shown(joints));
-  }
-  const int count = static_cast<int>(joints.size());
-  robot.limits = {JointVector(count), JointVector(count), JointVector(count), JointVector(count)};
-  std::set<std::string> names;
-  for (int j = 0; j < count; ++j) {
-    const std::string field = "joints[" + std::to_string(j) + "]";
-    const json& joint = joints[j];
-    if (!joint.is_object()) {
-      fail(field, "must be an object {\"name\": ..., \"min\": ..., ...}, not " + shown(joint));
-    }
-    onlyKnown(joint, field, {"name", "label", "min", "max", "max_velocity", "max_acceleration"});
-    const std::string name = text(joint, field, "name");
-    if (!names.insert(name).second) {
-      fail(field + ".name", "'" + name + "' is taken already; joint names must differ");
-    }
-    robot.joint_names.push_back(name);
-    robot.joint_labels.push_back(text(joint, field, "label"));
-    robot.limits.min_position[j] = number(member(joint, field, "min"), field + ".min");
-    robot.limits.max_position[j] = number(member(joint, field, "max"), field + ".max");
-    robot.limits.max_velocity[j] = number(member(joint, field, "max_velocity"), field + ".max_velocity");
-    robot.limits.max_acceleration[j] = number(member(joint, field, "max_acceleration"), field + ".max_acceleration");
-    if (robot.limits.min_position[j] > robot.limits.max_position[j]) {
-      fail(field, "min " + shown(joint.at("min")) + " is above max " + shown(joint.at("max")));
-    }
-    if (!(robot.limits.max_velocity[j] > 0.0)) {
-      fail(field + ".max_velocity", "must be positive (rad/s), not " + shown(joint.at("max_velocity")));
-    }
-    if (!(robot.limits.max_acceleration[j] > 0.0)) {
-      fail(field + ".max_acceleration", "must be positive (rad/s^2), not " + shown(joint.at("max_acceleration")));
-    }
-  }
-
-  const std::vector<double> home = numbers(member(root_object, "", "home"), "home", joints.size(),
-                                           std::to_string(count) + " angles (radians), one per joint");
-  robot.home = JointVector(count);
-  for (int j = 0; j < count; ++j) {
-    robot.home[j] = home[j];
-    if (home[j] < robot.limits.min_position[j] || home[j] > robot.limits.max_position[j]) {
-      fail("home[" + std::to_string(j) + "]", "is outside joint " + std::to_string(j + 1) + "'s limits");
-    }
-  }
+  readJoints(root_object,
+             {"min",
+              "max",
+              "max_velocity",
+              "max_acceleration",
+              "home",
+              1.0,
+              "radians",
+              " (rad/s)",
+              " (rad/s^2)",
+              {"name", "label", "min", "max", "max_velocity", "max_acceleration"}},
+             robot);
 
   robot.tool_in_flange = world::Pose::Identity();
   if (root_object.contains("tool")) {
@@ -206,10 +243,6 @@ std::filesystem::path generatedModel(const std::string& name, const std::string&
   return path;
 }
 
-double degrees(const json& object, const std::string& field, const std::string& key) {
-  return number(member(object, field, key), field + "." + key) * std::numbers::pi / 180.0;
-}
-
 /// Format costar-robot-description/1 (robots/README.md), the file robots/generate_models.py
 /// makes the models from: the generator's fields plus those only the runtime needs (type,
 /// label, kinematics, joints[].label and .acceleration_deg_s2, gripper_links). The fields of
@@ -230,54 +263,20 @@ RobotDescription parseGenerated(const json& root_object) {
       robot.solver_parameters[key] = numbers(value, "kinematics." + key);
     }
   }
-  const json& joints = member(root_object, "", "joints");
-  if (!joints.is_array() || joints.empty() || joints.size() > static_cast<std::size_t>(kMaxJoints)) {
-    fail("joints", "must be a list of 1 to " + std::to_string(kMaxJoints) + " joints, not " + shown(joints));
-  }
-  const int count = static_cast<int>(joints.size());
-  robot.limits = {JointVector(count), JointVector(count), JointVector(count), JointVector(count)};
-  std::set<std::string> names;
-  for (int j = 0; j < count; ++j) {
-    const std::string field = "joints[" + std::to_string(j) + "]";
-    const json& joint = joints[j];
-    if (!joint.is_object()) {
-      fail(field, "must be an object {\"name\": ..., \"lower_deg\": ..., ...}, not " + shown(joint));
-    }
-    onlyKnown(joint, field,
+  readJoints(root_object,
+             {"lower_deg",
+              "upper_deg",
+              "velocity_deg_s",
+              "acceleration_deg_s2",
+              "home_deg",
+              std::numbers::pi / 180.0,
+              "degrees",
+              "",
+              "",
               {"name", "label", "parent", "child", "origin", "rpy", "axis", "lower_deg", "upper_deg", "velocity_deg_s",
-               "acceleration_deg_s2", "effort_nm"});
-    const std::string name = text(joint, field, "name");
-    if (!names.insert(name).second) {
-      fail(field + ".name", "'" + name + "' is taken already; joint names must differ");
-    }
-    robot.joint_names.push_back(name);
-    robot.joint_labels.push_back(text(joint, field, "label"));
-    if (j == 0) {
-      robot.first_moving_link = text(joint, field, "child");
-    }
-    robot.limits.min_position[j] = degrees(joint, field, "lower_deg");
-    robot.limits.max_position[j] = degrees(joint, field, "upper_deg");
-    robot.limits.max_velocity[j] = degrees(joint, field, "velocity_deg_s");
-    robot.limits.max_acceleration[j] = degrees(joint, field, "acceleration_deg_s2");
-    if (robot.limits.min_position[j] > robot.limits.max_position[j]) {
-      fail(field, "lower_deg " + shown(joint.at("lower_deg")) + " is above upper_deg " + shown(joint.at("upper_deg")));
-    }
-    if (!(robot.limits.max_velocity[j] > 0.0)) {
-      fail(field + ".velocity_deg_s", "must be positive, not " + shown(joint.at("velocity_deg_s")));
-    }
-    if (!(robot.limits.max_acceleration[j] > 0.0)) {
-      fail(field + ".acceleration_deg_s2", "must be positive, not " + shown(joint.at("acceleration_deg_s2")));
-    }
-  }
-  const std::vector<double> home = numbers(member(root_object, "", "home_deg"), "home_deg", joints.size(),
-                                           std::to_string(count) + " angles (degrees), one per joint");
-  robot.home = JointVector(count);
-  for (int j = 0; j < count; ++j) {
-    robot.home[j] = home[j] * std::numbers::pi / 180.0;
-    if (robot.home[j] < robot.limits.min_position[j] || robot.home[j] > robot.limits.max_position[j]) {
-      fail("home_deg[" + std::to_string(j) + "]", "is outside joint " + std::to_string(j + 1) + "'s limits");
-    }
-  }
+               "acceleration_deg_s2", "effort_nm"}},
+             robot);
+  robot.first_moving_link = text(root_object.at("joints")[0], "joints[0]", "child");
   robot.base_link = text(root_object, "", "base_link");
   const json& tool = objectAt(root_object, "", "tool");
   robot.urdf_base_link = robot.base_link;

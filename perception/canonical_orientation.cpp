@@ -26,13 +26,20 @@ CanonicalPose setCanonicalOrientation(const world::Pose& pose, const world::Obje
       order[static_cast<std::size_t>(i)] = axisIndex(object_class.axis_priority[static_cast<std::size_t>(i)]);
     }
   }
+  // The candidate R S's axis a against the reference's: (R S e_a) . r_a = (R^T r_a) . (S e_a),
+  // so one product R^T r_a per axis serves every symmetry.
+  std::array<Eigen::Vector3d, 3> seen_reference;
+  for (int i = 0; i < 3; ++i) {
+    const int axis = order[static_cast<std::size_t>(i)];
+    seen_reference[static_cast<std::size_t>(i)] = rotation.transpose() * reference.col(axis);
+  }
   std::array<double, 3> best_score{-2.0, -2.0, -2.0};
   for (std::size_t k = 0; k < object_class.symmetries.size(); ++k) {
-    const Eigen::Matrix3d candidate = rotation * object_class.symmetries[k];
+    const Eigen::Matrix3d& symmetry = object_class.symmetries[k];
     std::array<double, 3> score{};
     for (int i = 0; i < 3; ++i) {
       const int axis = order[static_cast<std::size_t>(i)];
-      score[static_cast<std::size_t>(i)] = candidate.col(axis).dot(reference.col(axis));
+      score[static_cast<std::size_t>(i)] = seen_reference[static_cast<std::size_t>(i)].dot(symmetry.col(axis));
     }
     // Lexicographic comparison with a tolerance: the first axis that differs decides.
     bool better = false;

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <map>
 #include <optional>
+#include <span>
 #include <tuple>
 
 #include "perception/canonical_orientation.h"
@@ -25,6 +26,9 @@ using Box = bg::model::box<Point>;
 using Tree = bgi::rtree<Entry, bgi::rstar<16>>;
 
 Point toPoint(const Eigen::Vector3d& p) { return Point(p.x(), p.y(), p.z()); }
+
+/// How many detections ahead a matched previous object is fetched into the cache.
+constexpr std::size_t kPrefetchAhead = 8;
 
 }  // namespace
 
@@ -90,11 +94,26 @@ const std::vector<TrackedObject>& PersistenceFilter::update(const std::vector<De
       }
     }
   }
-  // Closest pairs first: a pair counts when neither side is matched yet.
-  std::sort(pairs.begin(), pairs.end());
+  // Closest pairs first: a pair counts when neither side is matched yet. A pair whose detection
+  // and previous object are in no other pair is taken whatever the order, so only the
+  // contested pairs need sorting.
+  std::vector<std::uint8_t> detection_pairs(detections.size(), 0);
+  std::vector<std::uint8_t> previous_pairs(previous.size(), 0);
+  for (const Pair& pair : pairs) {
+    detection_pairs[pair.detection] = std::min(detection_pairs[pair.detection] + 1, 2);
+    previous_pairs[pair.previous] = std::min(previous_pairs[pair.previous] + 1, 2);
+  }
   std::vector<std::optional<std::size_t>> match(detections.size());
   std::vector<bool> taken(previous.size(), false);
-  for (const Pair& pair : pairs) {
+  const auto contested = std::partition(pairs.begin(), pairs.end(), [&](const Pair& pair) {
+    return detection_pairs[pair.detection] == 1 && previous_pairs[pair.previous] == 1;
+  });
+  for (auto pair = pairs.begin(); pair != contested; ++pair) {
+    match[pair->detection] = pair->previous;
+    taken[pair->previous] = true;
+  }
+  std::sort(contested, pairs.end());
+  for (const Pair& pair : std::span(contested, pairs.end())) {
     if (!match[pair.detection] && !taken[pair.previous]) {
       match[pair.detection] = pair.previous;
       taken[pair.previous] = true;
@@ -110,6 +129,14 @@ const std::vector<TrackedObject>& PersistenceFilter::update(const std::vector<De
     return nullptr;
   };
   for (std::size_t d = 0; d < detections.size(); ++d) {
+    // The matched previous objects are read in the detections' order, scattered over memory:
+    // ask for the one a few detections ahead now, so it is in the cache when it is read.
+    if (const std::size_t ahead = d + kPrefetchAhead; ahead < detections.size() && match[ahead]) {
+      const auto* bytes = reinterpret_cast<const char*>(&previous[*match[ahead]]);
+      for (std::size_t offset = 0; offset < sizeof(TrackedObject); offset += 64) {
+        __builtin_prefetch(bytes + offset);
+      }
+    }
     const Detection& detection = detections[d];
     TrackedObject object;
     object.object_class = detection.object_class;

@@ -21,69 +21,15 @@ medial and distal ones bend (stiff springs) once it is blocked, so the finger wr
 and squeezes it with at most the force limit. Fingers with a scissor_sign turn about their
 base's z axis, coupled by an equality; one position servo drives that scissor axis.
 Bad input stops with a message naming the file, the field and the problem (exit status 1)."""
-import json
 import math
 import pathlib
 import sys
 
+from description_reader import DescriptionError, Reader, fmt
+
 FORMAT = "costar-gripper-description/1"
 PHALANGES = ("proximal", "medial", "distal")
 FINGERS = ("finger_middle", "finger_1", "finger_2")
-
-
-class DescriptionError(Exception):
-    pass
-
-
-def fmt(values):
-    return " ".join(f"{float(x):.12g}" for x in values)
-
-
-class Reader:
-    """Typed access to the description, with errors that name the field."""
-
-    def __init__(self, path):
-        self.path = path
-        try:
-            self.root = json.loads(pathlib.Path(path).read_text())
-        except OSError as error:
-            raise DescriptionError(f"{path}: cannot read: {error.strerror}")
-        except json.JSONDecodeError as error:
-            raise DescriptionError(f"{path}: line {error.lineno}, column {error.colno}: {error.msg}")
-        if not isinstance(self.root, dict):
-            raise DescriptionError(f"{path}: the top level must be an object")
-
-    def fail(self, field, problem):
-        raise DescriptionError(f"{self.path}: {field}: {problem}")
-
-    def get(self, obj, key, field, kind, positive=False):
-        name = f"{field}.{key}" if field else key
-        if not isinstance(obj, dict):
-            self.fail(field, "must be an object")
-        if key not in obj:
-            self.fail(name, "missing")
-        value = obj[key]
-        if kind == "number":
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                self.fail(name, f"must be a finite number, not {json.dumps(value)}")
-            if positive and value <= 0:
-                self.fail(name, f"must be positive, not {value}")
-        elif kind == "string":
-            if not isinstance(value, str) or not value:
-                self.fail(name, "must be a non-empty string")
-        elif kind == "vec3":
-            if (not isinstance(value, list) or len(value) != 3 or
-                    not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in value)):
-                self.fail(name, f"must be 3 finite numbers, not {json.dumps(value)}")
-            if positive and min(value) <= 0:
-                self.fail(name, "must be 3 positive numbers")
-        elif kind == "list":
-            if not isinstance(value, list) or not value:
-                self.fail(name, "must be a non-empty list")
-        elif kind == "object":
-            if not isinstance(value, dict):
-                self.fail(name, "must be an object")
-        return value
 
 
 def read_description(path):

@@ -17,20 +17,13 @@ Conventions (those of sim/models/ur5_arm.xml and sim/models/ur5_arm.urdf):
 - URDF: capsules become a cylinder and two spheres (the same solid); the tool frame is a link
   on a fixed joint; the base link carries no inertia (KDL does not accept one on the root).
 Bad input stops with a message naming the file, the field and the problem (exit status 1)."""
-import json
 import math
 import pathlib
 import sys
 
+from description_reader import DescriptionError, Reader, fmt
+
 FORMAT = "costar-robot-description/1"
-
-
-class DescriptionError(Exception):
-    pass
-
-
-def fmt(values):
-    return " ".join(f"{float(x):.12g}" for x in values)
 
 
 def rotation_rpy(rpy):
@@ -56,49 +49,6 @@ def mat_vec(m, v):
 
 def mat_mat(a, b):
     return [[sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
-
-
-class Reader:
-    """Typed access to the description, with errors that name the field."""
-
-    def __init__(self, path):
-        self.path = path
-        try:
-            self.root = json.loads(pathlib.Path(path).read_text())
-        except OSError as error:
-            raise DescriptionError(f"{path}: cannot read: {error.strerror}")
-        except json.JSONDecodeError as error:
-            raise DescriptionError(f"{path}: line {error.lineno}, column {error.colno}: {error.msg}")
-        if not isinstance(self.root, dict):
-            raise DescriptionError(f"{path}: the top level must be an object")
-
-    def fail(self, field, problem):
-        raise DescriptionError(f"{self.path}: {field}: {problem}")
-
-    def get(self, obj, key, field, kind, optional=False, default=None):
-        if key not in obj:
-            if optional:
-                return default
-            self.fail(f"{field}.{key}" if field else key, "missing")
-        value = obj[key]
-        name = f"{field}.{key}" if field else key
-        if kind == "number":
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                self.fail(name, f"must be a finite number, not {json.dumps(value)}")
-        elif kind == "string":
-            if not isinstance(value, str) or not value:
-                self.fail(name, "must be a non-empty string")
-        elif kind == "vec3":
-            if (not isinstance(value, list) or len(value) != 3 or
-                    not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in value)):
-                self.fail(name, f"must be 3 finite numbers, not {json.dumps(value)}")
-        elif kind == "list":
-            if not isinstance(value, list) or not value:
-                self.fail(name, "must be a non-empty list")
-        elif kind == "object":
-            if not isinstance(value, dict):
-                self.fail(name, "must be an object")
-        return value
 
 
 def read_description(path):

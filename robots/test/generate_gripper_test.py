@@ -1,49 +1,22 @@
 #!/usr/bin/env python3
 """robots/generate_gripper.py: the model it writes from robots/grippers/robotiq3f.json, and the
 errors it gives for bad descriptions (file, field, problem; exit status 1; nothing written)."""
-import json
 import math
-import pathlib
-import subprocess
-import sys
-import tempfile
 import unittest
 import xml.etree.ElementTree as ET
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-GENERATOR = ROOT / "robots" / "generate_gripper.py"
+from generator_case import ROOT, GeneratorCase
+
 ROBOTIQ = ROOT / "robots" / "grippers" / "robotiq3f.json"
 
 
-def run(description, out):
-    return subprocess.run([sys.executable, str(GENERATOR), str(description), str(out)], capture_output=True, text=True)
-
-
-class GenerateGripper(unittest.TestCase):
-    def setUp(self):
-        self.dir = tempfile.TemporaryDirectory()
-        self.tmp = pathlib.Path(self.dir.name)
-
-    def tearDown(self):
-        self.dir.cleanup()
-
-    def variant(self, change):
-        data = json.loads(ROBOTIQ.read_text())
-        change(data)
-        path = self.tmp / "gripper.json"
-        path.write_text(json.dumps(data))
-        return path
-
-    def expect_error(self, change, *fragments):
-        out = self.tmp / "out"
-        result = run(self.variant(change), out)
-        self.assertEqual(result.returncode, 1, result.stderr)
-        for fragment in ("gripper.json",) + fragments:
-            self.assertIn(fragment, result.stderr)
-        self.assertFalse(out.exists(), "nothing is written for a bad description")
+class GenerateGripper(GeneratorCase):
+    GENERATOR = ROOT / "robots" / "generate_gripper.py"
+    DESCRIPTION = ROBOTIQ
+    VARIANT_NAME = "gripper.json"
 
     def test_writes_three_underactuated_fingers_and_a_scissor_axis(self):
-        result = run(ROBOTIQ, self.tmp)
+        result = self.run_generator(ROBOTIQ, self.tmp)
         self.assertEqual(result.returncode, 0, result.stderr)
         alone = ET.parse(self.tmp / "robotiq3f.xml").getroot()
         body = ET.parse(self.tmp / "robotiq3f_body.xml").getroot()
@@ -111,7 +84,7 @@ class GenerateGripper(unittest.TestCase):
     def test_unreadable_json_names_the_line(self):
         path = self.tmp / "gripper.json"
         path.write_text('{\n  "format": \n}')
-        result = run(path, self.tmp / "out")
+        result = self.run_generator(path, self.tmp / "out")
         self.assertEqual(result.returncode, 1)
         self.assertIn("gripper.json: line 3", result.stderr)
 

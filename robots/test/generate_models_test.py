@@ -1,48 +1,21 @@
 #!/usr/bin/env python3
 """robots/generate_models.py: the models it writes from robots/iiwa14/iiwa14.json, and the errors
 it gives for bad descriptions (file, field, problem; exit status 1; nothing written)."""
-import json
-import pathlib
-import subprocess
-import sys
-import tempfile
 import unittest
 import xml.etree.ElementTree as ET
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-GENERATOR = ROOT / "robots" / "generate_models.py"
+from generator_case import ROOT, GeneratorCase
+
 IIWA = ROOT / "robots" / "iiwa14" / "iiwa14.json"
 
 
-def run(description, out):
-    return subprocess.run([sys.executable, str(GENERATOR), str(description), str(out)], capture_output=True, text=True)
-
-
-class GenerateModels(unittest.TestCase):
-    def setUp(self):
-        self.dir = tempfile.TemporaryDirectory()
-        self.tmp = pathlib.Path(self.dir.name)
-
-    def tearDown(self):
-        self.dir.cleanup()
-
-    def variant(self, change):
-        data = json.loads(IIWA.read_text())
-        change(data)
-        path = self.tmp / "robot.json"
-        path.write_text(json.dumps(data))
-        return path
-
-    def expect_error(self, change, *fragments):
-        out = self.tmp / "out"
-        result = run(self.variant(change), out)
-        self.assertEqual(result.returncode, 1, result.stderr)
-        for fragment in ("robot.json",) + fragments:
-            self.assertIn(fragment, result.stderr)
-        self.assertFalse(out.exists(), "nothing is written for a bad description")
+class GenerateModels(GeneratorCase):
+    GENERATOR = ROOT / "robots" / "generate_models.py"
+    DESCRIPTION = IIWA
+    VARIANT_NAME = "robot.json"
 
     def test_writes_both_models_with_the_described_chain(self):
-        result = run(IIWA, self.tmp)
+        result = self.run_generator(IIWA, self.tmp)
         self.assertEqual(result.returncode, 0, result.stderr)
         mjcf = ET.parse(self.tmp / "iiwa14.xml").getroot()
         urdf = ET.parse(self.tmp / "iiwa14.urdf").getroot()
@@ -74,10 +47,10 @@ class GenerateModels(unittest.TestCase):
     def test_unreadable_input(self):
         broken = self.tmp / "robot.json"
         broken.write_text('{"format": ')
-        result = run(broken, self.tmp / "out")
+        result = self.run_generator(broken, self.tmp / "out")
         self.assertEqual(result.returncode, 1)
         self.assertIn("robot.json: line 1", result.stderr)
-        result = run(self.tmp / "missing.json", self.tmp / "out")
+        result = self.run_generator(self.tmp / "missing.json", self.tmp / "out")
         self.assertEqual(result.returncode, 1)
         self.assertIn("cannot read", result.stderr)
 
