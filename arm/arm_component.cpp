@@ -19,26 +19,6 @@ std::string format(const char* pattern, double value) {
   return text;
 }
 
-/// Why a reading cannot be trusted, or empty.
-std::string problemWith(const ArmState& state, TimePoint now, Duration timeout,
-                        const std::vector<std::string>& joint_names) {
-  // Velocities: one per joint, or none from a driver that does not measure them.
-  const int count = static_cast<int>(joint_names.size());
-  if (state.position.size() != count || (state.velocity.size() != count && !state.velocity.empty())) {
-    return "arm driver: the joint state has " + std::to_string(state.position.size()) + " positions and " +
-           std::to_string(state.velocity.size()) + " velocities for " + std::to_string(count) + " joints";
-  }
-  for (int j = 0; j < count; ++j) {
-    if (!std::isfinite(state.position[j]) || (!state.velocity.empty() && !std::isfinite(state.velocity[j]))) {
-      return "arm driver: the joint state is not a number (" + joint_names[j] + ")";
-    }
-  }
-  if (state.stamp != TimePoint{} && now - state.stamp > timeout) {
-    return "arm driver: the joint state stopped updating (" + format("%.3f", toSeconds(now - state.stamp)) + " s old)";
-  }
-  return {};
-}
-
 /// Decelerates the motion being followed along its path, if it is not over.
 void stopMotion(ArmMotion& motion, ArmDriver& driver, const Clock& clock, const JointLimits& limits) {
   ++motion.counter;
@@ -86,7 +66,7 @@ class MotionOperation final : public component::RunningOperation {
     std::string problem;
     try {
       state = driver_.read();
-      problem = problemWith(state, now, config_.state_timeout, config_.joint_names);
+      problem = readingProblem(state, now, config_.state_timeout, config_.joint_names);
     } catch (const std::exception& e) {
       problem = e.what();
     }
@@ -128,6 +108,13 @@ class MotionOperation final : public component::RunningOperation {
   TimePoint start_;
 };
 
+std::unique_ptr<component::RunningOperation> finished(OperationResult result) {
+  return std::make_unique<component::FinishedOperation>(std::move(result));
+}
+
+/// How far (rad, any joint) a FollowJointPath may start from where the arm is.
+constexpr double kPathStartTolerance = 0.01;
+
 ParamSpec speedParam(double default_speed) {
   ParamSpec speed{"speed", ValueType::kDouble, "fraction of the arm's top speed and acceleration", default_speed};
   speed.min = 0.01;
@@ -137,12 +124,11 @@ ParamSpec speedParam(double default_speed) {
 
 }  // namespace
 
-ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::CollisionWorld& collisions,
+ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, const planning::CollisionWorld& collisions,
                            WaypointStore& waypoints, FrameLookup frames, std::shared_ptr<const Kinematics> kinematics,
                            ArmConfig config)
     : driver_(driver),
       clock_(clock),
-      collisions_(collisions),
       waypoints_(waypoints),
       frames_(std::move(frames)),
       kinematics_(std::move(kinematics)),
@@ -168,11 +154,17 @@ ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::Coll
       config_.joint_names.push_back("joint_" + std::to_string(j));
     }
   }
-  description_.name = config_.name;
-  description_.type = config_.type;
-  description_.implements = {"Arm"};
-  description_.inputs = {"joint_states"};
-  description_.outputs = {"joint_trajectory"};
+  planner_.emplace(driver_, clock_, collisions, kinematics_, config_);
+  declareOperations();
+}
+
+void ArmComponent::declareOperations() {
+  component::ComponentDescription description;
+  description.name = config_.name;
+  description.type = config_.type;
+  description.implements = {"Arm"};
+  description.inputs = {"joint_states"};
+  description.outputs = {"joint_trajectory"};
 
   ParamSpec waypoint{"waypoint", ValueType::kString, "name of a taught waypoint", {}};
   waypoint.choices_from = "waypoint";
@@ -204,158 +196,67 @@ ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, planning::Coll
   amount.min = -90;
   amount.max = 90;
   const ParamSpec speed = speedParam(config_.default_speed);
-  description_.operations = {
-      {"Move", "Moves the tool to a taught waypoint, around obstacles.", {waypoint, speed}},
-      {"Home", "Moves the arm to its home configuration.", {speed}},
-      {"MoveToPose",
-       "Moves the tool to a pose given in a frame.",
-       {{"pose", ValueType::kPose, "x;y;z;roll;pitch;yaw (m, degrees)", {}}, frame, speed}},
-      {"MoveRelative",
-       "Moves the tool along a straight line by an offset (e.g. 0;0;0.1 lifts 10 cm).",
-       {{"offset", ValueType::kPose, "x;y;z[;roll;pitch;yaw] (m, degrees)", {}}, axis_frame, speed}},
-      {"Teach",
-       "Saves where the arm is as a named waypoint.",
-       {{"waypoint", ValueType::kString, "name for the waypoint", {}}, kind, frame},
-       component::OperationKind::kKnowledge},
-      {"RenameWaypoint",
-       "Renames a taught waypoint.",
-       {waypoint, {"new_name", ValueType::kString, "the waypoint's new name", {}}},
-       component::OperationKind::kKnowledge},
-      {"DeleteWaypoint", "Forgets a taught waypoint.", {waypoint}, component::OperationKind::kKnowledge},
-      {"JogJoint", "Turns one joint by a few degrees.", {joint, degrees, speed}},
-      {"JogCartesian",
-       "Moves the tool a little along or about one axis, in a straight line.",
-       {axis, amount, axis_frame, speed}}};
-  description_.symbols = {{"endpoint", world::SymbolKind::kFrame, "the tool centre point, in the world"},
-                          {"arm_joints", world::SymbolKind::kJoints, "the joint configuration"}};
-  description_.predicates = {{"arm_moving", 0, "a joint is turning"},
-                             {"at_waypoint", 1, "at_waypoint(w): the tool is at waypoint w"}};
+  using Params = component::ParamMap;
+  component::OperationTable operations;
+  operations.add({"Move", "Moves the tool to a taught waypoint, around obstacles.", {waypoint, speed}},
+                 [this](const Params& params) { return move(params); });
+  operations.add({"Home", "Moves the arm to its home configuration.", {speed}},
+                 [this](const Params& params) { return execute(planToJoints(config_.home, speedOf(params)), "Home"); });
+  operations.add({"MoveToPose",
+                  "Moves the tool to a pose given in a frame.",
+                  {{"pose", ValueType::kPose, "x;y;z;roll;pitch;yaw (m, degrees)", {}}, frame, speed}},
+                 [this](const Params& params) {
+                   const std::string name = params.at("frame").asString();
+                   const auto base = frameInWorld(name);
+                   if (!base) {
+                     return finished(OperationResult::failure("unknown frame '" + name + "'"));
+                   }
+                   return execute(planToPose(*base * params.at("pose").asPose(), speedOf(params)), "MoveToPose");
+                 });
+  operations.add({"MoveRelative",
+                  "Moves the tool along a straight line by an offset (e.g. 0;0;0.1 lifts 10 cm).",
+                  {{"offset", ValueType::kPose, "x;y;z[;roll;pitch;yaw] (m, degrees)", {}}, axis_frame, speed}},
+                 [this](const Params& params) { return straightLine("MoveRelative", params); });
+  operations.add({"Teach",
+                  "Saves where the arm is as a named waypoint.",
+                  {{"waypoint", ValueType::kString, "name for the waypoint", {}}, kind, frame},
+                  component::OperationKind::kKnowledge},
+                 [this](const Params& params) { return teach(params); });
+  operations.add({"RenameWaypoint",
+                  "Renames a taught waypoint.",
+                  {waypoint, {"new_name", ValueType::kString, "the waypoint's new name", {}}},
+                  component::OperationKind::kKnowledge},
+                 [this](const Params& params) { return renameOrDelete(true, params); });
+  operations.add({"DeleteWaypoint", "Forgets a taught waypoint.", {waypoint}, component::OperationKind::kKnowledge},
+                 [this](const Params& params) { return renameOrDelete(false, params); });
+  operations.add({"JogJoint", "Turns one joint by a few degrees.", {joint, degrees, speed}},
+                 [this](const Params& params) { return jogJoint(params); });
+  operations.add({"JogCartesian",
+                  "Moves the tool a little along or about one axis, in a straight line.",
+                  {axis, amount, axis_frame, speed}},
+                 [this](const Params& params) { return straightLine("JogCartesian", params); });
+  ParamSpec path{"path",
+                 ValueType::kString,
+                 "the joint waypoints, start first, as JSON: [[q1, ..., qn], ...] (rad), from the cell's motion "
+                 "service",
+                 {}};
+  ParamSpec motion_label{"label", ValueType::kString, "what the motion is called in messages",
+                         std::string(kFollowJointPath)};
+  operations.add({std::string(kFollowJointPath),
+                  "Follows joint waypoints planned by the cell's motion service, timed within the arm's limits.",
+                  {path, speed, motion_label},
+                  component::OperationKind::kInternal},
+                 [this](const Params& params) { return followJointPath(params); });
+  description.symbols = {{"endpoint", world::SymbolKind::kFrame, "the tool centre point, in the world"},
+                         {"arm_joints", world::SymbolKind::kJoints, "the joint configuration"}};
+  description.predicates = {{"arm_moving", 0, "a joint is turning"},
+                            {"at_waypoint", 1, "at_waypoint(w): the tool is at waypoint w"}};
+  declare(std::move(description), std::move(operations));
 }
 
-Eigen::VectorXd ArmComponent::toEigen(const JointVector& q) const { return q.eigen(); }
-
-world::Pose ArmComponent::endpoint() const {
-  return config_.base_in_world * kinematics_->forward(checkedRead().position) * config_.tcp_in_flange;
-}
-
-ArmState ArmComponent::checkedRead() const {
-  const ArmState state = driver_.read();
-  if (const std::string problem = problemWith(state, clock_.now(), config_.state_timeout, config_.joint_names);
-      !problem.empty()) {
-    throw std::runtime_error(problem);
-  }
-  return state;
-}
+world::Pose ArmComponent::endpoint() const { return planner_->endpoint(); }
 
 void ArmComponent::stop() { stopMotion(*motion_, driver_, clock_, kinematics_->limits()); }
-
-world::Pose ArmComponent::flangeInBase(const world::Pose& tcp_in_world) const {
-  return config_.base_in_world.inverse() * tcp_in_world * config_.tcp_in_flange.inverse();
-}
-
-std::vector<JointVector> ArmComponent::solutions(const world::Pose& tcp_in_world, const JointVector& seed) const {
-  IkSolutions found;
-  kinematics_->solutionsNear(flangeInBase(tcp_in_world), seed, found);
-  return std::vector<JointVector>(found.begin(), found.end());
-}
-
-MotionPlan ArmComponent::timed(std::vector<JointVector> path, double speed) const {
-  MotionPlan plan;
-  try {
-    plan.goal = path.back();
-    plan.trajectory = std::make_shared<JointTrajectory>(
-        path.size() == 2 ? JointTrajectory::pointToPoint(path.front(), path.back(), kinematics_->limits(), speed)
-                         : JointTrajectory::alongPath(path, kinematics_->limits(), speed));
-  } catch (const std::invalid_argument& e) {
-    plan.trajectory.reset();
-    plan.failure = e.what();
-  }
-  return plan;
-}
-
-world::Pose ArmComponent::toolAt(const JointVector& q) const {
-  return config_.base_in_world * kinematics_->forward(q) * config_.tcp_in_flange;
-}
-
-MotionPlan ArmComponent::planToJoints(const JointVector& start, const JointVector& goal, double speed) const {
-  if (goal.size() != kinematics_->limits().size() || start.size() != kinematics_->limits().size()) {
-    return {nullptr, goal,
-            "the goal has " + std::to_string(goal.size()) + " joints and the start " + std::to_string(start.size()) +
-                ", the arm " + std::to_string(kinematics_->limits().size())};
-  }
-  for (int j = 0; j < goal.size(); ++j) {
-    if (goal[j] < kinematics_->limits().min_position[j] || goal[j] > kinematics_->limits().max_position[j]) {
-      return {nullptr, goal, "joint " + std::to_string(j + 1) + " would leave its limits"};
-    }
-  }
-  const planning::PlanResult path = planning::planPath(collisions_, toEigen(start), toEigen(goal), config_.planner);
-  if (!path.ok()) {
-    return {nullptr, goal, path.failure};
-  }
-  std::vector<JointVector> joints;
-  for (const auto& q : path.path) {
-    joints.push_back(JointVector::fromEigen(q));
-  }
-  return timed(std::move(joints), speed);
-}
-
-MotionPlan ArmComponent::planToPose(const world::Pose& tcp_in_world, double speed) const {
-  const JointVector current = checkedRead().position;
-  const std::vector<JointVector> candidates = solutions(tcp_in_world, current);
-  if (candidates.empty()) {
-    return {nullptr, current, "the pose is out of reach (no inverse kinematics solution within the joint limits)"};
-  }
-  std::string first_problem;
-  for (const JointVector& goal : candidates) {
-    if (const auto contact = collisions_.check(toEigen(goal))) {
-      if (first_problem.empty()) {
-        first_problem = "at the goal, " + contact->str();
-      }
-      continue;
-    }
-    MotionPlan plan = planToJoints(goal, speed);
-    if (plan.ok()) {
-      return plan;
-    }
-    if (first_problem.empty()) {
-      first_problem = plan.failure;
-    }
-  }
-  return {nullptr, current,
-          "none of the " + std::to_string(candidates.size()) + " arm configurations reaching the pose works (" +
-              first_problem + ")"};
-}
-
-MotionPlan ArmComponent::planLine(const JointVector& current, const world::Pose& target, double speed) const {
-  const world::Pose start = config_.base_in_world * kinematics_->forward(current) * config_.tcp_in_flange;
-  const double distance = (target.translation() - start.translation()).norm();
-  const double angle = world::rotationAngle(start, target);
-  const int steps =
-      std::max(1, static_cast<int>(std::ceil(std::max(distance / config_.line_step, angle / (2.0 * M_PI / 180.0)))));
-  const Eigen::Quaterniond q0(start.linear());
-  const Eigen::Quaterniond q1(target.linear());
-  std::vector<JointVector> path{current};
-  for (int i = 1; i <= steps; ++i) {
-    const double s = static_cast<double>(i) / steps;
-    world::Pose pose = world::Pose::Identity();
-    pose.translation() = start.translation() + s * (target.translation() - start.translation());
-    pose.linear() = q0.slerp(s, q1).toRotationMatrix();
-    const std::vector<JointVector> options = solutions(pose, path.back());
-    if (options.empty()) {
-      return {nullptr, current, "the straight line leaves the arm's reach " + format("%.0f %% of the way", 100.0 * s)};
-    }
-    if (maxAbsDifference(options.front(), path.back()) > 0.25) {
-      return {nullptr, current, "the straight line passes too close to a singularity (a joint would have to flip)"};
-    }
-    path.push_back(options.front());
-  }
-  for (std::size_t i = 1; i < path.size(); ++i) {
-    if (const auto contact = collisions_.checkSegment(toEigen(path[i - 1]), toEigen(path[i]))) {
-      return {nullptr, current, "the straight line is blocked: " + contact->str()};
-    }
-  }
-  return timed(std::move(path), speed);
-}
 
 std::optional<world::Pose> ArmComponent::waypointPose(const Waypoint& waypoint) const {
   if (waypoint.frame == "world") {
@@ -375,124 +276,138 @@ std::unique_ptr<component::RunningOperation> ArmComponent::execute(MotionPlan pl
   return std::make_unique<MotionOperation>(driver_, clock_, std::move(plan), motion_, config_, kinematics_, what);
 }
 
-std::unique_ptr<component::RunningOperation> ArmComponent::begin(const std::string& operation,
-                                                                 const component::ParamMap& params) {
-  const auto finished = [](OperationResult result) {
-    return std::make_unique<component::FinishedOperation>(std::move(result));
-  };
-  const auto speed = [&params, this] {
-    const auto it = params.find("speed");
-    return it == params.end() ? config_.default_speed : it->second.asDouble();
-  };
+double ArmComponent::speedOf(const component::ParamMap& params) const {
+  const auto it = params.find("speed");
+  return it == params.end() ? config_.default_speed : it->second.asDouble();
+}
 
-  if (operation == "Move") {
-    const std::string name = params.at("waypoint").asString();
-    const auto waypoint = waypoints_.find(name);
-    if (!waypoint) {
-      std::string known;
-      for (const auto& w : waypoints_.all()) {
-        known += (known.empty() ? "" : ", ") + w.name;
+std::optional<world::Pose> ArmComponent::frameInWorld(const std::string& frame) const {
+  if (frame == "world") {
+    return world::Pose::Identity();
+  }
+  return frames_ ? frames_(frame) : std::nullopt;
+}
+
+std::unique_ptr<component::RunningOperation> ArmComponent::move(const component::ParamMap& params) {
+  const std::string name = params.at("waypoint").asString();
+  const auto waypoint = waypoints_.find(name);
+  if (!waypoint) {
+    std::string known;
+    for (const auto& w : waypoints_.all()) {
+      known += (known.empty() ? "" : ", ") + w.name;
+    }
+    return finished(OperationResult::failure("unknown waypoint '" + name + "'" +
+                                             (known.empty() ? " (none taught yet)" : " (known: " + known + ")")));
+  }
+  if (waypoint->kind == Waypoint::Kind::kJoints) {
+    return execute(planToJoints(waypoint->joints, speedOf(params)), "Move to '" + name + "'");
+  }
+  const auto pose = waypointPose(*waypoint);
+  if (!pose) {
+    return finished(OperationResult::failure("waypoint '" + name + "' is relative to '" + waypoint->frame +
+                                             "', which is not known now"));
+  }
+  return execute(planToPose(*pose, speedOf(params)), "Move to '" + name + "'");
+}
+
+std::unique_ptr<component::RunningOperation> ArmComponent::straightLine(const std::string& operation,
+                                                                        const component::ParamMap& params) {
+  world::Pose offset = world::Pose::Identity();
+  if (operation == "MoveRelative") {
+    offset = params.at("offset").asPose();
+  } else {
+    const std::string axis = params.at("axis").asString();
+    const double amount = params.at("amount").asDouble();
+    const int index = axis == "x" || axis == "roll" ? 0 : axis == "y" || axis == "pitch" ? 1 : 2;
+    if (axis.size() == 1) {
+      if (std::abs(amount) > 0.2) {
+        return finished(OperationResult::failure("JogCartesian moves at most 0.2 m at a time"));
       }
-      return finished(OperationResult::failure("unknown waypoint '" + name + "'" +
-                                               (known.empty() ? " (none taught yet)" : " (known: " + known + ")")));
-    }
-    if (waypoint->kind == Waypoint::Kind::kJoints) {
-      return execute(planToJoints(waypoint->joints, speed()), "Move to '" + name + "'");
-    }
-    const auto pose = waypointPose(*waypoint);
-    if (!pose) {
-      return finished(OperationResult::failure("waypoint '" + name + "' is relative to '" + waypoint->frame +
-                                               "', which is not known now"));
-    }
-    return execute(planToPose(*pose, speed()), "Move to '" + name + "'");
-  }
-  if (operation == "Home") {
-    return execute(planToJoints(config_.home, speed()), "Home");
-  }
-  if (operation == "MoveToPose") {
-    const std::string frame = params.at("frame").asString();
-    const auto base = frame == "world" ? std::optional<world::Pose>(world::Pose::Identity())
-                                       : (frames_ ? frames_(frame) : std::nullopt);
-    if (!base) {
-      return finished(OperationResult::failure("unknown frame '" + frame + "'"));
-    }
-    return execute(planToPose(*base * params.at("pose").asPose(), speed()), "MoveToPose");
-  }
-  if (operation == "MoveRelative" || operation == "JogCartesian") {
-    world::Pose offset = world::Pose::Identity();
-    if (operation == "MoveRelative") {
-      offset = params.at("offset").asPose();
+      offset.translation()[index] = amount;
     } else {
-      const std::string axis = params.at("axis").asString();
-      const double amount = params.at("amount").asDouble();
-      const int index = axis == "x" || axis == "roll" ? 0 : axis == "y" || axis == "pitch" ? 1 : 2;
-      if (axis.size() == 1) {
-        if (std::abs(amount) > 0.2) {
-          return finished(OperationResult::failure("JogCartesian moves at most 0.2 m at a time"));
-        }
-        offset.translation()[index] = amount;
-      } else {
-        offset.linear() = Eigen::AngleAxisd(amount * M_PI / 180.0, Eigen::Vector3d::Unit(index)).toRotationMatrix();
-      }
+      offset.linear() = Eigen::AngleAxisd(amount * M_PI / 180.0, Eigen::Vector3d::Unit(index)).toRotationMatrix();
     }
-    const world::Pose now = endpoint();
-    world::Pose target = now;
-    if (params.at("frame").asString() == "tool") {
-      target = now * offset;
-    } else {
-      target.translation() = now.translation() + offset.translation();
-      target.linear() = offset.linear() * now.linear();
-    }
-    return execute(planLine(target, speed()), operation);
   }
-  if (operation == "JogJoint") {
-    JointVector goal = checkedRead().position;
-    goal[params.at("joint").asInt() - 1] += params.at("degrees").asDouble() * M_PI / 180.0;
-    return execute(planToJoints(goal, speed()), "JogJoint");
+  const world::Pose now = endpoint();
+  world::Pose target = now;
+  if (params.at("frame").asString() == "tool") {
+    target = now * offset;
+  } else {
+    target.translation() = now.translation() + offset.translation();
+    target.linear() = offset.linear() * now.linear();
   }
-  if (operation == "Teach") {
-    Waypoint waypoint;
-    waypoint.name = params.at("waypoint").asString();
-    if (params.at("kind").asString() == "joints") {
-      waypoint.kind = Waypoint::Kind::kJoints;
-      waypoint.joints = checkedRead().position;
-    } else {
-      waypoint.frame = params.at("frame").asString();
-      const auto frame = waypoint.frame == "world" ? std::optional<world::Pose>(world::Pose::Identity())
-                                                   : (frames_ ? frames_(waypoint.frame) : std::nullopt);
-      if (!frame) {
-        return finished(
-            OperationResult::failure("cannot teach relative to '" + waypoint.frame + "': no such frame is known now"));
-      }
-      waypoint.pose = frame->inverse() * endpoint();
+  return execute(planLine(target, speedOf(params)), operation);
+}
+
+std::unique_ptr<component::RunningOperation> ArmComponent::jogJoint(const component::ParamMap& params) {
+  JointVector goal = checkedRead().position;
+  goal[params.at("joint").asInt() - 1] += params.at("degrees").asDouble() * M_PI / 180.0;
+  return execute(planToJoints(goal, speedOf(params)), "JogJoint");
+}
+
+std::unique_ptr<component::RunningOperation> ArmComponent::teach(const component::ParamMap& params) {
+  Waypoint waypoint;
+  waypoint.name = params.at("waypoint").asString();
+  if (params.at("kind").asString() == "joints") {
+    waypoint.kind = Waypoint::Kind::kJoints;
+    waypoint.joints = checkedRead().position;
+  } else {
+    waypoint.frame = params.at("frame").asString();
+    const auto frame = frameInWorld(waypoint.frame);
+    if (!frame) {
+      return finished(
+          OperationResult::failure("cannot teach relative to '" + waypoint.frame + "': no such frame is known now"));
     }
-    try {
-      waypoints_.put(waypoint);
-    } catch (const std::exception& e) {
-      return finished(OperationResult::failure(std::string("cannot save the waypoint: ") + e.what()));
-    }
-    return finished(OperationResult::success({{"waypoint", waypoint.name}}));
+    waypoint.pose = frame->inverse() * endpoint();
   }
-  if (operation == "RenameWaypoint" || operation == "DeleteWaypoint") {
-    const std::string name = params.at("waypoint").asString();
-    try {
-      if (operation == "RenameWaypoint") {
-        waypoints_.rename(name, params.at("new_name").asString());
-      } else if (!waypoints_.remove(name)) {
-        return finished(OperationResult::failure("unknown waypoint '" + name + "'"));
-      }
-    } catch (const std::exception& e) {
-      return finished(OperationResult::failure(e.what()));
-    }
-    return finished(OperationResult::success());
+  try {
+    waypoints_.put(waypoint);
+  } catch (const std::exception& e) {
+    return finished(OperationResult::failure(std::string("cannot save the waypoint: ") + e.what()));
   }
-  return finished(OperationResult::failure("unknown operation " + operation));
+  return finished(OperationResult::success({{"waypoint", waypoint.name}}));
+}
+
+std::unique_ptr<component::RunningOperation> ArmComponent::renameOrDelete(bool rename,
+                                                                          const component::ParamMap& params) {
+  const std::string name = params.at("waypoint").asString();
+  try {
+    if (rename) {
+      waypoints_.rename(name, params.at("new_name").asString());
+    } else if (!waypoints_.remove(name)) {
+      return finished(OperationResult::failure("unknown waypoint '" + name + "'"));
+    }
+  } catch (const std::exception& e) {
+    return finished(OperationResult::failure(e.what()));
+  }
+  return finished(OperationResult::success());
+}
+
+std::unique_ptr<component::RunningOperation> ArmComponent::followJointPath(const component::ParamMap& params) {
+  const std::string label = params.contains("label") ? params.at("label").asString() : std::string(kFollowJointPath);
+  std::vector<JointVector> path;
+  try {
+    path = pathFromParam(params.at("path").asString(), jointCount());
+  } catch (const std::invalid_argument& e) {
+    return finished(OperationResult::failure(label + ": " + e.what()));
+  }
+  // A path planned from elsewhere than where the arm is would jump. A reading that cannot be
+  // trusted is reported (and the arm stopped) by the motion's first poll, as for every motion.
+  try {
+    const JointVector now = checkedRead().position;
+    if (const double gap = maxAbsDifference(path.front(), now); gap > kPathStartTolerance) {
+      return finished(OperationResult::failure(label + ": the path starts " + format("%.3f", gap) +
+                                               " rad from where the arm is (planned from elsewhere?)"));
+    }
+  } catch (const std::exception&) {
+  }
+  return execute(planner_->timed(std::move(path), speedOf(params)), label);
 }
 
 world::Report ArmComponent::report() const {
   // A reading that cannot be trusted makes the report throw: the registry then stops the cell.
   const ArmState state = checkedRead();
-  const world::Pose tcp = config_.base_in_world * kinematics_->forward(state.position) * config_.tcp_in_flange;
+  const world::Pose tcp = toolAt(state.position);
   const TimePoint now = clock_.now();
   world::Report report;
   report.symbols.push_back({"endpoint", "", now, world::FrameValue{"world", tcp}});

@@ -4,17 +4,18 @@
 // inverse) and its configuration (base, tool, home, joint names); nothing here is specific to
 // one arm.
 //
-// Every motion is planned before it runs: the goal is solved with the arm's IK (the
-// nearest solution within the joint limits whose configuration is collision-free), the
-// straight joint-space motion is collision-checked along its whole length against the table,
-// known parts and the arm itself, and when it would collide OMPL plans a way around. The
-// motion is then time-parameterized within the joint velocity and acceleration limits
-// (scaled by the operation's speed) and handed to the driver. Cancelling decelerates along
-// the path within the acceleration limits and stops.
+// Every motion is planned before it runs (arm/motion_planner.h: IK within the limits, the
+// first collision-free solution, the motion checked along its whole length and planned around
+// obstacles with OMPL when needed), time-parameterized within the joint velocity and
+// acceleration limits (scaled by the operation's speed) and handed to the driver. Cancelling
+// decelerates along the path within the acceleration limits and stops.
 //
-// Operations: Move(waypoint), Home, MoveToPose(pose, frame), MoveRelative(offset, frame)
-// (a straight Cartesian line), Teach(waypoint, kind, frame), RenameWaypoint, DeleteWaypoint,
-// JogJoint(joint, degrees), JogCartesian(axis, amount, frame).
+// Operations (one table of spec and handler, component/operation_table.h): Move(waypoint),
+// Home, MoveToPose(pose, frame), MoveRelative(offset, frame) (a straight Cartesian line),
+// Teach(waypoint, kind, frame), RenameWaypoint, DeleteWaypoint, JogJoint(joint, degrees),
+// JogCartesian(axis, amount, frame); and, for other components only (no node type),
+// FollowJointPath(path, speed, label): follows joint waypoints planned by the cell's motion
+// service (arm/motion_service.h), timed within the arm's limits: how SmartMove moves the arm.
 // Symbols: endpoint (the tool centre point in the world), arm_joints, and every waypoint
 // (pose waypoints as frames relative to their frame, joint waypoints as configurations).
 // Predicates: arm_moving, at_waypoint(w).
@@ -25,53 +26,16 @@
 #include <string>
 #include <vector>
 
+#include "arm/arm_config.h"
 #include "arm/arm_driver.h"
 #include "arm/kinematics.h"
+#include "arm/motion_planner.h"
 #include "arm/trajectory.h"
 #include "arm/waypoints.h"
-#include "component/component.h"
+#include "component/operation_table.h"
 #include "planning/collision_world.h"
-#include "planning/planner.h"
 
 namespace costar::arm {
-
-struct ArmConfig {
-  std::string name = "arm";
-  /// The component's concrete type (the robot description's "type", e.g. "UR5").
-  std::string type = "Arm";
-  /// Where the robot's base frame is in the world.
-  world::Pose base_in_world = world::Pose::Identity();
-  /// The tool centre point in the flange frame (between the gripper's finger pads).
-  world::Pose tcp_in_flange = world::Pose::Identity();
-  /// The joints' names (in arm_joints and joint waypoints) and labels for people ("wrist 3"),
-  /// base first; empty: "joint_1", "joint_2"... and no labels.
-  std::vector<std::string> joint_names;
-  std::vector<std::string> joint_labels;
-  /// The home configuration (Home), one angle per joint.
-  JointVector home{};
-  /// Default speed of motions: a fraction of the joint velocity and acceleration limits.
-  double default_speed = 0.5;
-  /// at_waypoint tolerances.
-  double at_waypoint_distance = 0.005;            // m
-  double at_waypoint_angle = 2.0 * M_PI / 180.0;  // rad
-  double at_waypoint_joints = 0.01;               // rad
-  /// A motion fails if the arm is not within this of its goal this long after the end.
-  double arrival_tolerance = 0.005;  // rad
-  Duration settle_time = std::chrono::seconds(1);
-  /// A joint state older than this (by the driver's stamp) means the driver stopped updating.
-  Duration state_timeout = std::chrono::milliseconds(50);
-  /// Cartesian straight lines are followed through IK points this far apart.
-  double line_step = 0.005;  // m
-  planning::PlannerOptions planner;
-};
-
-/// A motion ready to run, or why there is none.
-struct MotionPlan {
-  std::shared_ptr<const JointTrajectory> trajectory;
-  JointVector goal{};
-  std::string failure;
-  bool ok() const { return trajectory != nullptr; }
-};
 
 /// The motion the driver follows, shared by the component and the motion's operation.
 struct ArmMotion {
@@ -80,7 +44,7 @@ struct ArmMotion {
   TimePoint start{};
 };
 
-class ArmComponent final : public component::LocalComponent {
+class ArmComponent final : public component::TableComponent {
  public:
   /// Pose in the world of a frame symbol ("table_center", a part...), or nullopt if unknown.
   using FrameLookup = std::function<std::optional<world::Pose>(const std::string&)>;
@@ -90,43 +54,51 @@ class ArmComponent final : public component::LocalComponent {
   /// (its joint count and limits are the arm's).
   /// Throws std::invalid_argument without kinematics, or when `config.home` does not have one
   /// angle per joint.
-  ArmComponent(ArmDriver& driver, const Clock& clock, planning::CollisionWorld& collisions, WaypointStore& waypoints,
-               FrameLookup frames, std::shared_ptr<const Kinematics> kinematics, ArmConfig config);
+  ArmComponent(ArmDriver& driver, const Clock& clock, const planning::CollisionWorld& collisions,
+               WaypointStore& waypoints, FrameLookup frames, std::shared_ptr<const Kinematics> kinematics,
+               ArmConfig config);
 
-  const component::ComponentDescription& description() const override { return description_; }
   world::Report report() const override;
 
-  // --- planning, for other components (SmartMove) and the operations -------------------
+  // --- planning, for the operations and the calibration (other components ask the cell's
+  // motion service, arm/motion_service.h, and move the arm with FollowJointPath) -----------
   /// The tool centre point's pose in the world now (from the joint encoders).
   world::Pose endpoint() const;
   /// Every IK solution for a TCP pose in the world, each expressed nearest to `seed` within
   /// the joint limits, nearest first.
-  std::vector<JointVector> solutions(const world::Pose& tcp_in_world, const JointVector& seed) const;
+  std::vector<JointVector> solutions(const world::Pose& tcp_in_world, const JointVector& seed) const {
+    return planner_->solutions(tcp_in_world, seed);
+  }
   /// The joint configuration now (from the encoders).
   JointVector joints() const { return checkedRead().position; }
   /// The driver's reading, checked: finite and fresh.
   /// @throws std::runtime_error naming the problem (NaN joints, a state that stopped updating,
   /// or the driver's own error).
-  ArmState checkedRead() const;
+  ArmState checkedRead() const { return planner_->checkedRead(); }
   /// Stops any motion now: decelerates along its path within the acceleration limits. Needs
   /// no reading from the driver (it may be the thing that failed). The motion's operation
   /// then fails.
   void stop();
   /// A collision-free motion from the current configuration to the TCP pose.
-  MotionPlan planToPose(const world::Pose& tcp_in_world, double speed) const;
+  MotionPlan planToPose(const world::Pose& tcp_in_world, double speed) const {
+    return planner_->planToPose(joints(), tcp_in_world, speed);
+  }
   /// A collision-free motion from `from` (default: where the arm is) to `goal`.
   MotionPlan planToJoints(const JointVector& goal, double speed) const { return planToJoints(joints(), goal, speed); }
-  MotionPlan planToJoints(const JointVector& from, const JointVector& goal, double speed) const;
+  MotionPlan planToJoints(const JointVector& from, const JointVector& goal, double speed) const {
+    return planner_->planToJoints(from, goal, speed);
+  }
   /// A straight Cartesian line of the TCP from where it is (or from `from`) to `tcp_in_world`.
   MotionPlan planLine(const world::Pose& tcp_in_world, double speed) const {
     return planLine(joints(), tcp_in_world, speed);
   }
-  MotionPlan planLine(const JointVector& from, const world::Pose& tcp_in_world, double speed) const;
+  MotionPlan planLine(const JointVector& from, const world::Pose& tcp_in_world, double speed) const {
+    return planner_->planLine(from, tcp_in_world, speed);
+  }
   /// TCP pose in the world at a joint configuration.
-  world::Pose toolAt(const JointVector& q) const;
+  world::Pose toolAt(const JointVector& q) const { return planner_->toolAt(q); }
 
-  /// Runs a plan. Fails at once (nothing moves) when the plan is empty or does not start
-  /// where the arm is.
+  /// Runs a plan. Fails at once (nothing moves) when the plan is empty.
   std::unique_ptr<component::RunningOperation> execute(MotionPlan plan, const std::string& what);
 
   const ArmConfig& config() const { return config_; }
@@ -136,21 +108,27 @@ class ArmComponent final : public component::LocalComponent {
   const JointLimits& limits() const { return kinematics_->limits(); }
 
  private:
-  std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
-                                                     const component::ParamMap& params) override;
+  /// Declares the operations, each with its handler.
+  void declareOperations();
+  double speedOf(const component::ParamMap& params) const;
   std::optional<world::Pose> waypointPose(const Waypoint& waypoint) const;
-  world::Pose flangeInBase(const world::Pose& tcp_in_world) const;
-  MotionPlan timed(std::vector<JointVector> path, double speed) const;
-  Eigen::VectorXd toEigen(const JointVector& q) const;
+  std::optional<world::Pose> frameInWorld(const std::string& frame) const;
+  // The operations' handlers.
+  std::unique_ptr<component::RunningOperation> move(const component::ParamMap& params);
+  std::unique_ptr<component::RunningOperation> straightLine(const std::string& operation,
+                                                            const component::ParamMap& params);
+  std::unique_ptr<component::RunningOperation> jogJoint(const component::ParamMap& params);
+  std::unique_ptr<component::RunningOperation> teach(const component::ParamMap& params);
+  std::unique_ptr<component::RunningOperation> renameOrDelete(bool rename, const component::ParamMap& params);
+  std::unique_ptr<component::RunningOperation> followJointPath(const component::ParamMap& params);
 
-  component::ComponentDescription description_;
   ArmDriver& driver_;
   const Clock& clock_;
-  planning::CollisionWorld& collisions_;
   WaypointStore& waypoints_;
   FrameLookup frames_;
   std::shared_ptr<const Kinematics> kinematics_;
   ArmConfig config_;
+  std::optional<MotionPlanner> planner_;  // set once the configuration is checked
   std::shared_ptr<ArmMotion> motion_ = std::make_shared<ArmMotion>();
 };
 

@@ -54,9 +54,11 @@ struct Cell {
         collisions(robot, description.robot_base, {.padding = 0.005}, {robot_description.home.eigen()}),
         driver(robot_description.home),
         grasps(dataRoot() / "data/grasps.json", {}),
-        arm(driver, clock, collisions, waypoints, nullptr, arm::makeKinematics(robot_description), config()),
-        smartmove(arm, gripper, world, collisions, world::loadObjectClasses(dataRoot() / "data/objects"), grasps,
-                  smartmoveConfig()) {
+        kinematics(arm::makeKinematics(robot_description)),
+        arm(driver, clock, collisions, waypoints, nullptr, kinematics, config()),
+        motion(driver, clock, collisions, kinematics, config()),
+        smartmove(motion, arm, gripper, world, collisions, world::loadObjectClasses(dataRoot() / "data/objects"),
+                  grasps, smartmoveConfig()) {
     collisions.setBox("table", world::Pose(Eigen::Translation3d(description.table_centre)), description.table_size);
     collisions.allow(robot_description.base_link, "table");
     // 20 nodes at random on the table, any yaw, 6 cm apart at least.
@@ -105,7 +107,9 @@ struct Cell {
   arm::WaypointStore waypoints;
   smartmove::GraspLibrary grasps;
   NoGripper gripper;
+  std::shared_ptr<const arm::Kinematics> kinematics;
   arm::ArmComponent arm;
+  arm::MotionPlanner motion;
   smartmove::SmartMoveComponent smartmove;
 };
 

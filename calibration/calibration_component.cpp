@@ -345,10 +345,11 @@ CalibrationComponent::CalibrationComponent(arm::ArmComponent& arm, planning::Col
       drawn_camera_pose_(drawn_camera_pose),
       config_(std::move(config)),
       calibration_(std::move(initial)) {
-  description_.name = config_.name;
-  description_.type = "HandEyeCalibration";
-  description_.inputs = {"rgbd_frames", "joint_states"};
-  description_.outputs = {"camera_pose"};
+  component::ComponentDescription description;
+  description.name = config_.name;
+  description.type = "HandEyeCalibration";
+  description.inputs = {"rgbd_frames", "joint_states"};
+  description.outputs = {"camera_pose"};
   ParamSpec speed{"speed", ValueType::kDouble, "fraction of the arm's top speed", config_.speed};
   speed.min = 0.05;
   speed.max = 1.0;
@@ -372,17 +373,22 @@ CalibrationComponent::CalibrationComponent(arm::ArmComponent& arm, planning::Col
                    "refine the hand-eye solution on the marker corners' reprojection error (off: the method's own "
                    "solution, for comparison)",
                    true};
-  description_.operations = {
+  component::OperationTable operations;
+  operations.add(
       {"Calibrate",
        "Finds where the camera is: the arm shows the marker on the gripper to the camera from a few poses it chooses; "
        "perception uses the new camera pose at once. Needs the marker calibration (CalibrateMarker, once).",
        {camera_views, speed}},
+      [this](const component::ParamMap& params) { return beginCalibration(false, params); });
+  operations.add(
       {"CalibrateMarker",
        "Once, after fixing the marker to the gripper: finds where it is on the flange by hand-eye calibration (the arm "
        "shows it to the camera from many poses), and the camera with it.",
-       {marker_views, method, refine, speed}}};
-  description_.symbols = {{"camera", world::SymbolKind::kFrame, "the RGB-D camera's optical frame, as calibrated"}};
-  description_.predicates = {{"camera_calibrated", 0, "the camera's pose comes from a calibration"}};
+       {marker_views, method, refine, speed}},
+      [this](const component::ParamMap& params) { return beginCalibration(true, params); });
+  description.symbols = {{"camera", world::SymbolKind::kFrame, "the RGB-D camera's optical frame, as calibrated"}};
+  description.predicates = {{"camera_calibrated", 0, "the camera's pose comes from a calibration"}};
+  declare(std::move(description), std::move(operations));
 }
 
 world::Pose CalibrationComponent::cameraPose() const {
@@ -422,15 +428,12 @@ std::string CalibrationComponent::accept(const CellCalibration& next) {
   return {};
 }
 
-std::unique_ptr<component::RunningOperation> CalibrationComponent::begin(const std::string& operation,
-                                                                         const component::ParamMap& params) {
+std::unique_ptr<component::RunningOperation> CalibrationComponent::beginCalibration(bool marker_stage,
+                                                                                    const component::ParamMap& params) {
   const auto failed = [](std::string reason) {
     return std::make_unique<component::FinishedOperation>(OperationResult::failure(std::move(reason)));
   };
-  if (operation != "Calibrate" && operation != "CalibrateMarker") {
-    return failed(operation + ": not an operation of the calibration component");
-  }
-  const bool marker_stage = operation == "CalibrateMarker";
+  const std::string operation = marker_stage ? "CalibrateMarker" : "Calibrate";
   const auto number = [&params](const char* name, double fallback) {
     const auto it = params.find(name);
     return it == params.end() ? fallback : it->second.asDouble();

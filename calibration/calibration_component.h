@@ -33,7 +33,7 @@
 #include "calibration/calibration_file.h"
 #include "calibration/hand_eye.h"
 #include "camera/rgbd.h"
-#include "component/component.h"
+#include "component/operation_table.h"
 #include "core/clock.h"
 #include "planning/collision_world.h"
 
@@ -87,7 +87,7 @@ struct CalibrationConfig {
 /// The name of the keep-out obstacle in the collision world while a calibration runs.
 inline constexpr const char* kKeepOutObstacle = "calibration_keep_out";
 
-class CalibrationComponent final : public component::LocalComponent {
+class CalibrationComponent final : public component::TableComponent {
  public:
   /// `initial` is the calibration the cell starts with (saved earlier); without a camera pose
   /// in it, `drawn_camera_pose` (where the cell's drawings put the camera) is used.
@@ -98,7 +98,6 @@ class CalibrationComponent final : public component::LocalComponent {
                        const Clock& clock, const world::Pose& drawn_camera_pose, CellCalibration initial,
                        CalibrationConfig config);
 
-  const component::ComponentDescription& description() const override { return description_; }
   world::Report report() const override;
 
   /// The camera's optical frame in the world that perception uses now. Thread-safe.
@@ -109,12 +108,11 @@ class CalibrationComponent final : public component::LocalComponent {
 
  private:
   friend class CalibrationRun;
-  std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
-                                                     const component::ParamMap& params) override;
+  /// Starts Calibrate, or CalibrateMarker with `marker_stage` (the operations' handlers).
+  std::unique_ptr<component::RunningOperation> beginCalibration(bool marker_stage, const component::ParamMap& params);
   /// Saves and applies an accepted calibration; returns a problem saving it, or "".
   std::string accept(const CellCalibration& next);
 
-  component::ComponentDescription description_;
   arm::ArmComponent& arm_;
   planning::CollisionWorld& collisions_;
   camera::RgbdCamera& camera_;

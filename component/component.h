@@ -24,6 +24,9 @@ namespace costar::component {
 enum class OperationKind {
   kRobotAction,  // acts on the world: green
   kKnowledge,    // updates or queries knowledge (DetectObjects, ...): purple
+  /// For other components only (SmartMove moves the arm along a path it planned): no node type,
+  /// not offered to plans or in the editor.
+  kInternal,
 };
 
 struct OperationSpec {

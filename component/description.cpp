@@ -26,7 +26,17 @@ world::SymbolKind symbolKindNamed(const std::string& name) {
   throw std::invalid_argument("unknown symbol kind '" + name + "'");
 }
 
-const char* kindName(OperationKind kind) { return kind == OperationKind::kKnowledge ? "knowledge" : "robot_action"; }
+const char* kindName(OperationKind kind) {
+  switch (kind) {
+    case OperationKind::kKnowledge:
+      return "knowledge";
+    case OperationKind::kInternal:
+      return "internal";
+    case OperationKind::kRobotAction:
+      break;
+  }
+  return "robot_action";
+}
 
 /// json[key] as T, with the key named when it is missing or has the wrong type.
 template <typename T>
@@ -111,10 +121,12 @@ ComponentDescription descriptionFromJson(const nlohmann::json& json) {
       operation.name = field<std::string>(item, "name");
       operation.description = optionalField<std::string>(item, "description", "");
       const std::string kind = optionalField<std::string>(item, "kind", "robot_action");
-      if (kind != "robot_action" && kind != "knowledge") {
+      if (kind != "robot_action" && kind != "knowledge" && kind != "internal") {
         throw std::invalid_argument("operation '" + operation.name + "': unknown kind '" + kind + "'");
       }
-      operation.kind = kind == "knowledge" ? OperationKind::kKnowledge : OperationKind::kRobotAction;
+      operation.kind = kind == "knowledge"  ? OperationKind::kKnowledge
+                       : kind == "internal" ? OperationKind::kInternal
+                                            : OperationKind::kRobotAction;
       for (const auto& param : optionalField<nlohmann::json>(item, "params", nlohmann::json::array())) {
         operation.params.push_back(paramSpecFromJson(param));
       }

@@ -116,6 +116,9 @@ void ComponentRegistry::registerNodes(bt::NodeRegistry& nodes) {
   for (const auto& component : components_) {
     Component* target = component.get();
     for (const OperationSpec& operation : component->description().operations) {
+      if (operation.kind == OperationKind::kInternal) {
+        continue;  // for other components, not for plans
+      }
       bt::NodeSpec spec;
       spec.id = operation.name;
       spec.kind = bt::NodeKind::kAction;

@@ -183,11 +183,12 @@ std::string capitalised(std::string_view text) {
 AdaptiveGripper::AdaptiveGripper(AdaptiveGripperDriver& driver, const Clock& clock,
                                  AdaptiveGripperDescription description, AdaptiveGripperOptions options)
     : driver_(driver), clock_(clock), gripper_(std::move(description)), options_(std::move(options)) {
-  description_.name = options_.name;
-  description_.type = "AdaptiveGripper3F";
-  description_.implements = {"Gripper"};
-  description_.inputs = {"finger_state"};
-  description_.outputs = {"finger_command", "mode_command"};
+  component::ComponentDescription declared;
+  declared.name = options_.name;
+  declared.type = "AdaptiveGripper3F";
+  declared.implements = {"Gripper"};
+  declared.inputs = {"finger_state"};
+  declared.outputs = {"finger_command", "mode_command"};
   ParamSpec speed{"speed", ValueType::kDouble, "finger speed (full strokes per second)", options_.speed};
   speed.min = 0.1;
   speed.max = 1.0;
@@ -198,45 +199,49 @@ AdaptiveGripper::AdaptiveGripper(AdaptiveGripperDriver& driver, const Clock& clo
   for (const GripperMode m : kGripperModes) {
     mode.choices.emplace_back(toString(m));
   }
-  description_.operations = {
-      {"Open", "Opens every finger fully.", {speed}},
+  // One table: each operation declared with its handler.
+  component::OperationTable operations;
+  operations.add({"Open", "Opens every finger fully.", {speed}},
+                 [this](const component::ParamMap& params) -> std::unique_ptr<component::RunningOperation> {
+                   return std::make_unique<FingerMotion>(*this, driver_, clock_, std::array<double, kFingerCount>{},
+                                                         params.at("speed").asDouble(), options_.force,
+                                                         options_.timeout, false);
+                 });
+  operations.add(
       {"Close", "Closes the fingers of the current mode until each stops on the part or closes fully.", {speed, force}},
-      {"SetMode", "Turns fingers 1 and 2 to a mode (the fingers must be open).", {mode}}};
-  handlers_["Open"] = [this](const component::ParamMap& params) -> std::unique_ptr<component::RunningOperation> {
-    return std::make_unique<FingerMotion>(*this, driver_, clock_, std::array<double, kFingerCount>{},
-                                          params.at("speed").asDouble(), options_.force, options_.timeout, false);
-  };
-  handlers_["Close"] = [this](const component::ParamMap& params) -> std::unique_ptr<component::RunningOperation> {
-    const AdaptiveGripperReading reading = checkedRead();
-    const auto& closing = gripper_.mode(reading.mode).closing;
-    std::array<double, kFingerCount> targets{};
-    for (std::size_t i = 0; i < targets.size(); ++i) {
-      targets[i] = closing[i] ? 1.0 : 0.0;
-    }
-    return std::make_unique<FingerMotion>(*this, driver_, clock_, targets, params.at("speed").asDouble(),
-                                          params.at("force").asDouble(), options_.timeout, true);
-  };
-  handlers_["SetMode"] = [this](const component::ParamMap& params) {
-    const auto chosen = modeFromString(params.at("mode").asString());
-    if (!chosen) {  // the choices make this unreachable through the registry; a direct caller may
-      throw std::invalid_argument("SetMode: unknown mode '" + params.at("mode").asString() +
-                                  "' (basic, pinch, wide or scissor)");
-    }
-    return setMode(*chosen);
-  };
+      [this](const component::ParamMap& params) -> std::unique_ptr<component::RunningOperation> {
+        const AdaptiveGripperReading reading = checkedRead();
+        const auto& closing = gripper_.mode(reading.mode).closing;
+        std::array<double, kFingerCount> targets{};
+        for (std::size_t i = 0; i < targets.size(); ++i) {
+          targets[i] = closing[i] ? 1.0 : 0.0;
+        }
+        return std::make_unique<FingerMotion>(*this, driver_, clock_, targets, params.at("speed").asDouble(),
+                                              params.at("force").asDouble(), options_.timeout, true);
+      });
+  operations.add({"SetMode", "Turns fingers 1 and 2 to a mode (the fingers must be open).", {mode}},
+                 [this](const component::ParamMap& params) {
+                   const auto chosen = modeFromString(params.at("mode").asString());
+                   if (!chosen) {  // the choices make this unreachable through the registry; a direct caller may
+                     throw std::invalid_argument("SetMode: unknown mode '" + params.at("mode").asString() +
+                                                 "' (basic, pinch, wide or scissor)");
+                   }
+                   return setMode(*chosen);
+                 });
   for (const GripperMode m : kGripperModes) {
     const std::string name = capitalised(toString(m)) + "Mode";
-    description_.operations.push_back({name,
-                                       "Selects " + capitalised(toString(m)) +
-                                           " mode: " + gripper_.mode(m).description + " (the fingers must be open).",
-                                       {}});
-    handlers_[name] = [this, m](const component::ParamMap&) { return setMode(m); };
+    operations.add({name,
+                    "Selects " + capitalised(toString(m)) + " mode: " + gripper_.mode(m).description +
+                        " (the fingers must be open).",
+                    {}},
+                   [this, m](const component::ParamMap&) { return setMode(m); });
   }
-  description_.predicates = {
+  declared.predicates = {
       {"gripper_open", 0, "every finger is fully open"},
       {"gripper_closed", 0, "the fingers of the current mode are fully closed, nothing between them"},
       {"gripper_holding", 0, "at least two fingers stopped on something and squeeze it"},
       {"gripper_mode", 1, "gripper_mode(m): the gripper is in mode m"}};
+  declare(std::move(declared), std::move(operations));
 }
 
 AdaptiveGripperReading AdaptiveGripper::checkedRead() const {
@@ -300,15 +305,6 @@ std::unique_ptr<component::RunningOperation> AdaptiveGripper::setMode(GripperMod
     }
   }
   return std::make_unique<ModeChange>(*this, driver_, clock_, mode, options_.timeout);
-}
-
-std::unique_ptr<component::RunningOperation> AdaptiveGripper::begin(const std::string& operation,
-                                                                    const component::ParamMap& params) {
-  const auto it = handlers_.find(operation);
-  if (it == handlers_.end()) {
-    throw std::invalid_argument(options_.name + ": no operation '" + operation + "'");
-  }
-  return it->second(params);
 }
 
 }  // namespace costar::gripper

@@ -17,7 +17,7 @@
 #include <map>
 #include <memory>
 
-#include "component/component.h"
+#include "component/operation_table.h"
 #include "core/clock.h"
 #include "gripper/adaptive_gripper_description.h"
 #include "gripper/adaptive_gripper_driver.h"
@@ -34,12 +34,11 @@ struct AdaptiveGripperOptions {
   Duration reading_timeout = std::chrono::milliseconds(50);
 };
 
-class AdaptiveGripper final : public component::LocalComponent {
+class AdaptiveGripper final : public component::TableComponent {
  public:
   /// The driver and clock must outlive the component.
   AdaptiveGripper(AdaptiveGripperDriver& driver, const Clock& clock, AdaptiveGripperDescription description,
                   AdaptiveGripperOptions options = {});
-  const component::ComponentDescription& description() const override { return description_; }
   world::Report report() const override;
 
   /// Thresholds of the predicates (finger positions 0 open .. 1 closed): open below 0.03;
@@ -59,18 +58,12 @@ class AdaptiveGripper final : public component::LocalComponent {
   const AdaptiveGripperDescription& gripper() const { return gripper_; }
 
  private:
-  using Handler = std::function<std::unique_ptr<component::RunningOperation>(const component::ParamMap&)>;
-  std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
-                                                     const component::ParamMap& params) override;
   std::unique_ptr<component::RunningOperation> setMode(GripperMode mode);
 
-  component::ComponentDescription description_;
   AdaptiveGripperDriver& driver_;
   const Clock& clock_;
   AdaptiveGripperDescription gripper_;
   AdaptiveGripperOptions options_;
-  /// Each declared operation's handler: one table, so a declared operation cannot lack one.
-  std::map<std::string, Handler> handlers_;
 };
 
 }  // namespace costar::gripper

@@ -110,11 +110,12 @@ class FingerMotion final : public component::RunningOperation {
 
 ParallelGripper::ParallelGripper(GripperDriver& driver, const Clock& clock, ParallelGripperOptions options)
     : driver_(driver), clock_(clock), options_(std::move(options)) {
-  description_.name = options_.name;
-  description_.type = "ParallelGripper2F";
-  description_.implements = {"Gripper"};
-  description_.inputs = {"finger_state"};
-  description_.outputs = {"finger_command"};
+  component::ComponentDescription description;
+  description.name = options_.name;
+  description.type = "ParallelGripper2F";
+  description.implements = {"Gripper"};
+  description.inputs = {"finger_state"};
+  description.outputs = {"finger_command"};
   ParamSpec speed{"speed", ValueType::kDouble, "finger speed (m/s)", options_.speed};
   speed.min = 0.01;
   speed.max = 0.15;
@@ -127,18 +128,44 @@ ParallelGripper::ParallelGripper(GripperDriver& driver, const Clock& clock, Para
   opening.max = driver_.maxOpening();
   ParamSpec mode{"mode", ValueType::kString, "basic, pinch, wide or scissor (only pinch here)", std::string("pinch")};
   mode.choices = {"basic", "pinch", "wide", "scissor"};
-  description_.operations = {
-      {"Open", "Opens the fingers fully, or as far as `opening`.", {speed, opening}},
-      {"Close", "Closes the fingers until they stop on a part or close fully.", {speed, force}},
-      {"BasicMode", "Selects Basic mode (3-finger grippers only).", {}},
-      {"PinchMode", "Selects Pinch mode, the only mode of a parallel gripper.", {}},
-      {"WideMode", "Selects Wide mode (3-finger grippers only).", {}},
-      {"ScissorMode", "Selects Scissor mode (3-finger grippers only).", {}},
-      {"SetMode", "Selects a mode by name: pinch, the only mode of a parallel gripper.", {mode}}};
-  description_.predicates = {{"gripper_open", 0, "the fingers are fully open"},
-                             {"gripper_closed", 0, "the fingers are fully closed, nothing between them"},
-                             {"gripper_holding", 0, "the fingers stopped on something and squeeze it"},
-                             {"gripper_mode", 1, "gripper_mode(m): the gripper is in mode m"}};
+  using Params = component::ParamMap;
+  // Modes: Pinch is the only one; the others fail with the reason.
+  const auto mode_change = [](const std::string& what, bool pinch) -> std::unique_ptr<component::RunningOperation> {
+    return std::make_unique<component::FinishedOperation>(
+        pinch ? OperationResult::success()
+              : OperationResult::failure(
+                    what + ": mode not supported by this gripper (a parallel 2-finger gripper has only Pinch mode)"));
+  };
+  component::OperationTable operations;
+  operations.add({"Open", "Opens the fingers fully, or as far as `opening`.", {speed, opening}},
+                 [this](const Params& params) -> std::unique_ptr<component::RunningOperation> {
+                   return std::make_unique<FingerMotion>(*this, driver_, clock_, params.at("opening").asDouble(),
+                                                         params.at("speed").asDouble(), options_.force,
+                                                         options_.timeout, false);
+                 });
+  operations.add({"Close", "Closes the fingers until they stop on a part or close fully.", {speed, force}},
+                 [this](const Params& params) -> std::unique_ptr<component::RunningOperation> {
+                   return std::make_unique<FingerMotion>(*this, driver_, clock_, 0.0, params.at("speed").asDouble(),
+                                                         params.at("force").asDouble(), options_.timeout, true);
+                 });
+  operations.add({"BasicMode", "Selects Basic mode (3-finger grippers only).", {}},
+                 [mode_change](const Params&) { return mode_change("BasicMode", false); });
+  operations.add({"PinchMode", "Selects Pinch mode, the only mode of a parallel gripper.", {}},
+                 [mode_change](const Params&) { return mode_change("PinchMode", true); });
+  operations.add({"WideMode", "Selects Wide mode (3-finger grippers only).", {}},
+                 [mode_change](const Params&) { return mode_change("WideMode", false); });
+  operations.add({"ScissorMode", "Selects Scissor mode (3-finger grippers only).", {}},
+                 [mode_change](const Params&) { return mode_change("ScissorMode", false); });
+  operations.add({"SetMode", "Selects a mode by name: pinch, the only mode of a parallel gripper.", {mode}},
+                 [mode_change](const Params& params) {
+                   const std::string chosen = params.at("mode").asString();
+                   return mode_change("SetMode(" + chosen + ")", chosen == "pinch");
+                 });
+  description.predicates = {{"gripper_open", 0, "the fingers are fully open"},
+                            {"gripper_closed", 0, "the fingers are fully closed, nothing between them"},
+                            {"gripper_holding", 0, "the fingers stopped on something and squeeze it"},
+                            {"gripper_mode", 1, "gripper_mode(m): the gripper is in mode m"}};
+  declare(std::move(description), std::move(operations));
 }
 
 FingerReading ParallelGripper::checkedRead() const {
@@ -165,24 +192,6 @@ world::Report ParallelGripper::report() const {
   }
   report.predicates.push_back({"gripper_mode", {"pinch"}, true, ""});
   return report;
-}
-
-std::unique_ptr<component::RunningOperation> ParallelGripper::begin(const std::string& operation,
-                                                                    const component::ParamMap& params) {
-  if (operation == "Open") {
-    return std::make_unique<FingerMotion>(*this, driver_, clock_, params.at("opening").asDouble(),
-                                          params.at("speed").asDouble(), options_.force, options_.timeout, false);
-  }
-  if (operation == "Close") {
-    return std::make_unique<FingerMotion>(*this, driver_, clock_, 0.0, params.at("speed").asDouble(),
-                                          params.at("force").asDouble(), options_.timeout, true);
-  }
-  if (operation == "PinchMode" || (operation == "SetMode" && params.at("mode").asString() == "pinch")) {
-    return std::make_unique<component::FinishedOperation>(OperationResult::success());
-  }
-  const std::string what = operation == "SetMode" ? "SetMode(" + params.at("mode").asString() + ")" : operation;
-  return std::make_unique<component::FinishedOperation>(OperationResult::failure(
-      what + ": mode not supported by this gripper (a parallel 2-finger gripper has only Pinch mode)"));
 }
 
 }  // namespace costar::gripper

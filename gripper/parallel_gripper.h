@@ -9,7 +9,7 @@
 
 #include <memory>
 
-#include "component/component.h"
+#include "component/operation_table.h"
 #include "core/clock.h"
 #include "gripper/gripper_driver.h"
 
@@ -25,11 +25,10 @@ struct ParallelGripperOptions {
   Duration reading_timeout = std::chrono::milliseconds(50);
 };
 
-class ParallelGripper final : public component::LocalComponent {
+class ParallelGripper final : public component::TableComponent {
  public:
   /// The driver and clock must outlive the component.
   ParallelGripper(GripperDriver& driver, const Clock& clock, ParallelGripperOptions options = {});
-  const component::ComponentDescription& description() const override { return description_; }
   world::Report report() const override;
 
   /// Thresholds of the predicates: within 2 mm of fully open / closed; holding when the
@@ -46,9 +45,6 @@ class ParallelGripper final : public component::LocalComponent {
   FingerReading checkedRead() const;
 
  private:
-  std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
-                                                     const component::ParamMap& params) override;
-  component::ComponentDescription description_;
   GripperDriver& driver_;
   const Clock& clock_;
   ParallelGripperOptions options_;

@@ -36,6 +36,28 @@ bool touches(const fcl::CollisionObjectd& a, const fcl::CollisionObjectd& b) {
 
 }  // namespace
 
+AllowedContacts AllowedContacts::between(const std::vector<std::string>& robot_links,
+                                         const std::vector<std::string>& obstacles) {
+  AllowedContacts allowed;
+  for (const std::string& link : robot_links) {
+    for (const std::string& obstacle : obstacles) {
+      allowed.allow(link, obstacle);
+    }
+  }
+  return allowed;
+}
+
+void AllowedContacts::allow(const std::string& robot_link, const std::string& obstacle) {
+  if (!contains(robot_link, obstacle)) {
+    pairs_.emplace_back(robot_link, obstacle);
+  }
+}
+
+bool AllowedContacts::contains(std::string_view robot_link, std::string_view obstacle) const {
+  return std::any_of(pairs_.begin(), pairs_.end(),
+                     [&](const auto& pair) { return pair.first == robot_link && pair.second == obstacle; });
+}
+
 struct CollisionWorld::Impl {
   struct LinkObjects {
     std::vector<CollisionShape> shapes;
@@ -166,7 +188,7 @@ void CollisionWorld::disallow(const std::string& robot_link, const std::string& 
 
 void CollisionWorld::disallowAll() { impl_->allowed.clear(); }
 
-std::optional<Contact> CollisionWorld::check(const Eigen::VectorXd& q) const {
+std::optional<Contact> CollisionWorld::check(const Eigen::VectorXd& q, const AllowedContacts& allowed) const {
   ++checks_;
   if (workspace_ && !workspace_->contains((impl_->base * robot_.forward(q)).translation())) {
     return Contact{"tcp", "the workspace boundary"};
@@ -177,7 +199,7 @@ std::optional<Contact> CollisionWorld::check(const Eigen::VectorXd& q) const {
     for (const auto& [name, obstacle] : impl_->obstacles) {
       for (const auto& object : impl_->links[i].objects) {
         if (object->getAABB().overlap(obstacle->getAABB()) && !impl_->allowed.contains({links[i].link, name}) &&
-            touches(*object, *obstacle)) {
+            !allowed.contains(links[i].link, name) && touches(*object, *obstacle)) {
           return Contact{links[i].link, name};
         }
       }
@@ -191,12 +213,13 @@ std::optional<Contact> CollisionWorld::check(const Eigen::VectorXd& q) const {
   return std::nullopt;
 }
 
-std::optional<Contact> CollisionWorld::checkSegment(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const {
+std::optional<Contact> CollisionWorld::checkSegment(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                                                    const AllowedContacts& allowed) const {
   const double longest = (to - from).cwiseAbs().maxCoeff();
   const int steps = std::max(1, static_cast<int>(std::ceil(longest / options_.resolution)));
   for (int s = 0; s <= steps; ++s) {
     const Eigen::VectorXd q = from + (to - from) * (static_cast<double>(s) / steps);
-    if (auto contact = check(q)) {
+    if (auto contact = check(q, allowed)) {
       return contact;
     }
   }

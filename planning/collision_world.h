@@ -9,6 +9,8 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "planning/robot_model.h"
@@ -21,6 +23,23 @@ struct Contact {
   std::string robot_link;
   std::string other;  // an obstacle's name, or another robot link
   std::string str() const { return robot_link + " would touch " + other; }
+};
+
+/// Contacts one query allows, on top of the world's own (allow()): a gripper's links may touch
+/// the part it is grasping while that grasp is planned. Passed to each query, never stored in
+/// the world, so that a query cannot leave an allowance behind for the next one.
+class AllowedContacts {
+ public:
+  AllowedContacts() = default;
+  /// Every link of `robot_links` may touch every obstacle of `obstacles`.
+  static AllowedContacts between(const std::vector<std::string>& robot_links,
+                                 const std::vector<std::string>& obstacles);
+  void allow(const std::string& robot_link, const std::string& obstacle);
+  bool contains(std::string_view robot_link, std::string_view obstacle) const;
+  bool empty() const { return pairs_.empty(); }
+
+ private:
+  std::vector<std::pair<std::string, std::string>> pairs_;
 };
 
 struct CollisionOptions {
@@ -60,15 +79,18 @@ class CollisionWorld {
   /// @throws std::invalid_argument for a link without shapes.
   const std::vector<CollisionShape>& linkShapes(const std::string& link) const;
 
-  /// Lets `robot_link` touch `obstacle` (e.g. the fingers and the part being grasped).
+  /// Lets `robot_link` touch `obstacle` in every query, e.g. the robot's base and the table it
+  /// stands on (what one query allows: AllowedContacts).
   void allow(const std::string& robot_link, const std::string& obstacle);
   void disallow(const std::string& robot_link, const std::string& obstacle);
   void disallowAll();
 
-  /// The first contact of the robot at `q`, or nullopt when it is free.
-  std::optional<Contact> check(const Eigen::VectorXd& q) const;
+  /// The first contact of the robot at `q` that neither the world nor `allowed` allows, or
+  /// nullopt when it is free.
+  std::optional<Contact> check(const Eigen::VectorXd& q, const AllowedContacts& allowed = {}) const;
   /// Checks the straight joint-space segment from `from` to `to` at `options.resolution`.
-  std::optional<Contact> checkSegment(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
+  std::optional<Contact> checkSegment(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                                      const AllowedContacts& allowed = {}) const;
 
   const RobotModel& robot() const { return robot_; }
   const CollisionOptions& options() const { return options_; }

@@ -36,11 +36,12 @@ Predicator::Predicator(world::WorldState& world, std::vector<world::ObjectClass>
     std::string name = object.name;
     classes_.emplace(std::move(name), std::move(object));
   }
-  description_.name = config_.name;
-  description_.type = "Predicator";
-  description_.inputs = {"symbols"};
+  component::ComponentDescription description;
+  description.name = config_.name;
+  description.type = "Predicator";
+  description.inputs = {"symbols"};
   for (const Relation relation : allRelations()) {
-    description_.predicates.push_back(
+    description.predicates.push_back(
         {toString(relation), 2, std::string(toString(relation)) + "(a, b): see docs/PREDICATES.md"});
     world_.setEvaluator(toString(relation),
                         [this, relation](const world::WorldState&, std::span<const std::string> args) {
@@ -54,10 +55,13 @@ Predicator::Predicator(world::WorldState& world, std::vector<world::ObjectClass>
                         });
   }
   ParamSpec sub_component{"sub_component", ValueType::kString, "which predicates", {}, {"geometry", "contact"}};
-  description_.operations = {{"ActivatePredicates",
-                              "Switches a group of the predicator's predicates on or off.",
-                              {sub_component, {"active", ValueType::kBool, "on or off", true}},
-                              component::OperationKind::kKnowledge}};
+  component::OperationTable operations;
+  operations.add({"ActivatePredicates",
+                  "Switches a group of the predicator's predicates on or off.",
+                  {sub_component, {"active", ValueType::kBool, "on or off", true}},
+                  component::OperationKind::kKnowledge},
+                 [this](const component::ParamMap& params) { return activatePredicates(params); });
+  declare(std::move(description), std::move(operations));
 }
 
 Eigen::Matrix3d Predicator::viewpointAxes() const {
@@ -267,21 +271,17 @@ std::vector<std::string> Predicator::match(const std::vector<Pattern>& patterns,
   return result;
 }
 
-std::unique_ptr<component::RunningOperation> Predicator::begin(const std::string& operation,
-                                                               const component::ParamMap& params) {
-  if (operation == "ActivatePredicates") {
-    const std::string sub_component = params.at("sub_component").asString();
-    if (params.at("active").asBool()) {
-      inactive_.erase(sub_component);
-    } else {
-      inactive_.insert(sub_component);
-    }
-    reference_poses_.clear();  // recompute everything at the next report
-    objects_.clear();
-    facts_.clear();
-    return std::make_unique<component::FinishedOperation>(OperationResult::success());
+std::unique_ptr<component::RunningOperation> Predicator::activatePredicates(const component::ParamMap& params) {
+  const std::string sub_component = params.at("sub_component").asString();
+  if (params.at("active").asBool()) {
+    inactive_.erase(sub_component);
+  } else {
+    inactive_.insert(sub_component);
   }
-  return std::make_unique<component::FinishedOperation>(OperationResult::failure("unknown operation " + operation));
+  reference_poses_.clear();  // recompute everything at the next report
+  objects_.clear();
+  facts_.clear();
+  return std::make_unique<component::FinishedOperation>(OperationResult::success());
 }
 
 }  // namespace costar::predicator

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "component/component.h"
+#include "component/operation_table.h"
 #include "predicator/geometry.h"
 #include "predicator/pattern.h"
 #include "world/object_class.h"
@@ -38,12 +38,11 @@ struct PredicatorConfig {
 
 enum class MatchMode { kAll, kAny };
 
-class Predicator final : public component::LocalComponent {
+class Predicator final : public component::TableComponent {
  public:
   /// Registers the geometric predicates' evaluators in `world`, which must outlive this.
   Predicator(world::WorldState& world, std::vector<world::ObjectClass> classes, PredicatorConfig config = {});
 
-  const component::ComponentDescription& description() const override { return description_; }
   world::Report report() const override;
 
   /// Whether predicate(args) holds now (reported by any component, or evaluated).
@@ -62,13 +61,11 @@ class Predicator final : public component::LocalComponent {
     world::Pose pose;
     Placed placed;
   };
-  std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
-                                                     const component::ParamMap& params) override;
+  std::unique_ptr<component::RunningOperation> activatePredicates(const component::ParamMap& params);
   std::optional<Placed> place(const std::string& symbol) const;
   Eigen::Matrix3d viewpointAxes() const;
   void refresh() const;
 
-  component::ComponentDescription description_;
   world::WorldState& world_;
   std::map<std::string, world::ObjectClass> classes_;
   PredicatorConfig config_;

@@ -173,18 +173,21 @@ class SmartMoveComponent::PlannedFingers {
 
 std::string partObstacle(const std::string& object) { return "part:" + object; }
 
-SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Component& gripper, world::WorldState& world,
+SmartMoveComponent::SmartMoveComponent(const arm::MotionService& motion, component::Component& arm,
+                                       component::Component& gripper, world::WorldState& world,
                                        planning::CollisionWorld& collisions, std::vector<world::ObjectClass> classes,
                                        GraspLibrary& grasps, SmartMoveConfig config)
-    : arm_(arm),
+    : motion_(motion),
+      arm_(arm),
       gripper_(gripper),
       world_(world),
       collisions_(collisions),
       classes_(std::move(classes)),
       grasps_(grasps),
       config_(std::move(config)) {
-  description_.name = config_.name;
-  description_.type = "SmartMove";
+  component::ComponentDescription description;
+  description.name = config_.name;
+  description.type = "SmartMove";
   std::vector<std::string> class_names;
   for (const auto& object : classes_) {
     class_names.push_back(object.name);
@@ -252,31 +255,39 @@ SmartMoveComponent::SmartMoveComponent(arm::ArmComponent& arm, component::Compon
     }
     return {};
   };
-  description_.operations = {{"SmartMove",
-                              "Moves the tool to the best reachable part that satisfies the conditions.",
-                              {object_class, predicates, grasp, speed},
-                              component::OperationKind::kRobotAction,
-                              check_grasp},
-                             {"SmartGrasp",
-                              "Picks up the best reachable part that satisfies the conditions.",
-                              {object_class, predicates, grasp, approach, speed},
-                              component::OperationKind::kRobotAction,
-                              check_grasp},
-                             {"SmartRelease",
-                              "Puts the part held on a part that satisfies the conditions, or at a frame.",
-                              {target_class, predicates, target, approach, speed},
-                              component::OperationKind::kRobotAction,
-                              check_release},
-                             {"SmartPush",
-                              "Pushes the most crowded part that satisfies the conditions where it gets more room, "
-                              "with the closed gripper (when none can be grasped; look again after it).",
-                              {object_class, predicates, push_distance, speed},
-                              component::OperationKind::kRobotAction},
-                             {"TeachGrasp",
-                              "Saves how the gripper holds the nearest part of a class as a named grasp.",
-                              {object_class, {"grasp", ValueType::kString, "name of the new grasp", {}}},
-                              component::OperationKind::kKnowledge}};
-  description_.predicates = {{"holding", 1, "holding(o): the gripper holds part o"}};
+  using Params = component::ParamMap;
+  component::OperationTable operations;
+  operations.add({"SmartMove",
+                  "Moves the tool to the best reachable part that satisfies the conditions.",
+                  {object_class, predicates, grasp, speed},
+                  component::OperationKind::kRobotAction,
+                  check_grasp},
+                 [this](const Params& params) { return beginMoveOrGrasp(false, params); });
+  operations.add({"SmartGrasp",
+                  "Picks up the best reachable part that satisfies the conditions.",
+                  {object_class, predicates, grasp, approach, speed},
+                  component::OperationKind::kRobotAction,
+                  check_grasp},
+                 [this](const Params& params) { return beginMoveOrGrasp(true, params); });
+  operations.add({"SmartRelease",
+                  "Puts the part held on a part that satisfies the conditions, or at a frame.",
+                  {target_class, predicates, target, approach, speed},
+                  component::OperationKind::kRobotAction,
+                  check_release},
+                 [this](const Params& params) { return beginRelease(params); });
+  operations.add({"SmartPush",
+                  "Pushes the most crowded part that satisfies the conditions where it gets more room, "
+                  "with the closed gripper (when none can be grasped; look again after it).",
+                  {object_class, predicates, push_distance, speed},
+                  component::OperationKind::kRobotAction},
+                 [this](const Params& params) { return beginPushOperation(params); });
+  operations.add({"TeachGrasp",
+                  "Saves how the gripper holds the nearest part of a class as a named grasp.",
+                  {object_class, {"grasp", ValueType::kString, "name of the new grasp", {}}},
+                  component::OperationKind::kKnowledge},
+                 [this](const Params& params) { return beginTeachGrasp(params); });
+  description.predicates = {{"holding", 1, "holding(o): the gripper holds part o"}};
+  declare(std::move(description), std::move(operations));
 }
 
 const world::ObjectClass* SmartMoveComponent::objectClass(const std::string& name) const {
@@ -319,14 +330,12 @@ void SmartMoveComponent::syncObstacles() {
   obstacles_ = std::move(present);
 }
 
-void SmartMoveComponent::allowGripperContact(const std::string& object, bool allowed) {
-  for (const auto& link : config_.gripper_links) {
-    if (allowed) {
-      collisions_.allow(link, partObstacle(object));
-    } else {
-      collisions_.disallow(link, partObstacle(object));
-    }
+arm::AllowedContacts SmartMoveComponent::touching(const std::vector<std::string>& objects) const {
+  std::vector<std::string> obstacles;
+  for (const std::string& object : objects) {
+    obstacles.push_back(partObstacle(object));
   }
+  return arm::AllowedContacts::between(config_.gripper_links, obstacles);
 }
 
 std::vector<planning::CollisionShape> SmartMoveComponent::fingerShapes(double opening) const {
@@ -410,26 +419,11 @@ SmartMoveComponent::Matches SmartMoveComponent::matching(const std::string& obje
 }
 
 ArmModel SmartMoveComponent::armModel() const {
-  const arm::JointVector now = arm_.joints();
-  return {[this, now](const world::Pose& goal) { return arm_.solutions(goal, now); }, arm_.endpoint(), now};
+  const arm::JointVector now = motion_.joints();
+  return {[this, now](const world::Pose& goal) { return motion_.solutions(goal, now); }, motion_.endpoint(), now};
 }
 
 namespace {
-
-/// The first collision-free configuration among IK solutions, or why there is none.
-std::optional<arm::JointVector> freeConfiguration(const std::vector<arm::JointVector>& solutions,
-                                                  const planning::CollisionWorld& collisions, std::string& reason) {
-  for (const auto& q : solutions) {
-    const auto contact = collisions.check(q.eigen());
-    if (!contact) {
-      return q;
-    }
-    if (reason.empty()) {
-      reason = contact->str();
-    }
-  }
-  return std::nullopt;
-}
 
 void addRejected(Selection& selection, const SmartMoveComponent::Matches& matches) {
   for (const auto& [object, reason] : matches.rejected) {
@@ -459,7 +453,7 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
   }
   syncObstacles();
   const Matches matches = matching(object_class, patterns);
-  const arm::JointVector now = arm_.joints();
+  const arm::JointVector now = motion_.joints();
   const PlannedFingers fingers(*this);
   const FeasibilityCheck feasible = [&](Candidate& candidate) -> std::string {
     const auto object_pose = world_.worldPose(candidate.object);
@@ -470,36 +464,32 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
     if (with_approach) {
       fingers.at(*opening);  // SmartGrasp opens them this far first; SmartMove leaves them
     }
-    allowGripperContact(candidate.object, true);
-    struct Restore {
-      SmartMoveComponent& self;
-      std::string object;
-      ~Restore() { self.allowGripperContact(object, false); }
-    } restore{*this, candidate.object};
+    // The fingers may touch the part they are to grasp, in these queries only.
+    const arm::AllowedContacts allowed = touching({candidate.object});
     std::string reason;
-    const auto goal = freeConfiguration(candidate.solutions, collisions_, reason);
+    const auto goal = motion_.firstFree(candidate.solutions, allowed, reason);
     if (!goal) {
       return "collision at the goal: " + reason;
     }
     if (!with_approach) {
-      const arm::MotionPlan path = arm_.planToJoints(now, *goal, speed);
+      const arm::MotionPlan path = motion_.planToJoints(now, *goal, speed, allowed);
       return path.ok() ? std::string() : "no path: " + path.failure;
     }
     const world::Pose pregrasp = candidate.goal * world::Pose(Eigen::Translation3d(0, 0, -approach));
-    const auto pre = freeConfiguration(arm_.solutions(pregrasp, *goal), collisions_, reason);
+    const auto pre = motion_.firstFree(motion_.solutions(pregrasp, *goal), allowed, reason);
     if (!pre) {
       return "no reachable, collision-free pre-grasp: " + (reason.empty() ? "no IK solution" : reason);
     }
-    const arm::MotionPlan line = arm_.planLine(*pre, candidate.goal, config_.approach_speed);
+    const arm::MotionPlan line = motion_.planLine(*pre, candidate.goal, config_.approach_speed, allowed);
     if (!line.ok()) {
       return "no straight approach: " + line.failure;
     }
     const arm::MotionPlan retreat =
-        arm_.planLine(line.goal, up(config_.retreat) * candidate.goal, config_.approach_speed);
+        motion_.planLine(line.goal, up(config_.retreat) * candidate.goal, config_.approach_speed, allowed);
     if (!retreat.ok()) {
       return "no straight retreat: " + retreat.failure;
     }
-    const arm::MotionPlan path = arm_.planToJoints(now, *pre, speed);
+    const arm::MotionPlan path = motion_.planToJoints(now, *pre, speed, allowed);
     return path.ok() ? std::string() : "no path to the pre-grasp: " + path.failure;
   };
   Selection selection = selectGoal(matches.objects, *object, grasp, armModel(), config_.weights, feasible);
@@ -605,355 +595,365 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::moveToFreeConfiguration(co
                                                                               double speed, const std::string& what,
                                                                               const std::string& none) {
   std::string reason;
-  const auto configuration = freeConfiguration(arm_.solutions(pose, seed), collisions_, reason);
-  return arm_.execute(
-      configuration ? arm_.planToJoints(*configuration, speed) : arm::MotionPlan{nullptr, {}, none + ": " + reason},
-      what);
+  const auto configuration = motion_.firstFree(motion_.solutions(pose, seed), {}, reason);
+  return follow(configuration ? motion_.planToJoints(motion_.joints(), *configuration, speed)
+                              : arm::MotionPlan::failed({}, none + ": " + reason),
+                what);
 }
 
-std::unique_ptr<RunningOperation> SmartMoveComponent::begin(const std::string& operation,
-                                                            const component::ParamMap& params) {
+std::unique_ptr<RunningOperation> SmartMoveComponent::follow(const arm::MotionPlan& plan, const std::string& what) {
+  if (!plan.ok()) {
+    return failed(what + ": " + plan.failure);
+  }
+  return std::make_unique<ComponentStep>(arm_, std::string(arm::kFollowJointPath), arm::followParams(plan, what));
+}
+
+std::unique_ptr<RunningOperation> SmartMoveComponent::beginPushOperation(const component::ParamMap& params) {
   const auto text = [&params](const char* name) { return params.at(name).asString(); };
   std::vector<predicator::Pattern> patterns;
-  double speed = config_.default_speed;
-  if (operation != "TeachGrasp") {
-    try {
-      patterns = parsePredicateList(text("predicates"));
-    } catch (const std::invalid_argument& e) {
-      return failed(std::string("predicates: ") + e.what());
-    }
-    speed = params.at("speed").asDouble();
+  try {
+    patterns = parsePredicateList(text("predicates"));
+  } catch (const std::invalid_argument& e) {
+    return failed(std::string("predicates: ") + e.what());
   }
+  const double speed = params.at("speed").asDouble();
+  return beginPush(text("object_class"), patterns, params.at("distance").asDouble(), speed);
+}
 
-  if (operation == "SmartPush") {
-    return beginPush(text("object_class"), patterns, params.at("distance").asDouble(), speed);
+std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool grasping,
+                                                                       const component::ParamMap& params) {
+  const auto text = [&params](const char* name) { return params.at(name).asString(); };
+  std::vector<predicator::Pattern> patterns;
+  try {
+    patterns = parsePredicateList(text("predicates"));
+  } catch (const std::invalid_argument& e) {
+    return failed(std::string("predicates: ") + e.what());
   }
-  if (operation == "SmartMove" || operation == "SmartGrasp") {
-    const bool grasping = operation == "SmartGrasp";
-    const std::string object_class = text("object_class");
-    const auto grasp =
-        text("grasp").empty() ? grasps_.defaultFor(object_class) : grasps_.find(object_class, text("grasp"));
-    if (!grasp && text("grasp").empty()) {
-      return failed("no grasp is taught for class '" + object_class + "'");
+  const double speed = params.at("speed").asDouble();
+  const std::string object_class = text("object_class");
+  const auto grasp =
+      text("grasp").empty() ? grasps_.defaultFor(object_class) : grasps_.find(object_class, text("grasp"));
+  if (!grasp && text("grasp").empty()) {
+    return failed("no grasp is taught for class '" + object_class + "'");
+  }
+  if (!grasp) {
+    return failed("no grasp '" + text("grasp") + "' is taught for class '" + object_class + "'");
+  }
+  if (grasping && held_ && world_.holds("gripper_holding", {})) {
+    return failed("the gripper already holds " + *held_ + ": release it first");
+  }
+  const double approach = grasping ? params.at("approach").asDouble() : 0.0;
+  Selection selection = selectGrasp(object_class, patterns, grasp->tcp_in_object, approach, speed);
+  nlohmann::json data = selection.toJson();
+  if (!selection.ok()) {
+    return failed("no feasible " + object_class + ": " + selection.failure, data);
+  }
+  const Candidate chosen = selection.best();
+  const world::Pose object_pose = *world_.worldPose(chosen.object);
+  const double opening = graspOpening(chosen.goal, object_pose, *objectClass(object_class)).value_or(0.0);
+  if (!grasping) {
+    return std::make_unique<Script>(
+        std::vector<Script::Step>{{"move to " + chosen.object,
+                                   [this, chosen, speed] {
+                                     std::string reason;
+                                     const arm::JointVector now = motion_.joints();
+                                     const auto goal =
+                                         motion_.firstFree(motion_.solutions(chosen.goal, now), {}, reason);
+                                     return follow(
+                                         goal ? motion_.planToJoints(now, *goal, speed)
+                                              : arm::MotionPlan::failed({}, "collision at the goal: " + reason),
+                                         "SmartMove");
+                                   },
+                                   nullptr}},
+        data, nullptr);
+  }
+  const world::Pose pregrasp = chosen.goal * world::Pose(Eigen::Translation3d(0, 0, -approach));
+  const std::string object = chosen.object;
+  std::vector<Script::Step> steps;
+  steps.push_back({"open the gripper",
+                   [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); },
+                   nullptr});
+  steps.push_back({"move above " + object,
+                   [this, pregrasp, chosen, speed] {
+                     return moveToFreeConfiguration(pregrasp, chosen.solutions.front(), speed, "pre-grasp",
+                                                    "no collision-free pre-grasp");
+                   },
+                   nullptr});
+  steps.push_back({"approach " + object,
+                   [this, chosen, object] {
+                     return follow(
+                         motion_.planLine(motion_.joints(), chosen.goal, config_.approach_speed, touching({object})),
+                         "approach");
+                   },
+                   nullptr});
+  steps.push_back(
+      {"close on " + object,
+       [this] {
+         return std::make_unique<ComponentStep>(gripper_, "Close",
+                                                component::ParamMap{{"speed", 0.1}, {"force", 40.0}});
+       },
+       [this, object, object_class, object_pose, chosen, opening](const OperationResult& result) -> std::string {
+         if (!result.data.value("holding", false)) {
+           return "the fingers closed on nothing: " + object + " was not where it was seen";
+         }
+         held_ = object;
+         held_class_ = object_class;
+         held_grasp_ = object_pose.inverse() * chosen.goal;
+         held_opening_ = opening;
+         collisions_.remove(partObstacle(object));
+         return {};
+       }});
+  steps.push_back({"lift " + object,
+                   [this, object] {
+                     const arm::JointVector now = motion_.joints();
+                     return follow(motion_.planLine(now, up(config_.retreat) * motion_.toolAt(now),
+                                                    config_.approach_speed, touching({object})),
+                                   "retreat");
+                   },
+                   [this](const OperationResult&) -> std::string {
+                     return world_.holds("gripper_holding", {}) || !held_ ? std::string() : "the part slipped out";
+                   }});
+  // A grasp that fails once the tool went down (it closed on nothing, or on the part's top
+  // because the part moved) opens and lifts straight up before it reports the failure, so
+  // that the tool is clear of where the part was seen and a plan that looks again can go on
+  // (from down there every motion would start in collision with the part as it was seen).
+  const std::size_t approach_step = 2;
+  const std::size_t close_step = 3;
+  auto script = std::make_unique<Script>(std::move(steps), data, nullptr);
+  script->backOff(
+      approach_step, close_step,
+      {{"open the gripper",
+        [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); }, nullptr},
+       {"lift clear",
+        [this, object] {
+          // Straight up from wherever the miss left the fingers, even beside a neighbour (a
+          // part moved or caught by the fingers): up is away from every part on the table.
+          std::vector<std::string> obstacles = obstacles_;
+          obstacles.push_back(partObstacle(object));
+          const arm::AllowedContacts allowed = arm::AllowedContacts::between(config_.gripper_links, obstacles);
+          const arm::JointVector now = motion_.joints();
+          return follow(
+              motion_.planLine(now, up(config_.retreat) * motion_.toolAt(now), config_.approach_speed, allowed),
+              "back off");
+        },
+        nullptr}},
+      "the tool backed off up");
+  return script;
+}
+
+std::unique_ptr<RunningOperation> SmartMoveComponent::beginRelease(const component::ParamMap& params) {
+  const auto text = [&params](const char* name) { return params.at(name).asString(); };
+  std::vector<predicator::Pattern> patterns;
+  try {
+    patterns = parsePredicateList(text("predicates"));
+  } catch (const std::invalid_argument& e) {
+    return failed(std::string("predicates: ") + e.what());
+  }
+  const double speed = params.at("speed").asDouble();
+  if (!held_) {
+    return failed("nothing to release: no part was grasped with SmartGrasp");
+  }
+  const world::ObjectClass* held_object = objectClass(held_class_);
+  const std::string target_class = text("target_class");
+  const std::string target = text("target");
+  if (target_class.empty() == target.empty()) {
+    return failed("give either target_class (put the part on such a part) or target (put it at a frame)");
+  }
+  syncObstacles();
+  // Candidate poses of the held part: on top of each matching part, every symmetric way.
+  std::vector<Candidate> candidates;
+  Matches matches;
+  const auto addPlacements = [&](const std::string& name, const world::Pose& support, double lift) {
+    for (std::size_t h = 0; h < held_object->symmetries.size(); ++h) {
+      world::Pose held_symmetry = world::Pose::Identity();
+      held_symmetry.linear() = held_object->symmetries[h];
+      Candidate candidate;
+      candidate.object = name;
+      candidate.symmetry = static_cast<int>(h);
+      candidate.goal = support * up(lift) * held_symmetry * held_grasp_;
+      candidates.push_back(std::move(candidate));
     }
-    if (!grasp) {
-      return failed("no grasp '" + text("grasp") + "' is taught for class '" + object_class + "'");
+  };
+  if (target == "table") {
+    // Free spots on the table that satisfy the predicates, clear of every known part.
+    const std::vector<std::pair<std::string, world::Pose>> others = [&] {
+      std::vector<std::pair<std::string, world::Pose>> parts;
+      for (const auto& object : classes_) {
+        for (const auto& entry : matching(object.name, {}, *held_).objects) {
+          parts.push_back(entry);
+        }
+      }
+      return parts;
+    }();
+    for (const auto& pattern : patterns) {
+      const std::string problem = spotFailsPattern(Eigen::Vector3d::Zero(), pattern);
+      if (problem.rfind("only ", 0) == 0 || problem.rfind("unknown frame", 0) == 0) {
+        return failed(problem);
+      }
     }
-    if (grasping && held_ && world_.holds("gripper_holding", {})) {
-      return failed("the gripper already holds " + *held_ + ": release it first");
-    }
-    const double approach = grasping ? params.at("approach").asDouble() : 0.0;
-    Selection selection = selectGrasp(object_class, patterns, grasp->tcp_in_object, approach, speed);
-    nlohmann::json data = selection.toJson();
-    if (!selection.ok()) {
-      return failed("no feasible " + object_class + ": " + selection.failure, data);
-    }
-    const Candidate chosen = selection.best();
-    const world::Pose object_pose = *world_.worldPose(chosen.object);
-    const double opening = graspOpening(chosen.goal, object_pose, *objectClass(object_class)).value_or(0.0);
-    if (!grasping) {
-      return std::make_unique<Script>(
-          std::vector<Script::Step>{
-              {"move to " + chosen.object,
-               [this, chosen, speed] {
-                 std::string reason;
-                 const auto goal = freeConfiguration(arm_.solutions(chosen.goal, arm_.joints()), collisions_, reason);
-                 return arm_.execute(goal ? arm_.planToJoints(*goal, speed)
-                                          : arm::MotionPlan{nullptr, {}, "collision at the goal: " + reason},
-                                     "SmartMove");
-               },
-               nullptr}},
-          data, nullptr);
-    }
-    const world::Pose pregrasp = chosen.goal * world::Pose(Eigen::Translation3d(0, 0, -approach));
-    const std::string object = chosen.object;
-    std::vector<Script::Step> steps;
-    steps.push_back({"open the gripper",
-                     [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); },
-                     nullptr});
-    steps.push_back({"move above " + object,
-                     [this, pregrasp, chosen, speed] {
-                       return moveToFreeConfiguration(pregrasp, chosen.solutions.front(), speed, "pre-grasp",
-                                                      "no collision-free pre-grasp");
-                     },
-                     nullptr});
-    steps.push_back({"approach " + object,
-                     [this, chosen, object] {
-                       allowGripperContact(object, true);
-                       return arm_.execute(arm_.planLine(chosen.goal, config_.approach_speed), "approach");
-                     },
-                     nullptr});
-    steps.push_back(
-        {"close on " + object,
-         [this] {
-           return std::make_unique<ComponentStep>(gripper_, "Close",
-                                                  component::ParamMap{{"speed", 0.1}, {"force", 40.0}});
-         },
-         [this, object, object_class, object_pose, chosen, opening](const OperationResult& result) -> std::string {
-           if (!result.data.value("holding", false)) {
-             return "the fingers closed on nothing: " + object + " was not where it was seen";
-           }
-           held_ = object;
-           held_class_ = object_class;
-           held_grasp_ = object_pose.inverse() * chosen.goal;
-           held_opening_ = opening;
-           collisions_.remove(partObstacle(object));
-           return {};
-         }});
-    steps.push_back({"lift " + object,
-                     [this] {
-                       return arm_.execute(arm_.planLine(up(config_.retreat) * arm_.endpoint(), config_.approach_speed),
-                                           "retreat");
-                     },
-                     [this](const OperationResult&) -> std::string {
-                       return world_.holds("gripper_holding", {}) || !held_ ? std::string() : "the part slipped out";
-                     }});
-    // A grasp that fails once the tool went down (it closed on nothing, or on the part's top
-    // because the part moved) opens and lifts straight up before it reports the failure, so
-    // that the tool is clear of where the part was seen and a plan that looks again can go on
-    // (from down there every motion would start in collision with the part as it was seen).
-    const std::size_t approach_step = 2;
-    const std::size_t close_step = 3;
-    auto script =
-        std::make_unique<Script>(std::move(steps), data, [this, object](bool) { allowGripperContact(object, false); });
-    script->backOff(
-        approach_step, close_step,
-        {{"open the gripper",
-          [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); }, nullptr},
-         {"lift clear",
-          [this, object] {
-            // Straight up from wherever the miss left the fingers, even beside a neighbour (a
-            // part moved or caught by the fingers): up is away from every part on the table.
-            std::vector<std::string> beside;
-            for (const std::string& obstacle : obstacles_) {
-              if (obstacle != partObstacle(object)) {
-                beside.push_back(obstacle);
-                for (const auto& link : config_.gripper_links) {
-                  collisions_.allow(link, obstacle);
+    const double held_radius = 0.5 * held_object->bounds().sizes().head<2>().norm();
+    const double step = config_.table_spot_step;
+    for (double x = config_.table_min.x(); x <= config_.table_max.x() + 1e-9; x += step) {
+      for (double y = config_.table_min.y(); y <= config_.table_max.y() + 1e-9; y += step) {
+        const Eigen::Vector3d spot(x, y, 0.0);
+        const bool clear =
+            std::all_of(others.begin(), others.end(), [&](const std::pair<std::string, world::Pose>& other) {
+              const world::ObjectClass* c = nullptr;
+              for (const auto& object : classes_) {
+                if (world_.holds("is_a", std::vector<std::string>{other.first, object.name})) {
+                  c = &object;
                 }
               }
-            }
-            arm::MotionPlan lift = arm_.planLine(up(config_.retreat) * arm_.endpoint(), config_.approach_speed);
-            for (const std::string& obstacle : beside) {
-              for (const auto& link : config_.gripper_links) {
-                collisions_.disallow(link, obstacle);
-              }
-            }
-            return arm_.execute(std::move(lift), "back off");
-          },
-          nullptr}},
-        "the tool backed off up");
-    return script;
-  }
-
-  if (operation == "SmartRelease") {
-    if (!held_) {
-      return failed("nothing to release: no part was grasped with SmartGrasp");
-    }
-    const world::ObjectClass* held_object = objectClass(held_class_);
-    const std::string target_class = text("target_class");
-    const std::string target = text("target");
-    if (target_class.empty() == target.empty()) {
-      return failed("give either target_class (put the part on such a part) or target (put it at a frame)");
-    }
-    syncObstacles();
-    // Candidate poses of the held part: on top of each matching part, every symmetric way.
-    std::vector<Candidate> candidates;
-    Matches matches;
-    const auto addPlacements = [&](const std::string& name, const world::Pose& support, double lift) {
-      for (std::size_t h = 0; h < held_object->symmetries.size(); ++h) {
-        world::Pose held_symmetry = world::Pose::Identity();
-        held_symmetry.linear() = held_object->symmetries[h];
-        Candidate candidate;
-        candidate.object = name;
-        candidate.symmetry = static_cast<int>(h);
-        candidate.goal = support * up(lift) * held_symmetry * held_grasp_;
-        candidates.push_back(std::move(candidate));
-      }
-    };
-    if (target == "table") {
-      // Free spots on the table that satisfy the predicates, clear of every known part.
-      const std::vector<std::pair<std::string, world::Pose>> others = [&] {
-        std::vector<std::pair<std::string, world::Pose>> parts;
-        for (const auto& object : classes_) {
-          for (const auto& entry : matching(object.name, {}, *held_).objects) {
-            parts.push_back(entry);
-          }
-        }
-        return parts;
-      }();
-      for (const auto& pattern : patterns) {
-        const std::string problem = spotFailsPattern(Eigen::Vector3d::Zero(), pattern);
-        if (problem.rfind("only ", 0) == 0 || problem.rfind("unknown frame", 0) == 0) {
-          return failed(problem);
-        }
-      }
-      const double held_radius = 0.5 * held_object->bounds().sizes().head<2>().norm();
-      const double step = config_.table_spot_step;
-      for (double x = config_.table_min.x(); x <= config_.table_max.x() + 1e-9; x += step) {
-        for (double y = config_.table_min.y(); y <= config_.table_max.y() + 1e-9; y += step) {
-          const Eigen::Vector3d spot(x, y, 0.0);
-          const bool clear =
-              std::all_of(others.begin(), others.end(), [&](const std::pair<std::string, world::Pose>& other) {
-                const world::ObjectClass* c = nullptr;
-                for (const auto& object : classes_) {
-                  if (world_.holds("is_a", std::vector<std::string>{other.first, object.name})) {
-                    c = &object;
-                  }
-                }
-                const double radius = c != nullptr ? 0.5 * c->bounds().sizes().head<2>().norm() : 0.05;
-                return (other.second.translation().head<2>() - spot.head<2>()).norm() > held_radius + radius + 0.02;
-              });
-          std::string failing;
-          const double m = config_.table_spot_margin;
-          for (const auto& pattern : patterns) {
-            for (const Eigen::Vector3d& shift :
-                 {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(m, 0, 0), Eigen::Vector3d(-m, 0, 0),
-                  Eigen::Vector3d(0, m, 0), Eigen::Vector3d(0, -m, 0)}) {
-              failing = spotFailsPattern(spot + shift, pattern);
-              if (!failing.empty()) {
-                break;
-              }
-            }
+              const double radius = c != nullptr ? 0.5 * c->bounds().sizes().head<2>().norm() : 0.05;
+              return (other.second.translation().head<2>() - spot.head<2>()).norm() > held_radius + radius + 0.02;
+            });
+        std::string failing;
+        const double m = config_.table_spot_margin;
+        for (const auto& pattern : patterns) {
+          for (const Eigen::Vector3d& shift :
+               {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(m, 0, 0), Eigen::Vector3d(-m, 0, 0), Eigen::Vector3d(0, m, 0),
+                Eigen::Vector3d(0, -m, 0)}) {
+            failing = spotFailsPattern(spot + shift, pattern);
             if (!failing.empty()) {
               break;
             }
           }
-          if (!clear || !failing.empty()) {
-            continue;
+          if (!failing.empty()) {
+            break;
           }
-          char name[48];
-          std::snprintf(name, sizeof name, "table(%.2f,%.2f)", x, y);
-          world::Pose frame = world::Pose::Identity();
-          frame.translation() = spot;
-          addPlacements(name, frame, held_object->rest_height + config_.place_clearance);
         }
-      }
-      // Keep the held part's placements that rest it as it rests canonically (its z up).
-      std::erase_if(candidates, [this](const Candidate& candidate) {
-        const world::Pose part = candidate.goal * held_grasp_.inverse();
-        return part.linear().col(2).z() < 0.98;
-      });
-      if (candidates.empty()) {
-        return failed("no free spot on the table satisfies " + text("predicates"));
-      }
-    } else if (!target.empty()) {
-      const auto frame = world_.worldPose(target);
-      if (!frame) {
-        return failed("unknown frame '" + target + "'");
-      }
-      addPlacements(target, *frame, held_object->rest_height + config_.place_clearance);
-    } else {
-      const world::ObjectClass* support = objectClass(target_class);
-      matches = matching(target_class, patterns, *held_);
-      for (const auto& [name, pose] : matches.objects) {
-        for (const Eigen::Matrix3d& symmetry : support->symmetries) {
-          world::Pose frame = pose;
-          frame.linear() = pose.linear() * symmetry;
-          if (frame.linear().col(2).z() < 0.98) {
-            continue;  // only the part's top side faces up
-          }
-          addPlacements(name, frame,
-                        support->bounds().max().z() - held_object->bounds().min().z() + config_.place_clearance);
+        if (!clear || !failing.empty()) {
+          continue;
         }
+        char name[48];
+        std::snprintf(name, sizeof name, "table(%.2f,%.2f)", x, y);
+        world::Pose frame = world::Pose::Identity();
+        frame.translation() = spot;
+        addPlacements(name, frame, held_object->rest_height + config_.place_clearance);
       }
     }
-    // Checked with the fingers at the opening they release to: wider than they hold.
-    const PlannedFingers fingers(*this);
-    fingers.at(held_opening_ > 0.0 ? held_opening_ : config_.fingers ? config_.fingers->max_opening : 0.0);
-    const FeasibilityCheck feasible = [&](Candidate& candidate) -> std::string {
-      allowGripperContact(candidate.object, true);
-      struct Restore {
-        SmartMoveComponent& self;
-        std::string object;
-        ~Restore() { self.allowGripperContact(object, false); }
-      } restore{*this, candidate.object};
-      std::string reason;
-      const auto goal = freeConfiguration(candidate.solutions, collisions_, reason);
-      if (!goal) {
-        return "collision at the goal: " + reason;
-      }
-      const world::Pose above = up(params.at("approach").asDouble()) * candidate.goal;
-      const auto pre = freeConfiguration(arm_.solutions(above, *goal), collisions_, reason);
-      if (!pre) {
-        return "no reachable, collision-free point above: " + (reason.empty() ? "no IK solution" : reason);
-      }
-      const arm::MotionPlan line = arm_.planLine(*pre, candidate.goal, config_.approach_speed);
-      if (!line.ok()) {
-        return "no straight way down: " + line.failure;
-      }
-      const arm::MotionPlan path = arm_.planToJoints(arm_.joints(), *pre, speed);
-      return path.ok() ? std::string() : "no path: " + path.failure;
-    };
-    Selection selection = selectAmong(std::move(candidates), armModel(), config_.weights, feasible);
-    addRejected(selection, matches);
-    nlohmann::json data = selection.toJson();
-    if (!selection.ok()) {
-      return failed("no feasible place for " + *held_ + ": " + selection.failure, data);
+    // Keep the held part's placements that rest it as it rests canonically (its z up).
+    std::erase_if(candidates, [this](const Candidate& candidate) {
+      const world::Pose part = candidate.goal * held_grasp_.inverse();
+      return part.linear().col(2).z() < 0.98;
+    });
+    if (candidates.empty()) {
+      return failed("no free spot on the table satisfies " + text("predicates"));
     }
-    const Candidate chosen = selection.best();
-    const double approach = params.at("approach").asDouble();
-    const std::string released = *held_;
-    const std::string support_object = chosen.object;
-    std::vector<Script::Step> steps;
-    steps.push_back({"move above " + support_object,
-                     [this, chosen, approach, speed] {
-                       return moveToFreeConfiguration(up(approach) * chosen.goal, chosen.solutions.front(), speed,
-                                                      "above the place", "no collision-free point above");
-                     },
-                     nullptr});
-    steps.push_back({"lower onto " + support_object,
-                     [this, chosen, support_object] {
-                       allowGripperContact(support_object, true);
-                       return arm_.execute(arm_.planLine(chosen.goal, config_.approach_speed), "lower");
-                     },
-                     nullptr});
-    steps.push_back({"release " + released,
-                     [this, opening = held_opening_] {
-                       return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening));
-                     },
-                     [this](const OperationResult&) -> std::string {
-                       held_.reset();
-                       return {};
-                     }});
-    steps.push_back({"lift away",
-                     [this, approach] {
-                       return arm_.execute(arm_.planLine(up(approach) * arm_.endpoint(), config_.approach_speed),
-                                           "retreat");
-                     },
-                     nullptr});
-    return std::make_unique<Script>(std::move(steps), data,
-                                    [this, support_object](bool) { allowGripperContact(support_object, false); });
+  } else if (!target.empty()) {
+    const auto frame = world_.worldPose(target);
+    if (!frame) {
+      return failed("unknown frame '" + target + "'");
+    }
+    addPlacements(target, *frame, held_object->rest_height + config_.place_clearance);
+  } else {
+    const world::ObjectClass* support = objectClass(target_class);
+    matches = matching(target_class, patterns, *held_);
+    for (const auto& [name, pose] : matches.objects) {
+      for (const Eigen::Matrix3d& symmetry : support->symmetries) {
+        world::Pose frame = pose;
+        frame.linear() = pose.linear() * symmetry;
+        if (frame.linear().col(2).z() < 0.98) {
+          continue;  // only the part's top side faces up
+        }
+        addPlacements(name, frame,
+                      support->bounds().max().z() - held_object->bounds().min().z() + config_.place_clearance);
+      }
+    }
   }
+  // Checked with the fingers at the opening they release to: wider than they hold.
+  const PlannedFingers fingers(*this);
+  fingers.at(held_opening_ > 0.0 ? held_opening_ : config_.fingers ? config_.fingers->max_opening : 0.0);
+  const FeasibilityCheck feasible = [&](Candidate& candidate) -> std::string {
+    // The part held may touch its support, in these queries only.
+    const arm::AllowedContacts allowed = touching({candidate.object});
+    std::string reason;
+    const auto goal = motion_.firstFree(candidate.solutions, allowed, reason);
+    if (!goal) {
+      return "collision at the goal: " + reason;
+    }
+    const world::Pose above = up(params.at("approach").asDouble()) * candidate.goal;
+    const auto pre = motion_.firstFree(motion_.solutions(above, *goal), allowed, reason);
+    if (!pre) {
+      return "no reachable, collision-free point above: " + (reason.empty() ? "no IK solution" : reason);
+    }
+    const arm::MotionPlan line = motion_.planLine(*pre, candidate.goal, config_.approach_speed, allowed);
+    if (!line.ok()) {
+      return "no straight way down: " + line.failure;
+    }
+    const arm::MotionPlan path = motion_.planToJoints(motion_.joints(), *pre, speed, allowed);
+    return path.ok() ? std::string() : "no path: " + path.failure;
+  };
+  Selection selection = selectAmong(std::move(candidates), armModel(), config_.weights, feasible);
+  addRejected(selection, matches);
+  nlohmann::json data = selection.toJson();
+  if (!selection.ok()) {
+    return failed("no feasible place for " + *held_ + ": " + selection.failure, data);
+  }
+  const Candidate chosen = selection.best();
+  const double approach = params.at("approach").asDouble();
+  const std::string released = *held_;
+  const std::string support_object = chosen.object;
+  std::vector<Script::Step> steps;
+  steps.push_back({"move above " + support_object,
+                   [this, chosen, approach, speed] {
+                     return moveToFreeConfiguration(up(approach) * chosen.goal, chosen.solutions.front(), speed,
+                                                    "above the place", "no collision-free point above");
+                   },
+                   nullptr});
+  steps.push_back({"lower onto " + support_object,
+                   [this, chosen, support_object] {
+                     return follow(motion_.planLine(motion_.joints(), chosen.goal, config_.approach_speed,
+                                                    touching({support_object})),
+                                   "lower");
+                   },
+                   nullptr});
+  steps.push_back({"release " + released,
+                   [this, opening = held_opening_] {
+                     return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening));
+                   },
+                   [this](const OperationResult&) -> std::string {
+                     held_.reset();
+                     return {};
+                   }});
+  steps.push_back({"lift away",
+                   [this, approach, support_object] {
+                     const arm::JointVector now = motion_.joints();
+                     return follow(motion_.planLine(now, up(approach) * motion_.toolAt(now), config_.approach_speed,
+                                                    touching({support_object})),
+                                   "retreat");
+                   },
+                   nullptr});
+  return std::make_unique<Script>(std::move(steps), data, nullptr);
+}
 
-  if (operation == "TeachGrasp") {
-    const std::string object_class = text("object_class");
-    const world::ObjectClass* object = objectClass(object_class);
-    const world::Pose tool = arm_.endpoint();
-    std::optional<std::pair<std::string, world::Pose>> nearest;
-    for (const auto& [name, pose] : matching(object_class, {}).objects) {
-      if ((pose.translation() - tool.translation()).norm() < 0.1 &&
-          (!nearest || (pose.translation() - tool.translation()).norm() <
-                           (nearest->second.translation() - tool.translation()).norm())) {
-        nearest = {name, pose};
-      }
+std::unique_ptr<RunningOperation> SmartMoveComponent::beginTeachGrasp(const component::ParamMap& params) {
+  const auto text = [&params](const char* name) { return params.at(name).asString(); };
+  const std::string object_class = text("object_class");
+  const world::ObjectClass* object = objectClass(object_class);
+  const world::Pose tool = motion_.endpoint();
+  std::optional<std::pair<std::string, world::Pose>> nearest;
+  for (const auto& [name, pose] : matching(object_class, {}).objects) {
+    if ((pose.translation() - tool.translation()).norm() < 0.1 &&
+        (!nearest || (pose.translation() - tool.translation()).norm() <
+                         (nearest->second.translation() - tool.translation()).norm())) {
+      nearest = {name, pose};
     }
-    if (object == nullptr || !nearest) {
-      return failed("no " + object_class +
-                    " within 10 cm of the gripper: detect the parts, then put the gripper "
-                    "around one");
-    }
-    const world::Pose relative = snapToCanonical(nearest->second.inverse() * tool, *object);
-    try {
-      grasps_.teach({object_class, text("grasp"), relative});
-    } catch (const std::exception& e) {
-      return failed(std::string("cannot save the grasp: ") + e.what());
-    }
-    const Eigen::Vector3d& p = relative.translation();
-    return std::make_unique<component::FinishedOperation>(
-        OperationResult::success({{"object", nearest->first}, {"position", {p.x(), p.y(), p.z()}}}));
   }
-  return failed("unknown operation " + operation);
+  if (object == nullptr || !nearest) {
+    return failed("no " + object_class +
+                  " within 10 cm of the gripper: detect the parts, then put the gripper "
+                  "around one");
+  }
+  const world::Pose relative = snapToCanonical(nearest->second.inverse() * tool, *object);
+  try {
+    grasps_.teach({object_class, text("grasp"), relative});
+  } catch (const std::exception& e) {
+    return failed(std::string("cannot save the grasp: ") + e.what());
+  }
+  const Eigen::Vector3d& p = relative.translation();
+  return std::make_unique<component::FinishedOperation>(
+      OperationResult::success({{"object", nearest->first}, {"position", {p.x(), p.y(), p.z()}}}));
 }
 
 std::unique_ptr<RunningOperation> SmartMoveComponent::beginPush(const std::string& object_class,
@@ -1079,23 +1079,21 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginPush(const std::strin
                                   {"centre_room_before", room_now.centre},
                                   {"centre_room_after", room_after.centre}};
         std::string reason;
-        const auto beside = freeConfiguration(arm_.solutions(start, arm_.joints()), collisions_, reason);
-        const auto top = beside ? freeConfiguration(arm_.solutions(above, *beside), collisions_, reason) : std::nullopt;
+        const auto beside = motion_.firstFree(motion_.solutions(start, motion_.joints()), {}, reason);
+        const auto top = beside ? motion_.firstFree(motion_.solutions(above, *beside), {}, reason) : std::nullopt;
         if (!beside || !top) {
           attempt["rejected"] =
               "no collision-free tool pose beside it: " + (reason.empty() ? "no IK solution" : reason);
           tried.push_back(attempt);
           continue;
         }
-        const arm::MotionPlan descent = arm_.planLine(*top, start, config_.approach_speed);
+        const arm::MotionPlan descent = motion_.planLine(*top, start, config_.approach_speed);
         if (!descent.ok()) {
           attempt["rejected"] = "no straight way down beside it: " + descent.failure;
           tried.push_back(attempt);
           continue;
         }
-        allowGripperContact(object, true);
-        const arm::MotionPlan push = arm_.planLine(descent.goal, end, config_.approach_speed);
-        allowGripperContact(object, false);
+        const arm::MotionPlan push = motion_.planLine(descent.goal, end, config_.approach_speed, touching({object}));
         if (!push.ok()) {
           attempt["rejected"] = "the push is blocked: " + push.failure;
           tried.push_back(attempt);
@@ -1120,23 +1118,27 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginPush(const std::strin
                            return moveToFreeConfiguration(above, seed, speed, "pre-push", "no collision-free pre-push");
                          },
                          nullptr});
-        steps.push_back(
-            {"go down beside " + object,
-             [this, start] { return arm_.execute(arm_.planLine(start, config_.approach_speed), "descent"); }, nullptr});
+        steps.push_back({"go down beside " + object,
+                         [this, start] {
+                           return follow(motion_.planLine(motion_.joints(), start, config_.approach_speed), "descent");
+                         },
+                         nullptr});
         steps.push_back({"push " + object,
                          [this, end, object] {
-                           allowGripperContact(object, true);
-                           return arm_.execute(arm_.planLine(end, config_.approach_speed), "push");
+                           return follow(
+                               motion_.planLine(motion_.joints(), end, config_.approach_speed, touching({object})),
+                               "push");
                          },
                          nullptr});
         steps.push_back({"lift clear",
-                         [this] {
-                           return arm_.execute(
-                               arm_.planLine(up(config_.retreat) * arm_.endpoint(), config_.approach_speed), "retreat");
+                         [this, object] {
+                           const arm::JointVector now = motion_.joints();
+                           return follow(motion_.planLine(now, up(config_.retreat) * motion_.toolAt(now),
+                                                          config_.approach_speed, touching({object})),
+                                         "retreat");
                          },
                          nullptr});
-        return std::make_unique<Script>(std::move(steps), data,
-                                        [this, object](bool) { allowGripperContact(object, false); });
+        return std::make_unique<Script>(std::move(steps), data, nullptr);
       }
     }
   }

@@ -26,6 +26,12 @@
 // `predicates` is a ';'-separated list like "right_of(table_center); near(node_1)": each is
 // applied to the object (as its first argument, or where "?" stands). The result of every
 // operation lists every candidate with its cost or the reason it was rejected.
+//
+// Motion: SmartMove asks the cell's motion service (arm/motion_service.h) for where the arm is,
+// IK solutions, collisions and plans, passing the contacts each query allows (the fingers and
+// the part they grasp, the part held and its support); it moves the arm with the arm's
+// FollowJointPath operation and the gripper with the gripper's operations, as a plan would, so
+// it needs neither component's class. Cancelling a SmartMove cancels the arm's motion.
 // Predicate: holding(o) — the gripper holds part o (grasped by SmartGrasp, and still squeezing).
 
 #include <functional>
@@ -34,8 +40,8 @@
 #include <string>
 #include <vector>
 
-#include "arm/arm_component.h"
-#include "component/component.h"
+#include "arm/motion_service.h"
+#include "component/operation_table.h"
 #include "gripper/finger_geometry.h"
 #include "planning/collision_world.h"
 #include "predicator/predicator.h"
@@ -95,14 +101,17 @@ std::string partObstacle(const std::string& object);
 /// arguments, known reference frames): empty when fine, else the problem.
 using PatternCheck = predicator::PatternCheck;
 
-class SmartMoveComponent final : public component::LocalComponent {
+class SmartMoveComponent final : public component::TableComponent {
  public:
-  /// Everything passed by reference must outlive the component.
-  SmartMoveComponent(arm::ArmComponent& arm, component::Component& gripper, world::WorldState& world,
-                     planning::CollisionWorld& collisions, std::vector<world::ObjectClass> classes,
-                     GraspLibrary& grasps, SmartMoveConfig config = {});
+  /// Everything passed by reference must outlive the component. `motion`: the cell's motion
+  /// service for the arm; `arm` and `gripper`: the components SmartMove moves through their
+  /// operations (the arm's FollowJointPath; the gripper's Open and Close). `collisions`: the
+  /// cell's collision world, where SmartMove keeps the known parts (syncObstacles) and the
+  /// fingers' shapes (syncFingers); the motion service plans in it.
+  SmartMoveComponent(const arm::MotionService& motion, component::Component& arm, component::Component& gripper,
+                     world::WorldState& world, planning::CollisionWorld& collisions,
+                     std::vector<world::ObjectClass> classes, GraspLibrary& grasps, SmartMoveConfig config = {});
 
-  const component::ComponentDescription& description() const override { return description_; }
   world::Report report() const override;
 
   /// Puts every known part (symbols classified by is_a) in the collision world as a box, and
@@ -142,8 +151,11 @@ class SmartMoveComponent final : public component::LocalComponent {
                         const world::Pose& grasp, double approach, double speed);
 
  private:
-  std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
-                                                     const component::ParamMap& params) override;
+  // The operations' handlers (one table, declared in the constructor).
+  std::unique_ptr<component::RunningOperation> beginMoveOrGrasp(bool grasping, const component::ParamMap& params);
+  std::unique_ptr<component::RunningOperation> beginRelease(const component::ParamMap& params);
+  std::unique_ptr<component::RunningOperation> beginTeachGrasp(const component::ParamMap& params);
+  std::unique_ptr<component::RunningOperation> beginPushOperation(const component::ParamMap& params);
   const world::ObjectClass* objectClass(const std::string& name) const;
   /// SmartPush (see the top of this file).
   std::unique_ptr<component::RunningOperation> beginPush(const std::string& object_class,
@@ -152,7 +164,11 @@ class SmartMoveComponent final : public component::LocalComponent {
   /// Why a spot on the table does not satisfy `pattern` (empty if it does).
   std::string spotFailsPattern(const Eigen::Vector3d& spot, const predicator::Pattern& pattern) const;
   ArmModel armModel() const;
-  void allowGripperContact(const std::string& object, bool allowed);
+  /// Contacts a query may make: the gripper's links with these objects (parts, or a support).
+  arm::AllowedContacts touching(const std::vector<std::string>& objects) const;
+  /// Runs a plan with the arm's FollowJointPath (called `what` in messages), or an operation
+  /// that fails with the plan's reason.
+  std::unique_ptr<component::RunningOperation> follow(const arm::MotionPlan& plan, const std::string& what);
   /// Shifts (m along the tool's x) of a grasp at `tcp` that keep the pads on the part.
   std::vector<double> graspShifts(const world::Pose& tcp, const world::Pose& object,
                                   const world::ObjectClass& object_class) const;
@@ -172,8 +188,8 @@ class SmartMoveComponent final : public component::LocalComponent {
 
   friend class SmartStep;
   class PlannedFingers;
-  component::ComponentDescription description_;
-  arm::ArmComponent& arm_;
+  const arm::MotionService& motion_;
+  component::Component& arm_;
   component::Component& gripper_;
   world::WorldState& world_;
   planning::CollisionWorld& collisions_;

@@ -3,8 +3,10 @@
 #include <limits>
 
 #include "arm/arm_component.h"
+#include "arm/motion_planner.h"
 #include "arm/robot_description.h"
 #include "calibration/calibration_component.h"
+#include "component/operation_table.h"
 #include "core/paths.h"
 #include "faults/injector.h"
 #include "gripper/finger_geometry.h"
@@ -26,16 +28,17 @@ namespace {
 
 /// The workcell's fixed frames, as symbols: table_center (the workspace centre, on the table
 /// top; found from the ArUco marker when perception is set up) and the robot's base.
-class FixedFrames final : public component::LocalComponent {
+class FixedFrames final : public component::TableComponent {
  public:
   explicit FixedFrames(std::vector<std::pair<std::string, world::Pose>> frames) : frames_(std::move(frames)) {
-    description_.name = "workcell";
-    description_.type = "FixedFrames";
+    component::ComponentDescription description;
+    description.name = "workcell";
+    description.type = "FixedFrames";
     for (const auto& [name, pose] : frames_) {
-      description_.symbols.push_back({name, world::SymbolKind::kFrame, "a fixed frame of the workcell"});
+      description.symbols.push_back({name, world::SymbolKind::kFrame, "a fixed frame of the workcell"});
     }
+    declare(std::move(description), {});  // no operations
   }
-  const component::ComponentDescription& description() const override { return description_; }
   world::Report report() const override {
     world::Report report;
     for (const auto& [name, pose] : frames_) {
@@ -45,23 +48,20 @@ class FixedFrames final : public component::LocalComponent {
   }
 
  private:
-  std::unique_ptr<component::RunningOperation> begin(const std::string&, const component::ParamMap&) override {
-    return nullptr;  // no operations
-  }
-  component::ComponentDescription description_;
   std::vector<std::pair<std::string, world::Pose>> frames_;
 };
 
 /// TEST ONLY: the simulator's true part poses as object symbols, standing in for perception
 /// when SmartMove is tested apart from it.
-class TestOraclePerception final : public component::LocalComponent {
+class TestOraclePerception final : public component::TableComponent {
  public:
   explicit TestOraclePerception(sim::Simulation& simulation) : simulation_(simulation) {
-    description_.name = "test_oracle_perception";
-    description_.type = "TestOraclePerception";
-    description_.predicates = {{"is_a", 2, "TEST ONLY: is_a(part, class) from ground truth"}};
+    component::ComponentDescription description;
+    description.name = "test_oracle_perception";
+    description.type = "TestOraclePerception";
+    description.predicates = {{"is_a", 2, "TEST ONLY: is_a(part, class) from ground truth"}};
+    declare(std::move(description), {});  // no operations
   }
-  const component::ComponentDescription& description() const override { return description_; }
   world::Report report() const override {
     world::Report report;
     for (const sim::PartState& part : simulation_.parts()) {
@@ -72,10 +72,6 @@ class TestOraclePerception final : public component::LocalComponent {
   }
 
  private:
-  std::unique_ptr<component::RunningOperation> begin(const std::string&, const component::ParamMap&) override {
-    return nullptr;
-  }
-  component::ComponentDescription description_;
   sim::Simulation& simulation_;
 };
 
@@ -160,10 +156,13 @@ class SimWorkcell final : public Workcell {
     arm_config.tcp_in_flange = robot_description_.tool_in_flange * gripper_model_.tcp_in_flange;
     arm_config.joint_names = robot_description_.joint_names;
     arm_config.joint_labels = robot_description_.joint_labels;
+    const std::shared_ptr<const arm::Kinematics> kinematics = arm::makeKinematics(robot_description_);
     auto arm = std::make_shared<arm::ArmComponent>(
         arm_driver, clock(), collisions_, waypoints_,
-        [this](const std::string& frame) { return components().world().worldPose(frame); },
-        arm::makeKinematics(robot_description_), arm_config);
+        [this](const std::string& frame) { return components().world().worldPose(frame); }, kinematics, arm_config);
+    // The cell's motion service: what SmartMove asks (IK, collisions, plans); it moves the arm
+    // through the arm's operations.
+    motion_ = std::make_unique<arm::MotionPlanner>(arm_driver, clock(), collisions_, kinematics, arm_config);
     // SmartMove reaches the gripper through its operations, as the tree does: the same (possibly
     // fault-injected) component the registry holds.
     std::shared_ptr<component::Component> gripper = gripper_model_.make_component(gripper_driver, clock());
@@ -190,8 +189,9 @@ class SimWorkcell final : public Workcell {
     smartmove::SmartMoveConfig smartmove_config;
     smartmove_config.gripper_links = gripperLinks(robot_description_, gripper_model_);
     smartmove_config.fingers = gripper_model_.fingers;
-    smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(
-        *arm, *gripper, components().world(), collisions_, simulation_->objectClasses(), grasps_, smartmove_config);
+    smartmove_ =
+        std::make_shared<smartmove::SmartMoveComponent>(*motion_, *arm, *gripper, components().world(), collisions_,
+                                                        simulation_->objectClasses(), grasps_, smartmove_config);
     add(smartmove_);
     // Last: it derives its predicates from what the others report.
     add(std::make_shared<predicator::Predicator>(components().world(), simulation_->objectClasses()));
@@ -306,6 +306,7 @@ class SimWorkcell final : public Workcell {
   planning::CollisionWorld collisions_;
   arm::WaypointStore waypoints_;
   smartmove::GraspLibrary grasps_;
+  std::unique_ptr<arm::MotionPlanner> motion_;
   std::shared_ptr<smartmove::SmartMoveComponent> smartmove_;
   std::shared_ptr<calibration::CalibrationComponent> calibration_;
   std::shared_ptr<faults::Injector> faults_;

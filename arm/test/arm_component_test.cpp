@@ -229,6 +229,55 @@ TEST_F(ArmTest, TeachSavesWhereTheArmIsAndJoggingMovesIt) {
             "cannot save the waypoint: waypoint name 'bad name!' may contain only letters, digits, '_' and '-'");
 }
 
+// How another component moves the arm: it plans with a motion service of its own (the cell's,
+// here one on the same driver and collision world) and hands the plan's waypoints to the arm's
+// FollowJointPath, with the contacts the plan allowed passed to the query alone.
+TEST_F(ArmTest, FollowsAPathPlannedByTheMotionServiceExactlyAsItWouldItsOwn) {
+  const MotionPlanner service(driver, clock, collisions, std::make_shared<Ur5Kinematics>(), config());
+  const JointVector goal = {0.6, -1.8, 1.6, -M_PI / 2, -M_PI / 2, 0.0};
+  const MotionPlan plan = service.planToJoints(service.joints(), goal, 0.4);
+  ASSERT_TRUE(plan.ok()) << plan.failure;
+  const OperationResult result = run(std::string(kFollowJointPath), followParams(plan, "to the goal"));
+  ASSERT_EQ(result.state, OperationState::kSuccess) << result.reason;
+  EXPECT_LT(maxAbsDifference(driver.read().position, goal), 1e-9);
+  // Timed again by the arm from the waypoints and the speed: the very same trajectory.
+  ASSERT_EQ(driver.executed.size(), 1u);
+  EXPECT_EQ(driver.executed[0]->duration(), plan.trajectory->duration());
+  for (Duration t{}; t <= plan.trajectory->duration(); t += std::chrono::milliseconds(7)) {
+    EXPECT_EQ(driver.executed[0]->sample(t).position, plan.trajectory->sample(t).position);
+  }
+  // Not a node type: the abstract Arm's plans never see it.
+  EXPECT_EQ(arm.description().operation(kFollowJointPath)->kind, component::OperationKind::kInternal);
+}
+
+TEST_F(ArmTest, FollowJointPathRefusesABadPathOrOneFromElsewhereAndCancelStopsIt) {
+  const auto follow = [this](const std::string& path) {
+    return run(std::string(kFollowJointPath), {{"path", path}, {"label", "approach"}});
+  };
+  EXPECT_EQ(follow("[[0,0,0,0,0,0]]").reason, "approach: the path has 1 point(s); it needs a start and a goal");
+  EXPECT_EQ(follow("{}").reason, "approach: the path is not a JSON array of joint configurations");
+  EXPECT_EQ(follow("[[0,0,0,0,0,0],[0,0,0,0,0]]").reason, "approach: path point 2 is not a list of 6 angles");
+  EXPECT_EQ(follow("[[0,0,0,0,0,0],[0,0,\"x\",0,0,0]]").reason,
+            "approach: path point 2: joint 3 is not a finite number");
+  // Planned from somewhere the arm is not: it would jump there.
+  JointVector elsewhere = kHome;
+  elsewhere[0] += 0.3;
+  const OperationResult jump = follow(pathParam({elsewhere, kHome}));
+  EXPECT_NE(jump.reason.find("approach: the path starts 0.300 rad from where the arm is"), std::string::npos)
+      << jump.reason;
+  EXPECT_TRUE(driver.executed.empty());  // nothing moved
+  // Cancelling decelerates along the path, as for every motion.
+  JointVector far = kHome;
+  far[0] += 2.0;
+  const auto id = arm.start(std::string(kFollowJointPath), {{"path", pathParam({kHome, far})}, {"speed", 1.0}});
+  clock.advanceBy(std::chrono::milliseconds(500));
+  EXPECT_TRUE(holds("arm_moving"));
+  arm.cancel(id);
+  ASSERT_EQ(driver.executed.size(), 2u);
+  clock.advanceBy(driver.executed.back()->duration() + std::chrono::milliseconds(10));
+  EXPECT_FALSE(holds("arm_moving"));
+}
+
 TEST(WaypointStore, PersistsAtomicallyAndReloads) {
   const auto file = std::filesystem::temp_directory_path() / "costar_waypoints_test" / "waypoints.json";
   std::filesystem::remove_all(file.parent_path());

@@ -123,6 +123,22 @@ TEST_F(Collisions, AllowedContactsAreIgnoredAndObstaclesCanBeRemoved) {
   EXPECT_FALSE(world.check(kHome).has_value());
 }
 
+TEST_F(Collisions, ContactsAllowedForOneQueryAreNotLeftInTheWorld) {
+  const world::Pose tcp = kBaseInWorld * robot.forward(kHome);
+  world.setBox("part_1", tcp, {0.05, 0.05, 0.05});
+  const AllowedContacts grasping = AllowedContacts::between({"tool0", "fingers"}, {"part_1"});
+  EXPECT_FALSE(world.check(kHome, grasping).has_value());
+  EXPECT_FALSE(world.checkSegment(kHome, kHome, grasping).has_value());
+  // The next query, without them, sees the part again.
+  ASSERT_TRUE(world.check(kHome).has_value());
+  EXPECT_EQ(world.check(kHome)->other, "part_1");
+  // Allowing another part lets nothing touch this one.
+  EXPECT_EQ(world.check(kHome, AllowedContacts::between({"tool0", "fingers"}, {"part_2"}))->other, "part_1");
+  // A plan to a goal inside the part is refused unless the plan allows the contact.
+  EXPECT_FALSE(planPath(world, kHome, kHome).ok());
+  EXPECT_TRUE(planPath(world, kHome, kHome, {}, grasping).ok());
+}
+
 TEST_F(Collisions, ALinksShapesCanBeReplacedAndPutBack) {
   // A 2 cm block 5 cm from the tool centre point along the fingers' closing direction (the
   // tool's y): inside the box over the fingers' whole travel (60 mm + padding either side).

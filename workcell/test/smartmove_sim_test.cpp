@@ -10,6 +10,7 @@
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
+#include "component/component.h"
 #include "core/paths.h"
 #include "sim/simulation.h"
 #include "workcell/workcell.h"
@@ -58,6 +59,44 @@ TEST_F(SmartMoveSim, GraspsTheNodeThePredicatesSelectAndLiftsIt) {
   cell->beforeTick();
   EXPECT_TRUE(cell->components().world().holds("holding", std::vector<std::string>{"node_1"}));
   EXPECT_EQ(cell->simulation()->armTableContactSteps(), 0u);
+}
+
+// SmartMove moves the arm through the arm's FollowJointPath operation: cancelling the SmartGrasp
+// cancels that operation, and the arm decelerates along its path and stops.
+TEST_F(SmartMoveSim, CancellingASmartGraspStopsTheArmOnItsWay) {
+  open(R"x({"parts": [{"class": "node", "color": "red", "at": [0.45, -0.2, 25]}]})x");
+  component::Component* smartmove = cell->components().provider("SmartGrasp");
+  ASSERT_NE(smartmove, nullptr);
+  component::ParamMap params{{"object_class", "node"}, {"predicates", ""}, {"grasp", "top"}};
+  for (const auto& spec : smartmove->description().operation("SmartGrasp")->params) {
+    if (spec.default_value) {
+      params.try_emplace(spec.name, *spec.default_value);
+    }
+  }
+  const auto fastest = [this] {
+    double speed = 0.0;
+    for (const double v : cell->simulation()->armVelocities()) {
+      speed = std::max(speed, std::abs(v));
+    }
+    return speed;
+  };
+  cell->beforeTick();
+  const component::OperationId id = smartmove->start("SmartGrasp", params);
+  // Until the arm is well on its way above the part (the gripper opens first).
+  double moving = 0.0;
+  for (int tick = 0; tick < 1000 && moving < 0.3; ++tick) {
+    ASSERT_EQ(smartmove->poll(id).state, component::OperationState::kRunning);
+    cell->clock().sleepUntil(cell->clock().now() + std::chrono::milliseconds(10));
+    cell->beforeTick();
+    moving = fastest();
+  }
+  ASSERT_GE(moving, 0.3) << "the arm never moved";
+  smartmove->cancel(id);
+  cell->clock().sleepUntil(cell->clock().now() + std::chrono::seconds(1));
+  cell->beforeTick();
+  EXPECT_LT(fastest(), 0.01);
+  EXPECT_FALSE(cell->components().world().holds("arm_moving", {}));
+  EXPECT_LT(part("node_0").pose.translation().z(), 0.03);  // not grasped
 }
 
 TEST_F(SmartMoveSim, StacksANodeOnAnotherAndALinkOnANode) {

@@ -1,0 +1,241 @@
+// SmartMove reaches the arm only through the cell's motion service and the arm's operations:
+// against an arm component standing in for one in another process (it sees FollowJointPath's
+// parameters as JSON, as they would cross a process boundary), with every motion query
+// recorded with the contacts it allowed.
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "arm/motion_planner.h"
+#include "arm/robot_description.h"
+#include "core/paths.h"
+#include "planning/robot_model.h"
+#include "smartmove/smartmove.h"
+
+namespace costar::smartmove {
+namespace {
+
+using component::OperationResult;
+using component::OperationState;
+
+/// Encoders that read where the (remote) arm was last sent.
+class Encoders final : public arm::ArmDriver {
+ public:
+  explicit Encoders(arm::JointVector q) : q(q) {}
+  arm::ArmState read() const override { return {q, {}}; }
+  void execute(std::shared_ptr<const arm::JointTrajectory>, TimePoint) override {}
+  arm::JointVector q;
+};
+
+/// An arm known only by its operations: FollowJointPath runs until the test finishes it (then
+/// the encoders read the path's end) or it is cancelled.
+class RemoteArm final : public component::TableComponent {
+ public:
+  struct Motion {
+    nlohmann::json params;  // as received over the wire
+    bool finished = false;
+    bool cancelled = false;
+  };
+
+  explicit RemoteArm(Encoders& encoders) : encoders_(encoders) {
+    component::ComponentDescription description;
+    description.name = "arm";
+    component::OperationTable operations;
+    operations.add({std::string(arm::kFollowJointPath), "", {}, component::OperationKind::kInternal},
+                   [this](const component::ParamMap& params) {
+                     motions.push_back(std::make_shared<Motion>());
+                     motions.back()->params = nlohmann::json::parse(component::toJson(params).dump());
+                     return std::make_unique<Running>(*this, motions.back());
+                   });
+    declare(std::move(description), std::move(operations));
+  }
+  world::Report report() const override { return {}; }
+
+  std::vector<arm::JointVector> path(std::size_t motion) const {
+    return arm::pathFromParam(motions.at(motion)->params.at("path").get<std::string>(), 6);
+  }
+
+  std::vector<std::shared_ptr<Motion>> motions;
+
+ private:
+  class Running final : public component::RunningOperation {
+   public:
+    Running(RemoteArm& arm, std::shared_ptr<Motion> motion) : arm_(arm), motion_(std::move(motion)) {}
+    OperationResult poll() override {
+      if (!motion_->finished) {
+        return OperationResult::running();
+      }
+      arm_.encoders_.q = arm::pathFromParam(motion_->params.at("path").get<std::string>(), 6).back();
+      return OperationResult::success();
+    }
+    void cancel() override { motion_->cancelled = true; }
+
+   private:
+    RemoteArm& arm_;
+    std::shared_ptr<Motion> motion_;
+  };
+  Encoders& encoders_;
+};
+
+/// Opens and closes at once; Close reports that it holds something.
+class InstantGripper final : public component::TableComponent {
+ public:
+  InstantGripper() {
+    component::ComponentDescription description;
+    description.name = "gripper";
+    component::OperationTable operations;
+    for (const char* name : {"Open", "Close"}) {
+      operations.add({name, "", {}}, [](const component::ParamMap&) {
+        return std::make_unique<component::FinishedOperation>(OperationResult::success({{"holding", true}}));
+      });
+    }
+    declare(std::move(description), std::move(operations));
+  }
+  world::Report report() const override { return {}; }
+};
+
+/// The cell's motion service, with every planning query and the contacts it allowed recorded.
+class RecordingMotion final : public arm::MotionService {
+ public:
+  struct Query {
+    std::string kind;
+    bool part_allowed = false;  // the gripper may touch node_0
+  };
+  RecordingMotion(const arm::MotionService& inner, std::string gripper_link)
+      : inner_(inner), gripper_link_(std::move(gripper_link)) {}
+
+  arm::JointVector joints() const override { return inner_.joints(); }
+  world::Pose endpoint() const override { return inner_.endpoint(); }
+  world::Pose toolAt(const arm::JointVector& q) const override { return inner_.toolAt(q); }
+  std::vector<arm::JointVector> solutions(const world::Pose& tcp, const arm::JointVector& seed) const override {
+    return inner_.solutions(tcp, seed);
+  }
+  std::optional<planning::Contact> collision(const arm::JointVector& q,
+                                             const arm::AllowedContacts& allowed) const override {
+    return inner_.collision(q, allowed);
+  }
+  arm::MotionPlan planToJoints(const arm::JointVector& from, const arm::JointVector& goal, double speed,
+                               const arm::AllowedContacts& allowed) const override {
+    record("joints", allowed);
+    return inner_.planToJoints(from, goal, speed, allowed);
+  }
+  arm::MotionPlan planLine(const arm::JointVector& from, const world::Pose& tcp, double speed,
+                           const arm::AllowedContacts& allowed) const override {
+    record("line", allowed);
+    return inner_.planLine(from, tcp, speed, allowed);
+  }
+  arm::MotionPlan planToPose(const arm::JointVector& from, const world::Pose& tcp, double speed,
+                             const arm::AllowedContacts& allowed) const override {
+    record("pose", allowed);
+    return inner_.planToPose(from, tcp, speed, allowed);
+  }
+
+  mutable std::vector<Query> queries;
+
+ private:
+  void record(const char* kind, const arm::AllowedContacts& allowed) const {
+    queries.push_back({kind, allowed.contains(gripper_link_, partObstacle("node_0"))});
+  }
+  const arm::MotionService& inner_;
+  std::string gripper_link_;
+};
+
+class SmartMoveMotion : public ::testing::Test {
+ protected:
+  SmartMoveMotion()
+      : robot(arm::loadRobotDescription(arm::robotDescriptionFile("ur5"))),
+        model(planning::RobotModel::fromUrdf(robot.urdf, robot.urdf_base_link, robot.urdf_tool_link)),
+        collisions(model, world::Pose::Identity(), {.padding = 0.005}, {robot.home.eigen()}),
+        encoders(robot.home),
+        planner(encoders, clock, collisions, arm::makeKinematics(robot), armConfig()),
+        motion(planner, robot.gripper_links.front()),
+        remote(encoders),
+        grasps(dataRoot() / "data/grasps.json", {}),
+        smartmove(motion, remote, gripper, world, collisions, world::loadObjectClasses(dataRoot() / "data/objects"),
+                  grasps, smartmoveConfig()) {
+    collisions.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
+    collisions.allow(robot.base_link, "table");
+    world::Report report;
+    report.symbols.push_back(
+        {"node_0", "", {}, world::FrameValue{"world", world::poseFromXyzRpy(0.45, -0.2, 0.025, 0, 0, 0.4)}});
+    report.predicates.push_back({"is_a", {"node_0", "node"}, true, ""});
+    world.update("perception", report);
+  }
+  arm::ArmConfig armConfig() const {
+    arm::ArmConfig c;
+    c.home = robot.home;
+    c.tcp_in_flange = robot.tool_in_flange * Eigen::Translation3d(0, 0, 0.15);
+    c.joint_names = robot.joint_names;
+    return c;
+  }
+  SmartMoveConfig smartmoveConfig() const {
+    SmartMoveConfig c;
+    c.gripper_links = robot.gripper_links;
+    return c;
+  }
+  component::ParamMap params(const std::string& operation, component::ParamMap given) const {
+    for (const auto& spec : smartmove.description().operation(operation)->params) {
+      if (spec.default_value) {
+        given.try_emplace(spec.name, *spec.default_value);
+      }
+    }
+    return given;
+  }
+
+  arm::RobotDescription robot;
+  planning::RobotModel model;
+  planning::CollisionWorld collisions;
+  SimClock clock;
+  Encoders encoders;
+  arm::MotionPlanner planner;
+  RecordingMotion motion;
+  RemoteArm remote;
+  InstantGripper gripper;
+  world::WorldState world;
+  GraspLibrary grasps;
+  SmartMoveComponent smartmove;
+};
+
+TEST_F(SmartMoveMotion, MovesTheArmWithItsFollowJointPathAndCancellingCancelsTheMotion) {
+  const auto id = smartmove.start("SmartMove", params("SmartMove", {{"object_class", "node"}, {"grasp", "top"}}));
+  ASSERT_EQ(smartmove.poll(id).state, OperationState::kRunning);
+  ASSERT_EQ(remote.motions.size(), 1u);
+  EXPECT_EQ(remote.motions[0]->params.at("label"), "SmartMove");
+  EXPECT_EQ(remote.motions[0]->params.at("speed"), 0.5);
+  const std::vector<arm::JointVector> path = remote.path(0);
+  EXPECT_EQ(path.front(), robot.home);  // from where the arm is
+  const world::Pose goal = *world.worldPose("node_0") * grasps.find("node", "top")->tcp_in_object;
+  EXPECT_LT((planner.toolAt(path.back()).translation() - goal.translation()).norm(), 1e-6);
+  smartmove.cancel(id);
+  EXPECT_TRUE(remote.motions[0]->cancelled);
+}
+
+TEST_F(SmartMoveMotion, EachQueryIsGivenTheContactsItAllows) {
+  const auto id = smartmove.start("SmartGrasp", params("SmartGrasp", {{"object_class", "node"}, {"grasp", "top"}}));
+  // The choice: every query of the grasp's feasibility lets the fingers touch the part.
+  ASSERT_FALSE(motion.queries.empty());
+  for (const auto& query : motion.queries) {
+    EXPECT_TRUE(query.part_allowed) << query.kind;
+  }
+  motion.queries.clear();
+  // Open (at once), then above the part: a motion that must not touch it.
+  ASSERT_EQ(smartmove.poll(id).state, OperationState::kRunning);
+  ASSERT_EQ(remote.motions.size(), 1u);
+  ASSERT_EQ(motion.queries.size(), 1u);
+  EXPECT_FALSE(motion.queries[0].part_allowed);
+  // Down onto it in a straight line: the fingers may touch it.
+  remote.motions[0]->finished = true;
+  ASSERT_EQ(smartmove.poll(id).state, OperationState::kRunning);
+  ASSERT_EQ(remote.motions.size(), 2u);
+  EXPECT_EQ(remote.motions[1]->params.at("label"), "approach");
+  ASSERT_EQ(motion.queries.size(), 2u);
+  EXPECT_EQ(motion.queries[1].kind, "line");
+  EXPECT_TRUE(motion.queries[1].part_allowed);
+  EXPECT_EQ(remote.path(1).front(), remote.path(0).back());
+  smartmove.cancel(id);
+  EXPECT_TRUE(remote.motions[1]->cancelled);
+}
+
+}  // namespace
+}  // namespace costar::smartmove
