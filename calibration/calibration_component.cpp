@@ -50,6 +50,20 @@ class CalibrationRun final : public component::RunningOperation {
         speed_(speed),
         started_(component.clock_.now()),
         start_joints_(component.arm_.joints()) {
+    if (const auto& area = component.config_.keep_out) {
+      // The parts' area is an obstacle for every plan from here until the run ends.
+      c_.collisions_.setBox(kKeepOutObstacle, world::Pose(Eigen::Translation3d(area->center())), area->sizes());
+      keeping_out_ = true;
+      if (const auto contact = c_.collisions_.check(start_joints_.eigen());
+          contact && contact->other == kKeepOutObstacle) {
+        release();
+        done_ = OperationResult::failure(
+            operation() + ": the arm is in the table's part area (" + contact->str() +
+            "), where it cannot move without the risk of pushing a part: move it up first (e.g. Home); the previous "
+            "calibration is kept");
+        return;
+      }
+    }
     const CellCalibration now = component.calibration();
     marker_in_flange_ = marker_stage ? component.config_.marker_in_flange_guess : *now.marker_in_flange;
     aim_camera_ = component.cameraPose();
@@ -116,32 +130,54 @@ class CalibrationRun final : public component::RunningOperation {
  private:
   std::string operation() const { return marker_stage_ ? "CalibrateMarker" : "Calibrate"; }
 
+  /// The run is over: the keep-out leaves the collision world, another calibration may start.
   void release() {
+    if (keeping_out_) {
+      c_.collisions_.remove(kKeepOutObstacle);
+      keeping_out_ = false;
+    }
     std::lock_guard lock(c_.mutex_);
     c_.running_ = false;
   }
 
   /// The next candidate the camera would see (by the current estimate) and the arm can reach
-  /// without collision; the motion to it starts.
+  /// without collision; the motion to it starts. With a keep-out, a candidate the arm cannot
+  /// reach is tried again higher (lift_step at a time, up to the top of the views' region):
+  /// low views are the ones whose fingers would enter the parts' area.
   void startNextMotion() {
     const CalibrationConfig& config = c_.config_;
     const camera::Intrinsics& intrinsics = c_.camera_.intrinsics();
     const world::Pose tcp_in_flange = c_.arm_.config().tcp_in_flange;
     while (next_ < candidates_.size()) {
-      world::Pose marker = candidates_[next_++];
-      if (!markerInView(marker, config.solve.marker_size, aim_camera_, intrinsics, config.image_margin_px,
-                        config.max_view_angle_deg)) {
-        continue;
+      const world::Pose candidate = candidates_[next_++];
+      bool counted = false;
+      for (double lift = 0.0; lift == 0.0 || (keeping_out_ && config.lift_step > 0 &&
+                                              candidate.translation().z() + lift <= config.region_max.z() + 1e-9);
+           lift += config.lift_step) {
+        world::Pose marker = candidate;
+        marker.translation().z() += lift;
+        if (!markerInView(marker, config.solve.marker_size, aim_camera_, intrinsics, config.image_margin_px,
+                          config.max_view_angle_deg)) {
+          continue;
+        }
+        if (!counted) {
+          ++tried_;
+          counted = true;
+        }
+        const world::Pose tcp = marker * marker_in_flange_.inverse() * tcp_in_flange;
+        arm::MotionPlan plan = c_.arm_.planToPose(tcp, speed_);
+        if (!plan.ok()) {
+          continue;
+        }
+        if (lift > 0.0) {
+          ++lifted_;
+        }
+        motion_ = c_.arm_.execute(std::move(plan), operation() + " view " + std::to_string(tried_));
+        return;
       }
-      const world::Pose tcp = marker * marker_in_flange_.inverse() * tcp_in_flange;
-      arm::MotionPlan plan = c_.arm_.planToPose(tcp, speed_);
-      ++tried_;
-      if (!plan.ok()) {
+      if (counted) {
         ++unreachable_;
-        continue;
       }
-      motion_ = c_.arm_.execute(std::move(plan), operation() + " view " + std::to_string(tried_));
-      return;
     }
   }
 
@@ -226,6 +262,7 @@ class CalibrationRun final : public component::RunningOperation {
       data["views"] = views_.size();
       data["poses_tried"] = tried_;
       data["unreachable"] = unreachable_;
+      data["lifted"] = lifted_;
       data["marker_not_seen"] = not_seen_;
       if (const std::string problem = c_.accept(next); !problem.empty()) {
         data["warning"] = problem;
@@ -285,20 +322,24 @@ class CalibrationRun final : public component::RunningOperation {
   std::size_t next_ = 0;
   int tried_ = 0;
   int unreachable_ = 0;
+  int lifted_ = 0;
   int not_seen_ = 0;
   std::vector<std::string> skipped_;
   std::vector<MarkerView> views_;
   std::unique_ptr<component::RunningOperation> motion_;
   std::optional<TimePoint> settle_until_;
   bool returning_ = false;
+  bool keeping_out_ = false;
   OperationResult result_;
   std::optional<OperationResult> done_;
 };
 
-CalibrationComponent::CalibrationComponent(arm::ArmComponent& arm, camera::RgbdCamera& camera, const Clock& clock,
+CalibrationComponent::CalibrationComponent(arm::ArmComponent& arm, planning::CollisionWorld& collisions,
+                                           camera::RgbdCamera& camera, const Clock& clock,
                                            const world::Pose& drawn_camera_pose, CellCalibration initial,
                                            CalibrationConfig config)
     : arm_(arm),
+      collisions_(collisions),
       camera_(camera),
       clock_(clock),
       drawn_camera_pose_(drawn_camera_pose),

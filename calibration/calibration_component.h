@@ -14,6 +14,12 @@
 // Both move the arm back to where it started, save the result with the cell, and keep the
 // previous calibration when anything is wrong (marker not seen, too few or too similar views,
 // a degenerate solution, residuals too large), failing with the reason.
+// While either runs, the table's part area (CalibrationConfig::keep_out, from the workcell's
+// description) is an obstacle in the arm's collision world: the camera is not calibrated yet,
+// so no part seen can be trusted, and the arm, gripper and marker stay out of everywhere a
+// part may lie. Every view pose and every motion between views (and back) is planned and
+// checked against it by the arm's own planning; a view that would enter it is tried higher
+// (CalibrationConfig::lift_step), or left out.
 // Symbols: `camera` (the RGB-D camera's optical frame in the world, as calibrated).
 // Predicate: camera_calibrated (the camera's pose comes from a Calibrate, not the drawings).
 
@@ -29,6 +35,7 @@
 #include "camera/rgbd.h"
 #include "component/operation_table.h"
 #include "core/clock.h"
+#include "planning/collision_world.h"
 
 namespace costar::calibration {
 
@@ -69,15 +76,27 @@ struct CalibrationConfig {
   Duration time_budget = std::chrono::seconds(50);
   /// Where the calibration is saved (empty: not saved, e.g. trials and tests).
   std::filesystem::path file;
+  /// The table's part area (world; the workcell description's `part_area`): where parts may
+  /// lie or stand. No part of the arm enters it while calibrating. Absent: nothing kept out.
+  std::optional<Eigen::AlignedBox3d> keep_out;
+  /// With a keep-out: a view the arm cannot reach is tried again this much higher (m), and
+  /// again, up to the top of the region.
+  double lift_step = 0.03;
 };
+
+/// The name of the keep-out obstacle in the collision world while a calibration runs.
+inline constexpr const char* kKeepOutObstacle = "calibration_keep_out";
 
 class CalibrationComponent final : public component::TableComponent {
  public:
   /// `initial` is the calibration the cell starts with (saved earlier); without a camera pose
-  /// in it, `drawn_camera_pose` (where the cell's drawings put the camera) is used. The arm,
-  /// camera and clock must outlive the component.
-  CalibrationComponent(arm::ArmComponent& arm, camera::RgbdCamera& camera, const Clock& clock,
-                       const world::Pose& drawn_camera_pose, CellCalibration initial, CalibrationConfig config);
+  /// in it, `drawn_camera_pose` (where the cell's drawings put the camera) is used.
+  /// `collisions` is the arm's collision world (the one its planning checks against): the
+  /// keep-out is added to it while a calibration runs, and removed after. The arm, collision
+  /// world, camera and clock must outlive the component.
+  CalibrationComponent(arm::ArmComponent& arm, planning::CollisionWorld& collisions, camera::RgbdCamera& camera,
+                       const Clock& clock, const world::Pose& drawn_camera_pose, CellCalibration initial,
+                       CalibrationConfig config);
 
   world::Report report() const override;
 
@@ -95,6 +114,7 @@ class CalibrationComponent final : public component::TableComponent {
   std::string accept(const CellCalibration& next);
 
   arm::ArmComponent& arm_;
+  planning::CollisionWorld& collisions_;
   camera::RgbdCamera& camera_;
   const Clock& clock_;
   world::Pose drawn_camera_pose_;

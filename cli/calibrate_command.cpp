@@ -8,6 +8,7 @@
 
 #include "sim/simulation.h"
 #include "trials/calibration_eval.h"
+#include "workcell/sim_cell_description.h"
 #include "workcell/workcell.h"
 
 namespace costar::cli {
@@ -125,6 +126,18 @@ struct EvalOptions {
 };
 
 int evaluate(EvalOptions options) {
+  // Only the simulated cells have a true camera pose to compare with.
+  std::string known;
+  bool simulated = false;
+  for (const auto& [name, label] : workcell::simCells()) {
+    simulated = simulated || name == options.eval.workcell;
+    known += (known.empty() ? "" : ", ") + name;
+  }
+  if (!simulated) {
+    std::cerr << "error: unknown workcell '" << options.eval.workcell
+              << "' for calibrate eval (simulated cells: " << known << ")\n";
+    return 2;
+  }
   try {
     const auto [distance, angle] = parseMove(options.camera_move);
     options.eval.camera_move_m = distance;
@@ -140,18 +153,19 @@ int evaluate(EvalOptions options) {
     }
   }
   options.eval.refine = !options.no_refine;
-  std::printf("costar calibrate eval: %d set-up(s), seeds %llu.., camera moved %.3f m and turned %.1f deg\n",
-              options.eval.setups, static_cast<unsigned long long>(options.eval.seed), options.eval.camera_move_m,
-              options.eval.camera_turn_deg);
+  std::printf("costar calibrate eval: %s, %d set-up(s), seeds %llu.., camera moved %.3f m and turned %.1f deg\n",
+              options.eval.workcell.c_str(), options.eval.setups, static_cast<unsigned long long>(options.eval.seed),
+              options.eval.camera_move_m, options.eval.camera_turn_deg);
   std::fflush(stdout);
   const trials::CalibrationEvalSummary summary =
       trials::evaluateCalibration(options.eval, [](const trials::CalibrationSample& s) {
         if (s.camera_ok) {
           std::printf(
               "set-up %d %-10s camera %.2f mm %.3f deg (drawn pose was %.1f mm %.2f deg off), marker %.2f mm "
-              "%.3f deg, simulated %.1f + %.1f s\n",
+              "%.3f deg, simulated %.1f + %.1f s, parts moved by Calibrate %.1f mm\n",
               s.setup, s.method.empty() ? "cell" : s.method.c_str(), s.camera_mm, s.camera_deg, s.camera_before_mm,
-              s.camera_before_deg, s.marker_mm, s.marker_deg, s.marker_simulated_s, s.camera_simulated_s);
+              s.camera_before_deg, s.marker_mm, s.marker_deg, s.marker_simulated_s, s.camera_simulated_s,
+              s.parts_moved_mm);
           if (s.parts > 0) {
             std::printf("  DetectObjects: %d/%d parts within 5 mm and 5 deg before Calibrate, %d/%d after\n",
                         s.parts_accurate_before, s.parts, s.parts_accurate_after, s.parts);
@@ -216,6 +230,11 @@ void addCalibrateCommand(CLI::App& app, int& exit_code) {
   auto eval_options = std::make_shared<EvalOptions>();
   CLI::App* eval = command->add_subcommand(
       "eval", "Simulation: calibrate N seeded set-ups with the camera moved, and compare with its true pose");
+  eval->add_option("-w,--workcell", eval_options->eval.workcell,
+                   "simulated workcell (workcells/NAME.json: ur5-sim, iiwa-sim)")
+      ->capture_default_str();
+  eval->add_option("--scene", eval_options->eval.scene, "scene file (default sim/scenes/assembly.json)")
+      ->check(CLI::ExistingFile);
   eval->add_option("--setups", eval_options->eval.setups, "number of set-ups")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));

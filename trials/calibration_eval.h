@@ -15,6 +15,8 @@
 namespace costar::trials {
 
 struct CalibrationEvalOptions {
+  /// The simulated workcell (workcells/NAME.json).
+  std::string workcell = "ur5-sim";
   std::filesystem::path scene;  // default: sim/scenes/assembly.json
   int setups = 20;
   std::uint64_t seed = 100;  // set-up i: seed + i
@@ -33,7 +35,7 @@ struct CalibrationEvalOptions {
   int camera_views = 0;
 };
 
-/// One calibration in one set-up.
+/// One calibration in one set-up (a cell without a simulator: a failed sample saying so).
 struct CalibrationSample {
   int setup = 0;
   std::string method;  // "" for Calibrate with the cell's marker calibration
@@ -46,6 +48,8 @@ struct CalibrationSample {
   double camera_mm = 0, camera_deg = 0;  // after Calibrate
   double marker_simulated_s = 0, camera_simulated_s = 0;
   double reprojection_rms_px = 0;
+  /// The farthest any part moved while Calibrate ran (mm, the simulator's true poses).
+  double parts_moved_mm = 0;
   /// With `perception`: parts in the scene, and those DetectObjects put within 5 mm and 5
   /// degrees of their true pose, with the drawn camera pose and after Calibrate.
   int parts = 0;

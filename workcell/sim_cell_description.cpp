@@ -69,7 +69,7 @@ SimCellDescription parse(const json& root, const std::filesystem::path& data_roo
   }
   onlyKnown(root, "",
             {"name", "label", "notes", "robot", "gripper", "robot_base", "cell_model", "scene", "waypoints", "table",
-             "workspace", "calibration"});
+             "workspace", "part_area", "calibration"});
   SimCellDescription cell;
   cell.name = text(root, "", "name");
   cell.label = text(root, "", "label");
@@ -98,6 +98,14 @@ SimCellDescription parse(const json& root, const std::filesystem::path& data_roo
   cell.workspace = Eigen::AlignedBox3d(vec3(workspace, "workspace", "min"), vec3(workspace, "workspace", "max"));
   if ((cell.workspace.min().array() >= cell.workspace.max().array()).any()) {
     fail("workspace", "min must be below max on every axis");
+  }
+  if (root.contains("part_area")) {
+    const json& area = objectAt(root, "", "part_area");
+    onlyKnown(area, "part_area", {"min", "max"});
+    cell.part_area = Eigen::AlignedBox3d(vec3(area, "part_area", "min"), vec3(area, "part_area", "max"));
+    if ((cell.part_area->min().array() >= cell.part_area->max().array()).any()) {
+      fail("part_area", "min must be below max on every axis");
+    }
   }
   return cell;
 }

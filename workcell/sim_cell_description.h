@@ -17,12 +17,17 @@
 //                    waypoints of its own (tests, trials) and none is given
 //   table            {centre [x, y, z], size [x, y, z]} (m): the table as the planner's box
 //   workspace        {min [x, y, z], max [x, y, z]} (m): where the tool may go
-//   calibration      the shipped hand-eye calibration of the gripper's marker
+//   part_area        optional {min [x, y, z], max [x, y, z]} (m): where parts may lie or stand
+//                    on the table; the arm keeps out of it while it calibrates the camera
+//                    (calibration/calibration_component.h), when no part's place is known
+//   calibration      the shipped hand-eye calibration of the gripper's marker (the marker's place
+//                    on the flange: one file per gripper and marker, whichever arm carries it)
 //
 // Paths are relative to the data root (core/paths.h). Unknown fields are refused.
 
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +49,7 @@ struct SimCellDescription {
   Eigen::Vector3d table_centre = Eigen::Vector3d::Zero();
   Eigen::Vector3d table_size = Eigen::Vector3d::Zero();
   Eigen::AlignedBox3d workspace;
+  std::optional<Eigen::AlignedBox3d> part_area;
 };
 
 /// Reads a workcell description. @throws std::runtime_error "workcell description 'FILE':

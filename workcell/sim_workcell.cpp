@@ -328,8 +328,9 @@ class SimWorkcell final : public Workcell {
     config.marker_in_flange_guess = gripper_model_.marker_in_flange_guess;
     config.solve.marker_size = sim::Simulation::kGripperMarkerSize;
     config.marker_id = sim::Simulation::kGripperMarkerId;
-    return std::make_shared<calibration::CalibrationComponent>(arm, camera, clock(), simulation_->rgbdNominalPose(),
-                                                               std::move(initial), config);
+    config.keep_out = cell_.part_area;
+    return std::make_shared<calibration::CalibrationComponent>(
+        arm, collisions_, camera, clock(), simulation_->rgbdNominalPose(), std::move(initial), config);
   }
   static Eigen::VectorXd toEigen(const sim::ArmJoints& q) { return q.eigen(); }
 

@@ -47,7 +47,8 @@ struct WorkcellOptions {
   std::optional<CameraMove> camera_move;
   /// Where the cell's calibration (calibration/) is kept (default: beside the waypoints,
   /// calibration.json; in `memory_only` mode read from here if given, never written). Without
-  /// a marker calibration there, the one shipped in data/calibration/<workcell>.json is used.
+  /// a marker calibration there, the one the cell's description names (`calibration`, e.g.
+  /// data/calibration/parallel-2f_marker.json: the marker on that gripper) is used.
   std::filesystem::path calibration;
   /// TEST ONLY: report the simulator's true part poses as object symbols in place of
   /// perception, to test SmartMove apart from perception. Never set by the CLI.

@@ -26,7 +26,7 @@ namespace costar::workcell {
 namespace {
 
 TEST(IiwaSimWorkcell, TheComposedMujocoModelAndUrdfAgree) {
-  const SimCellDescription cell = loadSimCellDescription(simCellFile("iiwa-sim"));
+  const SimCellDescription cell = loadSimCellDescription(simCellFile("iiwa-3f-sim"));
   const arm::RobotDescription iiwa = arm::loadRobotDescription(arm::robotDescriptionFile(cell.robot));
   EXPECT_EQ(cell.gripper, "robotiq3f");  // the 3-finger adaptive gripper
   const GripperModel& gripper = gripperModel(cell.gripper);
@@ -117,7 +117,7 @@ TEST_P(IiwaAdaptiveGripper, PicksAPartUpInEachMode) {
   std::ofstream(scene) << R"({"parts": [{"class": ")" << part_class << R"(", "color": ")"
                        << (part_class == "link" ? "wood" : "red") << R"(", "at": [0.5, -0.15, 30]}]})";
   const auto cell =
-      makeWorkcell({.name = "iiwa-sim", .scene = scene, .memory_only = true, .test_oracle_perception = true});
+      makeWorkcell({.name = "iiwa-3f-sim", .scene = scene, .memory_only = true, .test_oracle_perception = true});
   const std::string body = R"(<Sequence><SetMode mode=")" + mode + R"("/><SmartGrasp object_class=")" + part_class +
                            R"(" grasp=")" + mode + R"("/><Sleep msec="1000"/></Sequence>)";
   const auto plan =

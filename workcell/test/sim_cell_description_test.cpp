@@ -25,11 +25,19 @@ TEST(SimCellDescription, BothCellsLoadAndAreListed) {
   const SimCellDescription iiwa = loadSimCellDescription(simCellFile("iiwa-sim"));
   EXPECT_EQ(iiwa.robot, "iiwa14");
   EXPECT_TRUE(std::filesystem::is_regular_file(iiwa.cell_model));
+  // Both keep Calibrate's arm out of the table's part area (the scenes' "table" region with a
+  // part's reach around it).
+  ASSERT_TRUE(ur5.part_area && iiwa.part_area);
+  EXPECT_TRUE(ur5.part_area->contains(Eigen::Vector3d(0.5, -0.3, 0.05)));
+  EXPECT_FALSE(iiwa.part_area->contains(Eigen::Vector3d(0.5, -0.3, 0.2)));
+  // The marker is on the gripper, so the cells with the same gripper share its calibration.
+  EXPECT_EQ(ur5.calibration, iiwa.calibration);
+  EXPECT_EQ(ur5.calibration.filename(), "parallel-2f_marker.json");
   std::vector<std::string> names;
   for (const auto& info : knownWorkcells()) {
     names.push_back(info.name);
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"ur5-sim", "iiwa-sim", "test", "none"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"ur5-sim", "iiwa-3f-sim", "iiwa-sim", "test", "none"}));
 }
 
 class BadCellFile : public ::testing::Test {
@@ -80,6 +88,15 @@ TEST_F(BadCellFile, EachProblemNamesItsField) {
   j = good_;
   j["workspace"]["min"] = {2, 0, 0};
   EXPECT_EQ(problem(j), "workspace: min must be below max on every axis");
+  j = good_;
+  j["part_area"]["max"] = {0.8, 0.5, -0.1};
+  EXPECT_EQ(problem(j), "part_area: min must be below max on every axis");
+  j = good_;
+  j["part_area"] = {{"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"height", 1}};
+  EXPECT_EQ(problem(j).rfind("part_area.height: unknown field (known: ", 0), 0u) << problem(j);
+  j = good_;
+  j.erase("part_area");
+  EXPECT_EQ(problem(j), "no error");  // optional: nothing kept out while calibrating
   j = good_;
   j["scene"] = "sim/scenes/no_such_scene.json";
   EXPECT_EQ(problem(j).rfind("scene: no such file '", 0), 0u) << problem(j);
