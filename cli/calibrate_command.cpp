@@ -184,7 +184,9 @@ int evaluate(EvalOptions options) {
 }
 
 void addCellOptions(CLI::App* command, CalibrateOptions& options) {
-  command->add_option("-w,--workcell", options.workcell, "simulated workcell (workcells/NAME.json: ur5-sim, iiwa-sim, iiwa-3f-sim)")
+  command
+      ->add_option("-w,--workcell", options.workcell,
+                   "simulated workcell (workcells/NAME.json: ur5-sim, iiwa-sim, iiwa-3f-sim)")
       ->capture_default_str();
   command->add_option("--scene", options.scene, "scene file (default sim/scenes/assembly.json)")
       ->check(CLI::ExistingFile);
