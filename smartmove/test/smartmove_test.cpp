@@ -70,10 +70,18 @@ TEST(Grasps, OneClassHasATwoFingerAndAThreeFingerGrasp) {
   ASSERT_EQ(two.forClass("node").size(), 1u);
   EXPECT_EQ(two.defaultFor("node")->name, "top");
   EXPECT_FALSE(two.find("node", "basic").has_value());
-  // The 3-finger gripper has one grasp per mode for the same class, and none of the 2-finger's.
-  EXPECT_EQ(three.forClass("node").size(), 4u);
-  EXPECT_EQ(three.forClass("link").size(), 4u);
-  EXPECT_FALSE(three.find("node", "top").has_value());
+  // The 3-finger gripper has one grasp per mode for the same class, plus its own "top" (node)
+  // and "middle" (link), so that the UR5 plans that name them run unchanged; none of the
+  // 2-finger's.
+  EXPECT_EQ(three.forClass("node").size(), 5u);
+  EXPECT_EQ(three.forClass("link").size(), 5u);
+  for (const Grasp& grasp : three.forClass("node")) {
+    EXPECT_EQ(grasp.gripper, kAdaptiveGripper) << grasp.name;
+  }
+  ASSERT_TRUE(three.find("node", "top").has_value());
+  EXPECT_EQ(three.find("node", "top")->gripper, kAdaptiveGripper);
+  EXPECT_NE(three.find("node", "top")->tcp_in_object.translation(),
+            two.find("node", "top")->tcp_in_object.translation());
   ASSERT_TRUE(three.find("link", "scissor").has_value());
   EXPECT_EQ(three.find("link", "scissor")->gripper, kAdaptiveGripper);
   // Scissor closes fingers 1 and 2 along the tool's x: across the link (object y), not along it.
