@@ -13,7 +13,8 @@ namespace {
 
 using Key = std::tuple<std::string, std::string, std::string>;
 
-void read(const std::filesystem::path& file, std::map<Key, Grasp>& into) {
+/// Reads `file`'s grasps into `into`; `order` (when given) gets their keys in the file's order.
+void read(const std::filesystem::path& file, std::map<Key, Grasp>& into, std::vector<Key>* order = nullptr) {
   std::ifstream stream(file);
   if (!stream) {
     throw std::runtime_error("cannot open grasp file '" + file.string() + "'");
@@ -27,13 +28,23 @@ void read(const std::filesystem::path& file, std::map<Key, Grasp>& into) {
       if (grasp.gripper.empty()) {
         throw std::runtime_error("\"gripper\" must not be empty");
       }
+      if (item.contains("mode")) {
+        grasp.mode = item.at("mode").get<std::string>();
+        if (grasp.mode.empty()) {
+          throw std::runtime_error("\"mode\" must not be empty (leave it out for any mode)");
+        }
+      }
       grasp.object_class = item.at("class").get<std::string>();
       grasp.name = item.at("name").get<std::string>();
       const auto p = item.at("position").get<std::array<double, 3>>();
       const auto rpy = item.at("rpy_degrees").get<std::array<double, 3>>();
       constexpr double kDeg = M_PI / 180.0;
       grasp.tcp_in_object = world::poseFromXyzRpy(p[0], p[1], p[2], rpy[0] * kDeg, rpy[1] * kDeg, rpy[2] * kDeg);
-      into[{grasp.gripper, grasp.object_class, grasp.name}] = grasp;
+      Key key{grasp.gripper, grasp.object_class, grasp.name};
+      if (order != nullptr && into.count(key) == 0) {
+        order->push_back(key);
+      }
+      into[key] = grasp;
       ++index;
     }
   } catch (const std::exception& e) {
@@ -46,7 +57,7 @@ void read(const std::filesystem::path& file, std::map<Key, Grasp>& into) {
 GraspLibrary::GraspLibrary(const std::filesystem::path& defaults_file, std::filesystem::path taught_file,
                            std::string gripper)
     : taught_file_(std::move(taught_file)), gripper_(std::move(gripper)) {
-  read(defaults_file, defaults_);
+  read(defaults_file, defaults_, &default_order_);
   if (!taught_file_.empty() && std::filesystem::exists(taught_file_)) {
     read(taught_file_, taught_);
   }
@@ -63,11 +74,14 @@ std::optional<Grasp> GraspLibrary::find(const std::string& object_class, const s
 }
 
 std::optional<Grasp> GraspLibrary::defaultFor(const std::string& object_class) const {
-  for (const auto* source : {&defaults_, &taught_}) {
-    for (const auto& [key, grasp] : *source) {
-      if (std::get<0>(key) == gripper_ && std::get<1>(key) == object_class) {
-        return find(object_class, std::get<2>(key));
-      }
+  for (const Key& key : default_order_) {  // the class's first in the defaults file
+    if (std::get<0>(key) == gripper_ && std::get<1>(key) == object_class) {
+      return find(object_class, std::get<2>(key));
+    }
+  }
+  for (const auto& [key, grasp] : taught_) {
+    if (std::get<0>(key) == gripper_ && std::get<1>(key) == object_class) {
+      return find(object_class, std::get<2>(key));
     }
   }
   return std::nullopt;
@@ -120,6 +134,9 @@ void GraspLibrary::teach(const Grasp& taught) {
                            {"rpy_degrees", {rpy.x(), rpy.y(), rpy.z()}}};
     if (g.gripper != kParallelGripper) {  // files of the 2-finger gripper stay as they were
       item["gripper"] = g.gripper;
+    }
+    if (!g.mode.empty()) {
+      item["mode"] = g.mode;
     }
     json["grasps"].push_back(item);
   }

@@ -29,6 +29,9 @@ struct Grasp {
   world::Pose tcp_in_object = world::Pose::Identity();
   /// Which gripper it is for; empty in teach(): the library's gripper.
   std::string gripper;
+  /// The gripper mode the grasp needs ("pinch", "basic", ...: the gripper's SetMode names);
+  /// SmartGrasp sets it while the fingers are open. Empty: whatever mode the gripper is in.
+  std::string mode;
 };
 
 class GraspLibrary {
@@ -56,6 +59,7 @@ class GraspLibrary {
   std::filesystem::path taught_file_;
   std::string gripper_;
   std::map<Key, Grasp> defaults_;
+  std::vector<Key> default_order_;  ///< the defaults file's order (defaultFor)
   std::map<Key, Grasp> taught_;
 };
 

@@ -767,12 +767,23 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
   steps.push_back({"open the gripper",
                    [this, opening] { return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening)); },
                    nullptr});
+  if (!grasp->mode.empty()) {
+    // The grasp was taught in this mode: the fingers are open now, the only time it can change.
+    steps.push_back({"set the gripper to " + grasp->mode + " mode",
+                     [this, mode = grasp->mode] {
+                       component::ParamMap params;
+                       params["mode"] = mode;
+                       return std::make_unique<ComponentStep>(gripper_, "SetMode", params);
+                     },
+                     nullptr});
+  }
   steps.push_back({"move above " + object,
                    [this, pregrasp, chosen, speed] {
                      return moveToFreeConfiguration(pregrasp, chosen.solutions.front(), speed, "pre-grasp",
                                                     "no collision-free pre-grasp");
                    },
                    nullptr});
+  const std::size_t approach_step = steps.size();
   steps.push_back({"approach " + object,
                    [this, chosen, object] {
                      return follow(
@@ -781,9 +792,7 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
                    },
                    nullptr});
   steps.push_back({"close on " + object,
-                   [this] {
-                     return std::make_unique<ComponentStep>(gripper_, "Close", closeParams(gripper_, 40.0));
-                   },
+                   [this] { return std::make_unique<ComponentStep>(gripper_, "Close", closeParams(gripper_, 40.0)); },
                    [this, object, object_class, object_pose, chosen, opening,
                     centring](const OperationResult& result) -> std::string {
                      if (!result.data.value("holding", false)) {
@@ -829,9 +838,7 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
                      line([rise](const world::Pose& tcp) { return up(-rise) * tcp; }, "approach"), nullptr});
     steps.push_back(
         {"close again on " + object,
-         [this] {
-           return std::make_unique<ComponentStep>(gripper_, "Close", closeParams(gripper_, 40.0));
-         },
+         [this] { return std::make_unique<ComponentStep>(gripper_, "Close", closeParams(gripper_, 40.0)); },
          [this, object, object_class, object_pose, chosen, centring](const OperationResult& result) -> std::string {
            if (!result.data.value("holding", false)) {
              return "the fingers closed on nothing: " + object + " was lost while squaring it up";
@@ -862,7 +869,6 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
   // (from down there every motion would start in collision with the part as it was seen).
   // Opening may fail (a finger that landed on the moved part, pressed against it); lifting
   // straight up is what gets the tool clear, so it runs all the same.
-  const std::size_t approach_step = 2;
   auto script = std::make_unique<Script>(std::move(steps), data, nullptr);
   script->backOff(
       approach_step, last_close,
@@ -1091,8 +1097,17 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginTeachGrasp(const comp
                   "around one");
   }
   const world::Pose relative = snapToCanonical(nearest->second.inverse() * tool, *object);
+  Grasp taught{object_class, text("grasp"), relative, {}, {}};
+  if (grasps_.gripper() != kParallelGripper) {  // a gripper with modes: the grasp needs the one it was taught in
+    for (const char* mode : {"basic", "pinch", "wide", "scissor"}) {
+      const std::string args[] = {mode};
+      if (world_.holds("gripper_mode", args)) {
+        taught.mode = mode;
+      }
+    }
+  }
   try {
-    grasps_.teach({object_class, text("grasp"), relative});
+    grasps_.teach(taught);
   } catch (const std::exception& e) {
     return failed(std::string("cannot save the grasp: ") + e.what());
   }

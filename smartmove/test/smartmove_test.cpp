@@ -80,10 +80,24 @@ TEST(Grasps, OneClassHasATwoFingerAndAThreeFingerGrasp) {
   }
   ASSERT_TRUE(three.find("node", "top").has_value());
   EXPECT_EQ(three.find("node", "top")->gripper, kAdaptiveGripper);
-  EXPECT_NE(three.find("node", "top")->tcp_in_object.translation(),
-            two.find("node", "top")->tcp_in_object.translation());
+  EXPECT_NE(three.find("link", "middle")->tcp_in_object.translation(),
+            two.find("link", "middle")->tcp_in_object.translation());
   ASSERT_TRUE(three.find("link", "scissor").has_value());
   EXPECT_EQ(three.find("link", "scissor")->gripper, kAdaptiveGripper);
+  // Each 3-finger grasp names the mode it needs (SmartGrasp sets it while the fingers are open);
+  // "top" and "middle" are fingertip (Pinch) grasps: an encompassing Basic grasp pulls the part
+  // toward the palm and the held transform no longer holds. The 2-finger grasps need none.
+  for (const char* name : {"basic", "pinch", "wide", "scissor"}) {
+    EXPECT_EQ(three.find("node", name)->mode, name);
+    EXPECT_EQ(three.find("link", name)->mode, name);
+  }
+  EXPECT_EQ(three.find("node", "top")->mode, "pinch");
+  // A plan that names no grasp gets the class's first in the file: the Pinch one for 3 fingers.
+  EXPECT_EQ(three.defaultFor("node")->name, "top");
+  EXPECT_EQ(three.defaultFor("link")->name, "middle");
+  EXPECT_EQ(three.find("link", "middle")->mode, "pinch");
+  EXPECT_TRUE(two.find("node", "top")->mode.empty());
+  EXPECT_TRUE(two.find("link", "middle")->mode.empty());
   // Scissor closes fingers 1 and 2 along the tool's x: across the link (object y), not along it.
   const Eigen::Vector3d closing = three.find("link", "scissor")->tcp_in_object.linear().col(0);
   EXPECT_NEAR(std::abs(closing.y()), 1.0, 1e-9);
@@ -97,7 +111,7 @@ TEST(Grasps, TeachingKeepsTheOtherGrippersGraspsAndOldFilesStayValid) {
   {
     GraspLibrary three(dataRoot() / "data/grasps.json", file, kAdaptiveGripper);
     EXPECT_FALSE(three.find("node", "edge").has_value());
-    three.teach({"node", "corner", world::poseFromXyzRpy(0.01, 0, 0, M_PI, 0, 0)});
+    three.teach({"node", "corner", world::poseFromXyzRpy(0.01, 0, 0, M_PI, 0, 0), {}, "wide"});
   }
   const GraspLibrary two(dataRoot() / "data/grasps.json", file);
   EXPECT_TRUE(two.find("node", "edge").has_value());  // still there after the 3-finger teach
@@ -105,6 +119,8 @@ TEST(Grasps, TeachingKeepsTheOtherGrippersGraspsAndOldFilesStayValid) {
   const GraspLibrary three(dataRoot() / "data/grasps.json", file, kAdaptiveGripper);
   ASSERT_TRUE(three.find("node", "corner").has_value());
   EXPECT_NEAR(three.find("node", "corner")->tcp_in_object.translation().x(), 0.01, 1e-12);
+  EXPECT_EQ(three.find("node", "corner")->mode, "wide");  // the mode it was taught in, saved
+  EXPECT_TRUE(two.find("node", "edge")->mode.empty());
   // The 2-finger entry is written back without a "gripper" field, as before.
   std::ifstream in(file);
   const nlohmann::json saved = nlohmann::json::parse(in);
@@ -126,6 +142,15 @@ TEST(Grasps, ABadEntryNamesTheFileAndTheEntry) {
     EXPECT_NE(std::string(e.what()).find("costar_grasps_bad_test.json': grasps[1]: \"gripper\" must not be empty"),
               std::string::npos)
         << e.what();
+  }
+  std::ofstream(file)
+      << R"({"grasps": [{"gripper": "robotiq3f", "mode": "", "class": "node", "name": "a", "position": [0, 0, 0],)"
+         R"( "rpy_degrees": [0, 0, 0]}]})";
+  try {
+    GraspLibrary library(file, {}, kAdaptiveGripper);
+    ADD_FAILURE() << "accepted an empty mode";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("grasps[0]: \"mode\" must not be empty"), std::string::npos) << e.what();
   }
   std::filesystem::remove(file);
 }

@@ -118,7 +118,9 @@ TEST_P(IiwaAdaptiveGripper, PicksAPartUpInEachMode) {
                        << (part_class == "link" ? "wood" : "red") << R"(", "at": [0.5, -0.15, 30]}]})";
   const auto cell =
       makeWorkcell({.name = "iiwa-3f-sim", .scene = scene, .memory_only = true, .test_oracle_perception = true});
-  const std::string body = R"(<Sequence><SetMode mode=")" + mode + R"("/><SmartGrasp object_class=")" + part_class +
+  // The gripper starts in another mode: SmartGrasp sets the one its grasp was taught in.
+  const std::string other = mode == "wide" ? "basic" : "wide";
+  const std::string body = R"(<Sequence><SetMode mode=")" + other + R"("/><SmartGrasp object_class=")" + part_class +
                            R"(" grasp=")" + mode + R"("/><Sleep msec="1000"/></Sequence>)";
   const auto plan =
       bt::loadPlanText(R"(<root BTCPP_format="4"><BehaviorTree ID="m">)" + body + "</BehaviorTree></root>", "mode.xml");
