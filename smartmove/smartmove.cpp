@@ -178,13 +178,14 @@ world::Pose up(double metres) { return world::Pose(Eigen::Translation3d(0, 0, me
 /// of the grasp it checks), and back as they were once the plan is made.
 class SmartMoveComponent::PlannedFingers {
  public:
-  explicit PlannedFingers(SmartMoveComponent& self) : self_(self) {
-    if (self_.config_.fingers) {
+  explicit PlannedFingers(SmartMoveComponent& self)
+      : self_(self), modelled_(self_.config_.fingers || !self_.config_.mode_fingers.empty()) {
+    if (modelled_) {
       saved_ = self_.collisions_.linkShapes(self_.config_.finger_link);
     }
   }
   ~PlannedFingers() {
-    if (self_.config_.fingers) {
+    if (modelled_) {
       self_.collisions_.setLinkShapes(self_.config_.finger_link, saved_);
     }
   }
@@ -198,8 +199,12 @@ class SmartMoveComponent::PlannedFingers {
     }
   }
 
+  /// The open fingers of gripper mode `mode` (SmartGrasp turns the gripper to it first).
+  void inMode(const std::string& mode) const { self_.fingersInMode(mode); }
+
  private:
   SmartMoveComponent& self_;
+  bool modelled_;
   std::vector<planning::CollisionShape> saved_;
   mutable double opening_ = -1.0;
 };
@@ -400,6 +405,12 @@ void SmartMoveComponent::syncFingers(double opening) {
   }
 }
 
+void SmartMoveComponent::fingersInMode(const std::string& mode) {
+  if (const auto it = config_.mode_fingers.find(mode); it != config_.mode_fingers.end()) {
+    collisions_.setLinkShapes(config_.finger_link, it->second);
+  }
+}
+
 component::ParamMap SmartMoveComponent::openParams(double opening) const {
   component::ParamMap params = gripperDefaults(gripper_, "Open");  // fully, unless the fingers' geometry says how far
   if (config_.fingers && opening > 0.0) {
@@ -481,7 +492,7 @@ void addRejected(Selection& selection, const SmartMoveComponent::Matches& matche
 
 Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
                                           const std::vector<predicator::Pattern>& patterns, const world::Pose& grasp,
-                                          double approach, double speed) {
+                                          double approach, double speed, const std::string& mode) {
   const bool with_approach = approach > 0.0;
   const world::ObjectClass* object = objectClass(object_class);
   if (object == nullptr) {
@@ -493,6 +504,9 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
   const Matches matches = matching(object_class, patterns);
   const arm::JointVector now = motion_.joints();
   const PlannedFingers fingers(*this);
+  if (with_approach && !mode.empty()) {
+    fingers.inMode(mode);
+  }
   const FeasibilityCheck feasible = [&](Candidate& candidate) -> std::string {
     const auto object_pose = world_.worldPose(candidate.object);
     const auto opening = graspOpening(candidate.goal, *object_pose, *object);
@@ -731,7 +745,8 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
     return failed("the gripper already holds " + *held_ + ": release it first");
   }
   const double approach = grasping ? params.at("approach").asDouble() : 0.0;
-  Selection selection = selectGrasp(object_class, patterns, grasp->tcp_in_object, approach, speed);
+  Selection selection =
+      selectGrasp(object_class, patterns, grasp->tcp_in_object, approach, speed, grasping ? grasp->mode : "");
   nlohmann::json data = selection.toJson();
   if (!selection.ok()) {
     return failed("no feasible " + object_class + ": " + selection.failure, data);
@@ -777,15 +792,19 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
                      },
                      nullptr});
   }
+  // The fingers are planned in the grasp's mode from here on (the cell's own sync follows once
+  // the gripper reports the mode).
   steps.push_back({"move above " + object,
-                   [this, pregrasp, chosen, speed] {
+                   [this, pregrasp, chosen, speed, mode = grasp->mode] {
+                     fingersInMode(mode);
                      return moveToFreeConfiguration(pregrasp, chosen.solutions.front(), speed, "pre-grasp",
                                                     "no collision-free pre-grasp");
                    },
                    nullptr});
   const std::size_t approach_step = steps.size();
   steps.push_back({"approach " + object,
-                   [this, chosen, object] {
+                   [this, chosen, object, mode = grasp->mode] {
+                     fingersInMode(mode);
                      return follow(
                          motion_.planLine(motion_.joints(), chosen.goal, config_.approach_speed, touching({object})),
                          "approach");

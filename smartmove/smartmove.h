@@ -35,6 +35,7 @@
 // Predicate: holding(o) — the gripper holds part o (grasped by SmartGrasp, and still squeezing).
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -77,6 +78,10 @@ struct SmartMoveConfig {
   /// finger shapes stay and the gripper opens fully.
   std::optional<gripper::FingerGeometry> fingers;
   std::string finger_link = "fingers";
+  /// A gripper with modes (the 3-finger gripper): the open fingers' shapes in each mode (by the
+  /// name SetMode takes), in the finger link's frame. A grasp that needs a mode is planned with
+  /// that mode's fingers, before SmartGrasp has turned the gripper to it.
+  std::map<std::string, std::vector<planning::CollisionShape>> mode_fingers;
   /// m added to the part's width between the fingers: covers perception error (a few mm, a few
   /// degrees of yaw) and the fingers' tracking.
   double grasp_margin = 0.016;
@@ -151,8 +156,9 @@ class SmartMoveComponent final : public component::TableComponent {
                    const std::string& exclude = {}) const;
 
   /// The candidate search of SmartMove (approach 0) and SmartGrasp (no motion).
+  /// `mode`: the gripper mode the grasp needs (its fingers are planned so; empty: as they are).
   Selection selectGrasp(const std::string& object_class, const std::vector<predicator::Pattern>& patterns,
-                        const world::Pose& grasp, double approach, double speed);
+                        const world::Pose& grasp, double approach, double speed, const std::string& mode = {});
 
  private:
   // The operations' handlers (one table, declared in the constructor).
@@ -179,6 +185,9 @@ class SmartMoveComponent final : public component::TableComponent {
   /// `centred` (none feasible) with the shifted grasps of its candidates tried after it.
   Selection withShiftedGrasps(Selection centred, const world::ObjectClass& object_class,
                               const FeasibilityCheck& feasible);
+  /// Puts the fingers' shapes of gripper mode `mode` in the collision world (nothing when the
+  /// mode's fingers are not given): before planning a motion the gripper makes in that mode.
+  void fingersInMode(const std::string& mode);
   /// Shapes of the fingers at `opening`, in the finger link's frame.
   std::vector<planning::CollisionShape> fingerShapes(double opening) const;
   /// The Open operation's parameters: at `opening` when the fingers are modelled, else fully.

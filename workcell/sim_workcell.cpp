@@ -200,6 +200,12 @@ class SimWorkcell final : public Workcell {
     smartmove::SmartMoveConfig smartmove_config;
     smartmove_config.gripper_links = gripperLinks(robot_description_, gripper_model_);
     smartmove_config.fingers = gripper_model_.fingers;
+    if (adaptive_) {
+      smartmove_config.finger_link = gripper_model_.finger_link;
+      for (const gripper::GripperMode mode : gripper::kGripperModes) {
+        smartmove_config.mode_fingers[std::string(gripper::toString(mode))] = adaptiveFingerShapes(mode);
+      }
+    }
     smartmove_ =
         std::make_shared<smartmove::SmartMoveComponent>(*motion_, *arm, *gripper, components().world(), collisions_,
                                                         simulation_->objectClasses(), grasps_, smartmove_config);
@@ -252,6 +258,12 @@ class SimWorkcell final : public Workcell {
     if (synced_mode_ == mode) {
       return;
     }
+    collisions_.setLinkShapes(gripper_model_.finger_link, adaptiveFingerShapes(mode));
+    synced_mode_ = mode;
+  }
+
+  /// The adaptive gripper's open fingers in `mode`, as collision shapes of the finger link.
+  std::vector<planning::CollisionShape> adaptiveFingerShapes(gripper::GripperMode mode) const {
     std::vector<planning::CollisionShape> shapes;
     for (const gripper::OrientedBox& box : gripper::openFingerBoxes(*adaptive_, mode)) {
       planning::CollisionShape shape;
@@ -260,8 +272,7 @@ class SimWorkcell final : public Workcell {
       shape.origin = box.pose;
       shapes.push_back(shape);
     }
-    collisions_.setLinkShapes(gripper_model_.finger_link, shapes);
-    synced_mode_ = mode;
+    return shapes;
   }
 
   /// A plan's predicate pattern names a declared predicate with the right number of arguments,

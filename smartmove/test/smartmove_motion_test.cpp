@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include <nlohmann/json.hpp>
 
 #include "arm/motion_planner.h"
@@ -90,9 +93,15 @@ class InstantGripper final : public component::TableComponent {
         return std::make_unique<component::FinishedOperation>(OperationResult::success({{"holding", true}}));
       });
     }
+    operations.add({"SetMode", "", {{"mode", component::ValueType::kString, "", std::string("pinch")}}},
+                   [this](const component::ParamMap& params) {
+                     modes.push_back(params.at("mode").asString());
+                     return std::make_unique<component::FinishedOperation>(OperationResult::success());
+                   });
     declare(std::move(description), std::move(operations));
   }
   world::Report report() const override { return {}; }
+  std::vector<std::string> modes;  // SetMode's, in order
 };
 
 /// The cell's motion service, with every planning query and the contacts it allowed recorded.
@@ -235,6 +244,44 @@ TEST_F(SmartMoveMotion, EachQueryIsGivenTheContactsItAllows) {
   EXPECT_EQ(remote.path(1).front(), remote.path(0).back());
   smartmove.cancel(id);
   EXPECT_TRUE(remote.motions[1]->cancelled);
+}
+
+TEST_F(SmartMoveMotion, AGraspThatNeedsAModeIsPlannedWithThatModesFingersAndSetsIt) {
+  const auto file = std::filesystem::temp_directory_path() / "costar_mode_grasps_test.json";
+  std::ofstream(file)
+      << R"({"grasps": [)"
+         R"({"class": "node", "name": "pinched", "mode": "pinch", "position": [0, 0, 0.005], "rpy_degrees": [180, 0, 0]},)"
+         R"({"class": "node", "name": "widened", "mode": "wide", "position": [0, 0, 0.005], "rpy_degrees": [180, 0, 0]}]})";
+  GraspLibrary library(file, {});
+  std::filesystem::remove(file);
+  SmartMoveConfig config = smartmoveConfig();
+  config.finger_link = "wrist_3_link";  // a link of the arm-only model with shapes
+  // Pinch's fingers, here a slab 80 cm thick round the wrist: at every candidate it would be in
+  // the table.
+  planning::CollisionShape slab;
+  slab.size = Eigen::Vector3d(1.0, 1.0, 0.8);
+  config.mode_fingers["pinch"] = {slab};
+  const std::size_t shapes_before = collisions.linkShapes(config.finger_link).size();
+  SmartMoveComponent moded(motion, remote, gripper, world, collisions,
+                           world::loadObjectClasses(dataRoot() / "data/objects"), library, config);
+
+  const auto refused =
+      moded.start("SmartGrasp", params("SmartGrasp", {{"object_class", "node"}, {"grasp", "pinched"}}));
+  const OperationResult result = moded.poll(refused);
+  ASSERT_EQ(result.state, OperationState::kFailure);
+  EXPECT_NE(result.reason.find("collision at the goal"), std::string::npos) << result.reason;
+  EXPECT_TRUE(remote.motions.empty());
+  EXPECT_TRUE(gripper.modes.empty());
+  // The fingers are as they were once the choice is made.
+  EXPECT_EQ(collisions.linkShapes(config.finger_link).size(), shapes_before);
+
+  // A mode whose fingers are not given: planned with the fingers as they are; the gripper is
+  // opened, then set to the grasp's mode before the arm moves.
+  const auto id = moded.start("SmartGrasp", params("SmartGrasp", {{"object_class", "node"}, {"grasp", "widened"}}));
+  ASSERT_EQ(moded.poll(id).state, OperationState::kRunning);
+  EXPECT_EQ(gripper.modes, std::vector<std::string>{"wide"});
+  ASSERT_EQ(remote.motions.size(), 1u);
+  moded.cancel(id);
 }
 
 }  // namespace
