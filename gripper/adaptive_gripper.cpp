@@ -201,12 +201,31 @@ AdaptiveGripper::AdaptiveGripper(AdaptiveGripperDriver& driver, const Clock& clo
   }
   // One table: each operation declared with its handler.
   component::OperationTable operations;
-  operations.add({"Open", "Opens every finger fully.", {speed}},
-                 [this](const component::ParamMap& params) -> std::unique_ptr<component::RunningOperation> {
-                   return std::make_unique<FingerMotion>(*this, driver_, clock_, std::array<double, kFingerCount>{},
-                                                         params.at("speed").asDouble(), options_.force,
-                                                         options_.timeout, false);
-                 });
+  ParamSpec position{"position", ValueType::kDouble,
+                     "how far closed the mode's closing fingers stop (0: fully open; above 0 only in a fingertip "
+                     "mode, whose fingers stay straight: Pinch)",
+                     0.0};
+  position.min = 0.0;
+  position.max = 0.9;
+  operations.add(
+      {"Open", "Opens the fingers: fully, or to a position part way in a fingertip mode.", {speed, position}},
+      [this](const component::ParamMap& params) -> std::unique_ptr<component::RunningOperation> {
+        const double part_way = params.at("position").asDouble();
+        std::array<double, kFingerCount> targets{};
+        if (part_way > 0.0) {
+          const AdaptiveGripperReading reading = checkedRead();
+          const AdaptiveModeDescription& mode = gripper_.mode(reading.mode);
+          if (!mode.fingertip) {
+            throw std::invalid_argument("Open to " + percent(part_way) + " closed: only in a fingertip mode (pinch); " +
+                                        "the gripper is in " + std::string(toString(reading.mode)) + " mode");
+          }
+          for (std::size_t i = 0; i < targets.size(); ++i) {
+            targets[i] = mode.closing[i] ? part_way : 0.0;
+          }
+        }
+        return std::make_unique<FingerMotion>(*this, driver_, clock_, targets, params.at("speed").asDouble(),
+                                              options_.force, options_.timeout, false);
+      });
   operations.add(
       {"Close", "Closes the fingers of the current mode until each stops on the part or closes fully.", {speed, force}},
       [this](const component::ParamMap& params) -> std::unique_ptr<component::RunningOperation> {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -120,6 +121,7 @@ AdaptiveGripperDescription loadAdaptiveGripperDescription(const std::filesystem:
         std::max(description.finger_thickness, fields.number(phalanges[i], "thickness", field));
   }
   description.open_lean_deg = std::max(0.0, -fields.number(phalanges[0], "lower_deg", "phalanges[0]"));
+  description.proximal_upper_deg = fields.number(phalanges[0], "upper_deg", "phalanges[0]");
   const auto& actuation = fields.at(root, "actuation", "");
   description.max_force = fields.number(actuation, "max_force_n", "actuation");
   description.lever = fields.number(actuation, "lever_m", "actuation");
@@ -188,9 +190,23 @@ AdaptiveGripperDescription loadAdaptiveGripperDescription(const std::filesystem:
 }
 
 std::vector<OrientedBox> openFingerBoxes(const AdaptiveGripperDescription& description, GripperMode mode) {
+  return fingerBoxesAt(description, mode, 0.0);
+}
+
+std::vector<OrientedBox> fingerBoxesAt(const AdaptiveGripperDescription& description, GripperMode mode,
+                                       double position) {
   constexpr double kDeg = M_PI / 180.0;
   constexpr double kKnuckle = 0.012;  // the knuckle's radius, behind the finger's base
-  const double scissor = description.mode(mode).scissor_deg * kDeg;
+  const AdaptiveModeDescription& mode_description = description.mode(mode);
+  if (!(position >= 0.0 && position <= 1.0) || (position > 0.0 && !mode_description.fingertip)) {
+    throw std::invalid_argument("finger boxes at " + std::to_string(position) + " in " + std::string(toString(mode)) +
+                                " mode: only a fingertip mode's fingers are modelled closed part way (0 .. 1)");
+  }
+  const double scissor = mode_description.scissor_deg * kDeg;
+  // The proximal joint from its lower limit (open, leaning out) toward its upper one; the
+  // finger straight beyond it. Leaning out is a turn about the finger's +x axis.
+  const double proximal_deg =
+      -description.open_lean_deg + position * (description.proximal_upper_deg + description.open_lean_deg);
   std::vector<OrientedBox> boxes;
   for (const AdaptiveFingerPlacement& finger : description.fingers) {
     // Knuckle frame, turned on the scissor axis, then the open finger leaning out (away from
@@ -198,7 +214,7 @@ std::vector<OrientedBox> openFingerBoxes(const AdaptiveGripperDescription& descr
     const Eigen::Isometry3d frame = Eigen::Translation3d(finger.base) *
                                     Eigen::AngleAxisd(finger.yaw_deg * kDeg, Eigen::Vector3d::UnitZ()) *
                                     Eigen::AngleAxisd(finger.scissor_sign * scissor, Eigen::Vector3d::UnitZ()) *
-                                    Eigen::AngleAxisd(description.open_lean_deg * kDeg, Eigen::Vector3d::UnitX());
+                                    Eigen::AngleAxisd(-proximal_deg * kDeg, Eigen::Vector3d::UnitX());
     OrientedBox box;
     const double length = description.finger_length + kKnuckle + 0.001;
     box.pose = frame * Eigen::Translation3d(0, 0, length / 2 - kKnuckle);
@@ -206,6 +222,40 @@ std::vector<OrientedBox> openFingerBoxes(const AdaptiveGripperDescription& descr
     boxes.push_back(box);
   }
   return boxes;
+}
+
+double fingertipClearance(const AdaptiveGripperDescription& description, GripperMode mode, double position) {
+  const std::vector<OrientedBox> boxes = fingerBoxesAt(description, mode, position);
+  const auto& closing = description.mode(mode).closing;
+  double clear = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    if (!closing[i]) {
+      continue;
+    }
+    // The box's corners at its far end (the fingertip): the nearest one to the axis, across.
+    const Eigen::Vector3d half = boxes[i].size / 2;
+    for (const double x : {-half.x(), half.x()}) {
+      for (const double y : {-half.y(), half.y()}) {
+        clear = std::min(clear, std::abs((boxes[i].pose * Eigen::Vector3d(x, y, half.z())).y()));
+      }
+    }
+  }
+  return clear;
+}
+
+double fingertipPositionFor(const AdaptiveGripperDescription& description, GripperMode mode, double half_width) {
+  if (!description.mode(mode).fingertip) {
+    return 0.0;
+  }
+  double best = 0.0;
+  for (int step = 1; step <= 100; ++step) {
+    const double position = step / 100.0;
+    if (fingertipClearance(description, mode, position) < half_width) {
+      break;
+    }
+    best = position;
+  }
+  return best;
 }
 
 }  // namespace costar::gripper

@@ -46,7 +46,8 @@ struct AdaptiveGripperDescription {
   double finger_length = 0.0;                                   // m: the three phalanges, knuckle to fingertip
   double finger_width = 0.0;                                    // m
   double finger_thickness = 0.0;                                // m, pad included
-  double open_lean_deg = 0.0;  // how far an open finger leans out (the proximal joint's lower limit, negated)
+  double open_lean_deg = 0.0;       // how far an open finger leans out (the proximal joint's lower limit, negated)
+  double proximal_upper_deg = 0.0;  // the proximal joint's upper limit: a fingertip mode's finger fully closed
   std::map<GripperMode, AdaptiveModeDescription> modes;
   double min_force = 0.0;                         // N per finger: the least grip the servos hold steadily
   double max_force = 0.0;                         // N per finger
@@ -70,5 +71,22 @@ AdaptiveGripperDescription loadAdaptiveGripperDescription(const std::filesystem:
 /// clear of neighbours when the gripper comes down open. Closing fingers move inward, into the
 /// grasp.
 std::vector<OrientedBox> openFingerBoxes(const AdaptiveGripperDescription& description, GripperMode mode);
+
+/// The fingers in `mode` stopped at `position` (0 open .. 1 closed, the driver's units), as
+/// openFingerBoxes. Only a fingertip mode's fingers stay straight as they close (the proximal
+/// joint turns from its lower to its upper limit); in the other modes they curl, and only open
+/// fingers (position 0) are modelled: @throws std::invalid_argument for another position there.
+std::vector<OrientedBox> fingerBoxesAt(const AdaptiveGripperDescription& description, GripperMode mode,
+                                       double position);
+
+/// Half the clear width between the closing fingers' tips (m, along the flange's y, from its z
+/// axis) with the fingers at `position` in `mode` (a fingertip mode for positions above 0).
+double fingertipClearance(const AdaptiveGripperDescription& description, GripperMode mode, double position);
+
+/// The most closed position (0 .. 1, in steps of 0.01) at which the fingertips in `mode` leave
+/// at least `half_width` (m) clear either side of the flange's z axis: how far to close the
+/// fingers before going down round a part among neighbours. 0 (fully open) in a mode that is
+/// not a fingertip mode, or when even open fingers leave less.
+double fingertipPositionFor(const AdaptiveGripperDescription& description, GripperMode mode, double half_width);
 
 }  // namespace costar::gripper

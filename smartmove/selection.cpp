@@ -114,6 +114,9 @@ nlohmann::json Selection::toJson() const {
     if (!candidate.rejected.empty()) {
       item["rejected"] = candidate.rejected;
     }
+    if (candidate.finger_position > 0.0) {
+      item["finger_position"] = candidate.finger_position;
+    }
     list.push_back(std::move(item));
   }
   nlohmann::json json = {{"candidates", std::move(list)}, {"seconds", seconds}};

@@ -39,6 +39,9 @@ struct Candidate {
   double cost = std::numeric_limits<double>::infinity();
   std::string rejected;  // why not; empty for the chosen one
   bool chosen = false;
+  /// How far the fingers close before the approach (0 open .. 1, the gripper's units): above 0
+  /// for a fingertip grasp that clears its neighbours only with the fingers closed part way.
+  double finger_position = 0.0;
 };
 
 struct Selection {

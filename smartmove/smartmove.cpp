@@ -179,7 +179,7 @@ world::Pose up(double metres) { return world::Pose(Eigen::Translation3d(0, 0, me
 class SmartMoveComponent::PlannedFingers {
  public:
   explicit PlannedFingers(SmartMoveComponent& self)
-      : self_(self), modelled_(self_.config_.fingers || !self_.config_.mode_fingers.empty()) {
+      : self_(self), modelled_(self_.config_.fingers || self_.config_.mode_fingers) {
     if (modelled_) {
       saved_ = self_.collisions_.linkShapes(self_.config_.finger_link);
     }
@@ -199,8 +199,8 @@ class SmartMoveComponent::PlannedFingers {
     }
   }
 
-  /// The open fingers of gripper mode `mode` (SmartGrasp turns the gripper to it first).
-  void inMode(const std::string& mode) const { self_.fingersInMode(mode); }
+  /// The fingers of gripper mode `mode` at `position` (SmartGrasp turns the gripper to it first).
+  void inMode(const std::string& mode, double position = 0.0) const { self_.fingersInMode(mode, position); }
 
  private:
   SmartMoveComponent& self_;
@@ -405,10 +405,27 @@ void SmartMoveComponent::syncFingers(double opening) {
   }
 }
 
-void SmartMoveComponent::fingersInMode(const std::string& mode) {
-  if (const auto it = config_.mode_fingers.find(mode); it != config_.mode_fingers.end()) {
-    collisions_.setLinkShapes(config_.finger_link, it->second);
+void SmartMoveComponent::fingersInMode(const std::string& mode, double position) {
+  if (!config_.mode_fingers || mode.empty()) {
+    return;
   }
+  std::vector<planning::CollisionShape> shapes = config_.mode_fingers->shapes(mode, position);
+  if (!shapes.empty()) {
+    collisions_.setLinkShapes(config_.finger_link, std::move(shapes));
+  }
+}
+
+double SmartMoveComponent::partHalfWidth(const world::Pose& tcp, const world::Pose& object,
+                                         const world::ObjectClass& object_class) {
+  // The part's bounding box in the tool's frame: its extent along y, either side of the TCP.
+  const Eigen::AlignedBox3d bounds = object_class.bounds();
+  const world::Pose part_in_tool = tcp.inverse() * object;
+  double half = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d p = part_in_tool * bounds.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+    half = std::max(half, std::abs(p.y()));
+  }
+  return half;
 }
 
 component::ParamMap SmartMoveComponent::openParams(double opening) const {
@@ -425,14 +442,7 @@ std::optional<double> SmartMoveComponent::graspOpening(const world::Pose& tcp, c
     return 0.0;
   }
   const double stroke = config_.fingers->max_opening;
-  // The part's bounding box in the tool's frame: its extent along y, either side of the TCP.
-  const Eigen::AlignedBox3d bounds = object_class.bounds();
-  const world::Pose part_in_tool = tcp.inverse() * object;
-  double half = 0.0;
-  for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d p = part_in_tool * bounds.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
-    half = std::max(half, std::abs(p.y()));
-  }
+  const double half = partHalfWidth(tcp, object, object_class);
   if (2.0 * half > stroke) {
     return std::nullopt;
   }
@@ -504,10 +514,11 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
   const Matches matches = matching(object_class, patterns);
   const arm::JointVector now = motion_.joints();
   const PlannedFingers fingers(*this);
-  if (with_approach && !mode.empty()) {
+  const bool in_mode = with_approach && !mode.empty() && config_.mode_fingers;
+  if (in_mode) {
     fingers.inMode(mode);
   }
-  const FeasibilityCheck feasible = [&](Candidate& candidate) -> std::string {
+  const FeasibilityCheck check = [&](Candidate& candidate) -> std::string {
     const auto object_pose = world_.worldPose(candidate.object);
     const auto opening = graspOpening(candidate.goal, *object_pose, *object);
     if (!opening) {
@@ -543,6 +554,30 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
     }
     const arm::MotionPlan path = motion_.planToJoints(now, *pre, speed, allowed);
     return path.ok() ? std::string() : "no path to the pre-grasp: " + path.failure;
+  };
+  // In a mode whose fingers can close part way: a candidate the open fingers do not fit is
+  // checked again with them closed as far as the part allows (beside a neighbour that the
+  // open fingers, leaning out, would reach).
+  const FeasibilityCheck feasible = [&](Candidate& candidate) -> std::string {
+    candidate.finger_position = 0.0;
+    const std::string open = check(candidate);
+    if (!in_mode || open.empty() || open.starts_with("too wide")) {
+      return open;
+    }
+    const world::Pose object_pose = *world_.worldPose(candidate.object);
+    const double half = partHalfWidth(candidate.goal, object_pose, *object) + 0.5 * config_.grasp_margin;
+    const double position = config_.mode_fingers->position_for(mode, half);
+    if (position <= 0.0) {
+      return open;
+    }
+    fingers.inMode(mode, position);
+    const std::string part_way = check(candidate);
+    fingers.inMode(mode);
+    if (!part_way.empty()) {
+      return open;
+    }
+    candidate.finger_position = position;
+    return {};
   };
   Selection selection = selectGoal(matches.objects, *object, grasp, armModel(), config_.weights, feasible);
   if (!selection.ok() && with_approach && config_.fingers) {
@@ -792,19 +827,29 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
                      },
                      nullptr});
   }
+  const double finger_position = chosen.finger_position;
+  if (finger_position > 0.0) {
+    steps.push_back({"close the fingers part way, to clear the neighbours",
+                     [this, finger_position] {
+                       component::ParamMap params = gripperDefaults(gripper_, "Open");
+                       params["position"] = finger_position;
+                       return std::make_unique<ComponentStep>(gripper_, "Open", params);
+                     },
+                     nullptr});
+  }
   // The fingers are planned in the grasp's mode from here on (the cell's own sync follows once
   // the gripper reports the mode).
   steps.push_back({"move above " + object,
-                   [this, pregrasp, chosen, speed, mode = grasp->mode] {
-                     fingersInMode(mode);
+                   [this, pregrasp, chosen, speed, mode = grasp->mode, finger_position] {
+                     fingersInMode(mode, finger_position);
                      return moveToFreeConfiguration(pregrasp, chosen.solutions.front(), speed, "pre-grasp",
                                                     "no collision-free pre-grasp");
                    },
                    nullptr});
   const std::size_t approach_step = steps.size();
   steps.push_back({"approach " + object,
-                   [this, chosen, object, mode = grasp->mode] {
-                     fingersInMode(mode);
+                   [this, chosen, object, mode = grasp->mode, finger_position] {
+                     fingersInMode(mode, finger_position);
                      return follow(
                          motion_.planLine(motion_.joints(), chosen.goal, config_.approach_speed, touching({object})),
                          "approach");

@@ -78,10 +78,19 @@ struct SmartMoveConfig {
   /// finger shapes stay and the gripper opens fully.
   std::optional<gripper::FingerGeometry> fingers;
   std::string finger_link = "fingers";
-  /// A gripper with modes (the 3-finger gripper): the open fingers' shapes in each mode (by the
-  /// name SetMode takes), in the finger link's frame. A grasp that needs a mode is planned with
-  /// that mode's fingers, before SmartGrasp has turned the gripper to it.
-  std::map<std::string, std::vector<planning::CollisionShape>> mode_fingers;
+  /// A gripper with modes (the 3-finger gripper). A grasp that needs a mode is planned with that
+  /// mode's fingers, before SmartGrasp has turned the gripper to it; when none of its candidates
+  /// is free with the fingers open, with them closed part way round the part (a fingertip mode:
+  /// the gripper's Open takes a `position`).
+  struct ModeFingers {
+    /// The fingers' shapes in mode (SetMode's name) stopped at position (0 open .. 1 closed),
+    /// in the finger link's frame; empty for a mode it does not model.
+    std::function<std::vector<planning::CollisionShape>(const std::string& mode, double position)> shapes;
+    /// The most closed position in mode that leaves half_width (m) clear either side of the
+    /// tool's axis between the fingertips; 0 when the fingers cannot close part way.
+    std::function<double(const std::string& mode, double half_width)> position_for;
+  };
+  std::optional<ModeFingers> mode_fingers;
   /// m added to the part's width between the fingers: covers perception error (a few mm, a few
   /// degrees of yaw) and the fingers' tracking.
   double grasp_margin = 0.016;
@@ -185,9 +194,13 @@ class SmartMoveComponent final : public component::TableComponent {
   /// `centred` (none feasible) with the shifted grasps of its candidates tried after it.
   Selection withShiftedGrasps(Selection centred, const world::ObjectClass& object_class,
                               const FeasibilityCheck& feasible);
-  /// Puts the fingers' shapes of gripper mode `mode` in the collision world (nothing when the
-  /// mode's fingers are not given): before planning a motion the gripper makes in that mode.
-  void fingersInMode(const std::string& mode);
+  /// Puts the fingers' shapes of gripper mode `mode` at `position` in the collision world
+  /// (nothing when the mode's fingers are not given): before planning a motion in that mode.
+  void fingersInMode(const std::string& mode, double position = 0.0);
+  /// Half the part's width between the fingers of a grasp with the tool centre point at `tcp`
+  /// (its extent along the tool's y, either side of the TCP).
+  static double partHalfWidth(const world::Pose& tcp, const world::Pose& object,
+                              const world::ObjectClass& object_class);
   /// Shapes of the fingers at `opening`, in the finger link's frame.
   std::vector<planning::CollisionShape> fingerShapes(double opening) const;
   /// The Open operation's parameters: at `opening` when the fingers are modelled, else fully.

@@ -202,9 +202,15 @@ class SimWorkcell final : public Workcell {
     smartmove_config.fingers = gripper_model_.fingers;
     if (adaptive_) {
       smartmove_config.finger_link = gripper_model_.finger_link;
-      for (const gripper::GripperMode mode : gripper::kGripperModes) {
-        smartmove_config.mode_fingers[std::string(gripper::toString(mode))] = adaptiveFingerShapes(mode);
-      }
+      smartmove_config.mode_fingers = smartmove::SmartMoveConfig::ModeFingers{
+          [this](const std::string& name, double position) {
+            const auto mode = gripper::modeFromString(name);
+            return mode ? adaptiveFingerShapes(*mode, position) : std::vector<planning::CollisionShape>{};
+          },
+          [this](const std::string& name, double half_width) {
+            const auto mode = gripper::modeFromString(name);
+            return mode ? gripper::fingertipPositionFor(*adaptive_, *mode, half_width) : 0.0;
+          }};
     }
     smartmove_ =
         std::make_shared<smartmove::SmartMoveComponent>(*motion_, *arm, *gripper, components().world(), collisions_,
@@ -246,26 +252,41 @@ class SimWorkcell final : public Workcell {
     smartmove_->syncFingers(opening);
   }
 
-  /// The adaptive gripper's fingers in the collision world: open, as its mode places them (a
-  /// reading that fails leaves them as they were; the component reports the failure).
+  /// The adaptive gripper's fingers in the collision world, as its mode places them: open, or in
+  /// a fingertip mode closed part way as far as its most open closing finger reads (rounded
+  /// down to 5 %, toward open). A reading that fails leaves them as they were (the component
+  /// reports the failure).
   void syncAdaptiveFingers() {
-    gripper::GripperMode mode;
+    gripper::AdaptiveGripperReading reading;
     try {
-      mode = simulation_->adaptiveGripper()->read().mode;
+      reading = simulation_->adaptiveGripper()->read();
     } catch (const std::exception&) {
       return;
     }
-    if (synced_mode_ == mode) {
+    const auto& mode = adaptive_->mode(reading.mode);
+    double position = 0.0;
+    if (mode.fingertip) {
+      position = 1.0;
+      for (std::size_t i = 0; i < reading.fingers.size(); ++i) {
+        if (mode.closing[i]) {
+          position = std::min(position, reading.fingers[i].position);
+        }
+      }
+      position = std::clamp(std::floor(position * 20.0) / 20.0, 0.0, 0.9);
+    }
+    if (synced_mode_ == reading.mode && synced_position_ == position) {
       return;
     }
-    collisions_.setLinkShapes(gripper_model_.finger_link, adaptiveFingerShapes(mode));
-    synced_mode_ = mode;
+    collisions_.setLinkShapes(gripper_model_.finger_link, adaptiveFingerShapes(reading.mode, position));
+    synced_mode_ = reading.mode;
+    synced_position_ = position;
   }
 
-  /// The adaptive gripper's open fingers in `mode`, as collision shapes of the finger link.
-  std::vector<planning::CollisionShape> adaptiveFingerShapes(gripper::GripperMode mode) const {
+  /// The adaptive gripper's fingers in `mode` at `position` (0: open), as collision shapes of
+  /// the finger link.
+  std::vector<planning::CollisionShape> adaptiveFingerShapes(gripper::GripperMode mode, double position = 0.0) const {
     std::vector<planning::CollisionShape> shapes;
-    for (const gripper::OrientedBox& box : gripper::openFingerBoxes(*adaptive_, mode)) {
+    for (const gripper::OrientedBox& box : gripper::fingerBoxesAt(*adaptive_, mode, position)) {
       planning::CollisionShape shape;
       shape.kind = planning::CollisionShape::Kind::kBox;
       shape.size = box.size;
@@ -354,6 +375,7 @@ class SimWorkcell final : public Workcell {
   sim::SimGripperDriver gripper_driver_;
   std::optional<gripper::AdaptiveGripperDescription> adaptive_;  // the adaptive gripper's, if it is one
   std::optional<gripper::GripperMode> synced_mode_;              // its fingers' mode in the collision world
+  double synced_position_ = -1.0;                                // and their position there (0: open)
   gripper::GripperDriver* cell_gripper_driver_ = nullptr;        // the 2-finger's, as the cell uses it (faults)
   sim::SimRgbdCamera camera_;
   planning::RobotModel robot_;

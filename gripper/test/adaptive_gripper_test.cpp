@@ -218,6 +218,50 @@ TEST_F(AdaptiveGripperTest, ScissorModeClosesFingersOneAndTwoOnly) {
   EXPECT_TRUE(holds("gripper_closed"));  // closed: the mode's closing fingers are
 }
 
+TEST_F(AdaptiveGripperTest, InPinchModeTheFingersOpenPartWayElsewhereOpenRefuses) {
+  // In Basic mode the fingers curl as they close: only fully open is modelled.
+  try {
+    run("Open", {{"position", 0.3}});
+    ADD_FAILURE() << "opened part way in basic mode";
+  } catch (const std::invalid_argument& e) {  // it cannot start: the reason
+    EXPECT_NE(std::string(e.what()).find("only in a fingertip mode"), std::string::npos) << e.what();
+  }
+  ASSERT_EQ(run("PinchMode").state, OperationState::kSuccess);
+  ASSERT_EQ(run("Open", {{"position", 0.3}}).state, OperationState::kSuccess);
+  for (const auto& finger : hand.read().fingers) {
+    EXPECT_NEAR(finger.position, 0.3, 0.011);
+  }
+  EXPECT_FALSE(holds("gripper_open"));
+  ASSERT_EQ(run("Open").state, OperationState::kSuccess);
+  EXPECT_TRUE(holds("gripper_open"));
+}
+
+TEST(AdaptiveGripperDescriptionTest, PinchFingersClosedPartWayClearAPartAndStayStraight) {
+  const AdaptiveGripperDescription description = robotiq3f();
+  // Open, the fingertips lean out past their knuckles (4.5 cm from the axis, 1.6 cm thick);
+  // closing turns them in, so the clear width shrinks as the position grows.
+  const double open = fingertipClearance(description, GripperMode::kPinch, 0.0);
+  EXPECT_GT(open, 0.045);
+  double previous = open;
+  for (const double position : {0.1, 0.2, 0.3, 0.4}) {
+    const double clear = fingertipClearance(description, GripperMode::kPinch, position);
+    EXPECT_LT(clear, previous) << position;
+    previous = clear;
+  }
+  // A 2.5 cm part with 8 mm either side: the most closed position that still clears it.
+  const double position = fingertipPositionFor(description, GripperMode::kPinch, 0.0205);
+  EXPECT_GT(position, 0.0);
+  EXPECT_GE(fingertipClearance(description, GripperMode::kPinch, position), 0.0205);
+  EXPECT_LT(fingertipClearance(description, GripperMode::kPinch, position + 0.01), 0.0205);
+  // Open boxes are the position-0 ones; other modes are modelled open only.
+  const auto boxes = openFingerBoxes(description, GripperMode::kPinch);
+  const auto at_zero = fingerBoxesAt(description, GripperMode::kPinch, 0.0);
+  ASSERT_EQ(boxes.size(), at_zero.size());
+  EXPECT_TRUE(boxes[0].pose.isApprox(at_zero[0].pose));
+  EXPECT_EQ(fingertipPositionFor(description, GripperMode::kBasic, 0.0205), 0.0);
+  EXPECT_THROW(fingerBoxesAt(description, GripperMode::kBasic, 0.3), std::invalid_argument);
+}
+
 TEST_F(AdaptiveGripperTest, ModeChangeWithClosedFingersFailsAndSaysWhy) {
   hand.block = {0.3, 0.35, 0.32};
   ASSERT_EQ(run("Close").state, OperationState::kSuccess);

@@ -88,11 +88,14 @@ class InstantGripper final : public component::TableComponent {
     component::ComponentDescription description;
     description.name = "gripper";
     component::OperationTable operations;
-    for (const char* name : {"Open", "Close"}) {
-      operations.add({name, "", {}}, [](const component::ParamMap&) {
-        return std::make_unique<component::FinishedOperation>(OperationResult::success({{"holding", true}}));
-      });
-    }
+    operations.add({"Open", "", {{"position", component::ValueType::kDouble, "", 0.0}}},
+                   [this](const component::ParamMap& params) {
+                     openings.push_back(params.at("position").asDouble());
+                     return std::make_unique<component::FinishedOperation>(OperationResult::success());
+                   });
+    operations.add({"Close", "", {}}, [](const component::ParamMap&) {
+      return std::make_unique<component::FinishedOperation>(OperationResult::success({{"holding", true}}));
+    });
     operations.add({"SetMode", "", {{"mode", component::ValueType::kString, "", std::string("pinch")}}},
                    [this](const component::ParamMap& params) {
                      modes.push_back(params.at("mode").asString());
@@ -102,6 +105,7 @@ class InstantGripper final : public component::TableComponent {
   }
   world::Report report() const override { return {}; }
   std::vector<std::string> modes;  // SetMode's, in order
+  std::vector<double> openings;    // Open's positions (0: fully), in order
 };
 
 /// The cell's motion service, with every planning query and the contacts it allowed recorded.
@@ -260,7 +264,16 @@ TEST_F(SmartMoveMotion, AGraspThatNeedsAModeIsPlannedWithThatModesFingersAndSets
   // the table.
   planning::CollisionShape slab;
   slab.size = Eigen::Vector3d(1.0, 1.0, 0.8);
-  config.mode_fingers["pinch"] = {slab};
+  // Closed part way, they would be clear (a 1 cm cube); here they cannot close part way.
+  planning::CollisionShape small;
+  small.size = Eigen::Vector3d(0.01, 0.01, 0.01);
+  double part_way = 0.0;
+  config.mode_fingers = SmartMoveConfig::ModeFingers{
+      [&](const std::string& mode, double position) {
+        return mode != "pinch" ? std::vector<planning::CollisionShape>{}
+                               : std::vector<planning::CollisionShape>{position > 0.0 ? small : slab};
+      },
+      [&](const std::string&, double) { return part_way; }};
   const std::size_t shapes_before = collisions.linkShapes(config.finger_link).size();
   SmartMoveComponent moded(motion, remote, gripper, world, collisions,
                            world::loadObjectClasses(dataRoot() / "data/objects"), library, config);
@@ -280,8 +293,21 @@ TEST_F(SmartMoveMotion, AGraspThatNeedsAModeIsPlannedWithThatModesFingersAndSets
   const auto id = moded.start("SmartGrasp", params("SmartGrasp", {{"object_class", "node"}, {"grasp", "widened"}}));
   ASSERT_EQ(moded.poll(id).state, OperationState::kRunning);
   EXPECT_EQ(gripper.modes, std::vector<std::string>{"wide"});
+  EXPECT_EQ(gripper.openings, std::vector<double>{0.0});
   ASSERT_EQ(remote.motions.size(), 1u);
   moded.cancel(id);
+
+  // When the fingers can close part way round the part, the grasp the open fingers refused is
+  // taken with them so: open, the mode, then closed part way before the arm moves.
+  part_way = 0.3;
+  gripper.modes.clear();
+  gripper.openings.clear();
+  const auto taken = moded.start("SmartGrasp", params("SmartGrasp", {{"object_class", "node"}, {"grasp", "pinched"}}));
+  ASSERT_EQ(moded.poll(taken).state, OperationState::kRunning);
+  EXPECT_EQ(gripper.modes, std::vector<std::string>{"pinch"});
+  EXPECT_EQ(gripper.openings, (std::vector<double>{0.0, 0.3}));
+  ASSERT_EQ(remote.motions.size(), 2u);
+  moded.cancel(taken);
 }
 
 }  // namespace
