@@ -572,6 +572,58 @@ std::vector<world::Pose> ClassPoseEstimator::principalAxisSeeds(const Cloud& clo
   return seeds;
 }
 
+std::vector<world::Pose> restingSeeds(const Cloud& cloud, const std::vector<int>& indices, const TablePlane& support,
+                                      const world::ObjectClass& object_class) {
+  std::vector<world::Pose> seeds;
+  if (indices.size() < 10) {
+    return seeds;
+  }
+  const Eigen::Vector3d normal = support.normal.normalized();  // out of the table, toward the camera
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const int i : indices) {
+    mean += cloud.points[static_cast<std::size_t>(i)].cast<double>();
+  }
+  mean /= static_cast<double>(indices.size());
+  // The points' spread in the plane: its main axis is a first guess of the object's x.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const int i : indices) {
+    Eigen::Vector3d d = cloud.points[static_cast<std::size_t>(i)].cast<double>() - mean;
+    d -= d.dot(normal) * normal;
+    covariance += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  Eigen::Vector3d axis = solver.eigenvectors().col(2);
+  axis -= axis.dot(normal) * normal;
+  if (axis.norm() < 1e-9) {
+    return seeds;
+  }
+  axis.normalize();
+  const Eigen::Vector3d side = normal.cross(axis);
+  // Under the points, on the plane: the seen faces are the top and the side facing the camera,
+  // so the middle lies a little further away, horizontally.
+  const Eigen::AlignedBox3d bounds = object_class.bounds();
+  Eigen::Vector3d on_plane = mean - support.height(mean.cast<float>()) * normal;
+  Eigen::Vector3d away = on_plane - on_plane.dot(normal) * normal;  // the camera is at the origin
+  if (away.norm() > 1e-9) {
+    on_plane += away.normalized() * (0.25 * std::min(bounds.sizes().x(), bounds.sizes().y()));
+  }
+  constexpr double kStep = 15.0 * M_PI / 180.0;
+  for (int k = 0; k < 12; ++k) {  // 0 .. 165 degrees: a turn of 180 more is the same box
+    const double yaw = k * kStep;
+    Eigen::Matrix3d rotation;  // columns: the object's x, y, z in the camera frame
+    rotation.col(0) = std::cos(yaw) * axis + std::sin(yaw) * side;
+    rotation.col(2) = normal;
+    rotation.col(1) = rotation.col(2).cross(rotation.col(0));
+    world::Pose seed = world::Pose::Identity();
+    seed.linear() = rotation;
+    // The object's bottom face on the plane, its footprint's middle at on_plane.
+    const Eigen::Vector3d footprint_middle(bounds.center().x(), bounds.center().y(), bounds.min().z());
+    seed.translation() = on_plane - rotation * footprint_middle;
+    seeds.push_back(seed);
+  }
+  return seeds;
+}
+
 std::vector<int> ClassPoseEstimator::unexplainedPoints(const Cloud& cloud, const std::vector<int>& cluster,
                                                        const std::vector<Detection>& detections) const {
   std::vector<Eigen::Isometry3f> to_object;
@@ -722,6 +774,13 @@ std::vector<Detection> ClassPoseEstimator::estimateCluster(const Cloud& cloud, c
     if (attempt > 0 && candidates.empty()) {
       for (const world::Pose& seed : principalAxisSeeds(cloud, remaining)) {
         candidates.push_back({seed, 0.0f});
+      }
+      // The points' axes mislead when two faces are in view (a node's top and front): the
+      // object standing upright on the table, turned in steps, starts near the truth too.
+      if (support_plane_) {
+        for (const world::Pose& seed : restingSeeds(cloud, remaining, *support_plane_, model_.object_class)) {
+          candidates.push_back({seed, 0.0f});
+        }
       }
     }
     local.recognition += seconds(start);

@@ -115,6 +115,15 @@ DepthAgreement compareWithDepth(const ObjectModel& model, const world::Pose& pos
 double overlapFraction(const ObjectModel& a, const world::Pose& pose_a, const ObjectModel& b, const world::Pose& pose_b,
                        double margin = 0.001);
 
+/// Start poses (in the optical frame, the camera at the origin) of an object of
+/// `object_class` resting upright on `support` under `indices` of `points`: its z along the
+/// plane's normal, its bottom on the plane under the points (pushed back from the camera by a
+/// quarter of its width: the seen faces are its top and the side facing the camera), turned
+/// about the normal in 15° steps from the points' main horizontal axis (12 poses: 0..165°).
+/// Empty for fewer than 10 points.
+std::vector<world::Pose> restingSeeds(const Cloud& points, const std::vector<int>& indices, const TablePlane& support,
+                                      const world::ObjectClass& object_class);
+
 /// ObjRecRANSAC loaded with one class's model. Building it hashes the model's point pairs
 /// (milliseconds). One instance must not be used by two threads at once; distinct instances
 /// may run in parallel.
@@ -171,6 +180,7 @@ class ClassPoseEstimator {
   static double meanSupport(const std::vector<Detection>& detections);
   /// Start poses from the principal axes of `indices` of `points` (see estimateCluster).
   std::vector<world::Pose> principalAxisSeeds(const Cloud& points, const std::vector<int>& indices) const;
+
   /// For an elongated model: the shift along its long axes (up to 24 mm) that the depth image
   /// agrees with best, if better than `pose`; nullopt otherwise.
   std::optional<world::Pose> slideAlongLongAxes(const world::Pose& pose, const camera::RgbdFrame& frame) const;

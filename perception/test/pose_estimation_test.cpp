@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <numeric>
+
 #include "core/paths.h"
 #include "perception/canonical_orientation.h"
 #include "perception/test/synthetic_scene.h"
@@ -151,6 +153,38 @@ TEST_F(PoseEstimation, IsDeterministic) {
   ASSERT_EQ(first.size(), 1u);
   ASSERT_EQ(second.size(), 1u);
   EXPECT_TRUE(first[0].pose_in_camera.isApprox(second[0].pose_in_camera, 1e-12));
+}
+
+TEST_F(PoseEstimation, RestingSeedsStartNearANodeSeenSquareOn) {
+  // A node turned square to the camera (its top and its front face in view, the sides at
+  // grazing angles): the points' principal axes lie between the two faces; standing on the
+  // table, turned in steps, one start is near the truth.
+  const ObjectModel& node = model("node");
+  const Rgb green{30, 180, 60};
+  const world::Pose truth = world::poseFromXyzRpy(0.42, 0.05, 0.025, 0, 0, M_PI / 2);
+  const camera::RgbdFrame frame = test::renderSynthetic({{&node.object_class, truth, green}}, 0.001, 5);
+  const Cloud points = pointsOfColor(frame, green);
+  ASSERT_GT(points.size(), 100u);
+  std::vector<int> indices(points.size());
+  std::iota(indices.begin(), indices.end(), 0);
+  const TablePlane plane = cropWorkspace(frame, {}).plane;
+  const std::vector<world::Pose> seeds = restingSeeds(points, indices, plane, node.object_class);
+  ASSERT_EQ(seeds.size(), 12u);
+  const world::Pose truth_in_camera = frame.camera_pose.inverse() * truth;
+  double nearest_angle = M_PI;
+  double nearest_distance = 1.0;
+  for (const world::Pose& seed : seeds) {
+    // Upright on the plane: z along its normal, the bottom face's middle on it.
+    EXPECT_GT(seed.linear().col(2).dot(plane.normal), 0.999);
+    EXPECT_NEAR(plane.height((seed * Eigen::Vector3d(0, 0, node.object_class.bounds().min().z())).cast<float>()), 0.0,
+                1e-6);
+    nearest_angle =
+        std::min(nearest_angle, symmetricRotationDistance(seed.linear(), truth_in_camera.linear(), node.object_class));
+    nearest_distance = std::min(nearest_distance, (seed.translation() - truth_in_camera.translation()).norm());
+  }
+  EXPECT_LT(nearest_angle, 8 * M_PI / 180);
+  EXPECT_LT(nearest_distance, 0.015);
+  EXPECT_TRUE(restingSeeds(points, {0, 1, 2}, plane, node.object_class).empty());  // too few points
 }
 
 TEST_F(PoseEstimation, NoPointsNoDetections) {
