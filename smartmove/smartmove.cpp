@@ -558,11 +558,33 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
   // In a mode whose fingers can close part way: a candidate the open fingers do not fit is
   // checked again with them closed as far as the part allows (beside a neighbour that the
   // open fingers, leaning out, would reach).
+  // The fingers closing from `from` onto the part, at the goal: they sweep the space between,
+  // which must be free of neighbours (a part lying against it would be caught too).
+  const auto closingClear = [&](const Candidate& candidate, double from) -> std::string {
+    const world::Pose object_pose = *world_.worldPose(candidate.object);
+    const double contact =
+        config_.mode_fingers->position_for(mode, partHalfWidth(candidate.goal, object_pose, *object));
+    const arm::AllowedContacts allowed = touching({candidate.object});
+    std::string reason;
+    const auto goal = motion_.firstFree(candidate.solutions, allowed, reason);
+    std::string blocked;
+    for (double position = from + 0.05; blocked.empty() && position < contact + 0.025; position += 0.05) {
+      fingers.inMode(mode, std::min(position, contact));
+      if (const auto touch = goal ? motion_.collision(*goal, allowed) : std::nullopt) {
+        blocked = "the closing fingers would touch " + touch->str();
+      }
+    }
+    fingers.inMode(mode);
+    return blocked;
+  };
   const FeasibilityCheck feasible = [&](Candidate& candidate) -> std::string {
     candidate.finger_position = 0.0;
     const std::string open = check(candidate);
-    if (!in_mode || open.empty() || open.starts_with("too wide")) {
+    if (!in_mode || open.starts_with("too wide")) {
       return open;
+    }
+    if (open.empty()) {
+      return closingClear(candidate, 0.0);
     }
     const world::Pose object_pose = *world_.worldPose(candidate.object);
     const double half = partHalfWidth(candidate.goal, object_pose, *object) + 0.5 * config_.grasp_margin;
@@ -575,6 +597,9 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
     fingers.inMode(mode);
     if (!part_way.empty()) {
       return open;
+    }
+    if (std::string blocked = closingClear(candidate, position); !blocked.empty()) {
+      return blocked;
     }
     candidate.finger_position = position;
     return {};
@@ -828,6 +853,14 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
                      nullptr});
   }
   const double finger_position = chosen.finger_position;
+  // Released with the fingers only as far open as they need to clear the part (a fingertip
+  // mode), so that the place is chosen, and left, with the fingers as they will be.
+  const double release_position =
+      grasp->mode.empty() || !config_.mode_fingers
+          ? 0.0
+          : config_.mode_fingers->position_for(
+                grasp->mode,
+                partHalfWidth(chosen.goal, object_pose, *objectClass(object_class)) + 0.5 * config_.grasp_margin);
   if (finger_position > 0.0) {
     steps.push_back({"close the fingers part way, to clear the neighbours",
                      [this, finger_position] {
@@ -857,8 +890,8 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
                    nullptr});
   steps.push_back({"close on " + object,
                    [this] { return std::make_unique<ComponentStep>(gripper_, "Close", closeParams(gripper_, 40.0)); },
-                   [this, object, object_class, object_pose, chosen, opening,
-                    centring](const OperationResult& result) -> std::string {
+                   [this, object, object_class, object_pose, chosen, opening, centring, mode = grasp->mode,
+                    release_position](const OperationResult& result) -> std::string {
                      if (!result.data.value("holding", false)) {
                        return "the fingers closed on nothing: " + object + " was not where it was seen";
                      }
@@ -869,6 +902,8 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
                      held_class_ = object_class;
                      held_grasp_ = object_pose.inverse() * chosen.goal;
                      held_opening_ = opening;
+                     held_mode_ = mode;
+                     held_finger_position_ = release_position;
                      collisions_.remove(partObstacle(object));
                      return {};
                    }});
@@ -912,6 +947,8 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
            // Centred both ways and square with the pads: as planned, turned.
            held_grasp_ = object_pose.inverse() * chosen.goal * centring->turn;
            held_opening_ = centring->opening;
+           held_mode_.clear();
+           held_finger_position_ = 0.0;
            collisions_.remove(partObstacle(object));
            return {};
          }});
@@ -1079,6 +1116,7 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginRelease(const compone
   // Checked with the fingers at the opening they release to: wider than they hold.
   const PlannedFingers fingers(*this);
   fingers.at(held_opening_ > 0.0 ? held_opening_ : config_.fingers ? config_.fingers->max_opening : 0.0);
+  fingers.inMode(held_mode_, held_finger_position_);
   const FeasibilityCheck feasible = [&](Candidate& candidate) -> std::string {
     // The part held may touch its support, in these queries only.
     const arm::AllowedContacts allowed = touching({candidate.object});
@@ -1124,7 +1162,12 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginRelease(const compone
                    },
                    nullptr});
   steps.push_back({"release " + released,
-                   [this, opening = held_opening_] {
+                   [this, opening = held_opening_, position = held_finger_position_] {
+                     if (position > 0.0) {  // a fingertip mode: as far as the part needs
+                       component::ParamMap params = gripperDefaults(gripper_, "Open");
+                       params["position"] = position;
+                       return std::make_unique<ComponentStep>(gripper_, "Open", params);
+                     }
                      return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening));
                    },
                    [this](const OperationResult&) -> std::string {
@@ -1132,7 +1175,8 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginRelease(const compone
                      return {};
                    }});
   steps.push_back({"lift away",
-                   [this, approach, support_object] {
+                   [this, approach, support_object, mode = held_mode_, position = held_finger_position_] {
+                     fingersInMode(mode, position);
                      const arm::JointVector now = motion_.joints();
                      return follow(motion_.planLine(now, up(approach) * motion_.toolAt(now), config_.approach_speed,
                                                     touching({support_object})),

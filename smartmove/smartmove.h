@@ -239,6 +239,8 @@ class SmartMoveComponent final : public component::TableComponent {
   std::string held_class_;
   world::Pose held_grasp_ = world::Pose::Identity();  // the TCP in the held part's frame
   double held_opening_ = 0.0;                         // the opening of its grasp, m (0: fully)
+  std::string held_mode_;                             // the gripper mode it was grasped in (mode_fingers)
+  double held_finger_position_ = 0.0;                 // where its fingers release to in that mode (0: open)
   double synced_opening_ = -1.0;                      // the fingers' shapes are at this opening
   std::vector<std::string> obstacles_;
   std::shared_ptr<PatternCheck> pattern_check_ = std::make_shared<PatternCheck>();

@@ -254,7 +254,7 @@ class SimWorkcell final : public Workcell {
 
   /// The adaptive gripper's fingers in the collision world, as its mode places them: open, or in
   /// a fingertip mode closed part way as far as its most open closing finger reads (rounded
-  /// down to 5 %, toward open). A reading that fails leaves them as they were (the component
+  /// down to 1 %, toward open). A reading that fails leaves them as they were (the component
   /// reports the failure).
   void syncAdaptiveFingers() {
     gripper::AdaptiveGripperReading reading;
@@ -272,7 +272,7 @@ class SimWorkcell final : public Workcell {
           position = std::min(position, reading.fingers[i].position);
         }
       }
-      position = std::clamp(std::floor(position * 20.0) / 20.0, 0.0, 0.9);
+      position = std::clamp(std::floor(position * 100.0) / 100.0, 0.0, 0.9);
     }
     if (synced_mode_ == reading.mode && synced_position_ == position) {
       return;

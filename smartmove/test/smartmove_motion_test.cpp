@@ -268,10 +268,13 @@ TEST_F(SmartMoveMotion, AGraspThatNeedsAModeIsPlannedWithThatModesFingersAndSets
   planning::CollisionShape small;
   small.size = Eigen::Vector3d(0.01, 0.01, 0.01);
   double part_way = 0.0;
+  bool closing_hits = false;  // the fingers closed part way would be the slab instead
   config.mode_fingers = SmartMoveConfig::ModeFingers{
       [&](const std::string& mode, double position) {
-        return mode != "pinch" ? std::vector<planning::CollisionShape>{}
-                               : std::vector<planning::CollisionShape>{position > 0.0 ? small : slab};
+        if (mode != "pinch") {
+          return std::vector<planning::CollisionShape>{};
+        }
+        return std::vector<planning::CollisionShape>{(position > 0.0) != closing_hits ? small : slab};
       },
       [&](const std::string&, double) { return part_way; }};
   const std::size_t shapes_before = collisions.linkShapes(config.finger_link).size();
@@ -308,6 +311,15 @@ TEST_F(SmartMoveMotion, AGraspThatNeedsAModeIsPlannedWithThatModesFingersAndSets
   EXPECT_EQ(gripper.openings, (std::vector<double>{0.0, 0.3}));
   ASSERT_EQ(remote.motions.size(), 2u);
   moded.cancel(taken);
+
+  // Open fingers that fit, but that would sweep through something as they close onto the part
+  // (a neighbour lying against it): refused.
+  closing_hits = true;
+  const auto swept = moded.start("SmartGrasp", params("SmartGrasp", {{"object_class", "node"}, {"grasp", "pinched"}}));
+  const OperationResult sweep = moded.poll(swept);
+  ASSERT_EQ(sweep.state, OperationState::kFailure);
+  EXPECT_NE(sweep.reason.find("the closing fingers would touch"), std::string::npos) << sweep.reason;
+  EXPECT_EQ(remote.motions.size(), 2u);
 }
 
 }  // namespace
