@@ -596,7 +596,7 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
     const std::string part_way = check(candidate);
     fingers.inMode(mode);
     if (!part_way.empty()) {
-      return open;
+      return open + "; with the fingers closed part way: " + part_way;
     }
     if (std::string blocked = closingClear(candidate, position); !blocked.empty()) {
       return blocked;
