@@ -24,10 +24,11 @@ std::string eglError(const char* what) {
 /// number of renderers using it. Made on first use and never destroyed, so that a renderer
 /// destroyed during static destruction at exit still finds the lock.
 struct SharedDisplay {
-  /// Held while a renderer is created or destroyed: the display's initialization and
-  /// termination, and MuJoCo's loading of GL functions into its globals (mjr_makeContext).
+  /// Held while a renderer is created or destroyed: the display's initialization, and MuJoCo's
+  /// loading of GL functions into its globals (mjr_makeContext).
   std::mutex mutex;
   int users = 0;
+  int initializations = 0;
   EGLDisplay display = EGL_NO_DISPLAY;
   EGLConfig config = nullptr;
 };
@@ -39,7 +40,7 @@ SharedDisplay& sharedDisplay() {
 
 /// One more user of the display: initializes it for the first. The caller holds the mutex.
 void acquireDisplay(SharedDisplay& shared) {
-  if (shared.users == 0) {
+  if (shared.display == EGL_NO_DISPLAY) {
     // Mesa's surfaceless platform: no display server, no GPU needed.
     const auto get_platform_display =
         reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
@@ -80,19 +81,16 @@ void acquireDisplay(SharedDisplay& shared) {
     }
     shared.display = display;
     shared.config = config;
+    ++shared.initializations;
   }
   ++shared.users;
 }
 
-/// One user fewer: the last terminates the display (no context is left on it then). The
-/// caller holds the mutex.
-void releaseDisplay(SharedDisplay& shared) {
-  if (--shared.users == 0) {
-    eglTerminate(shared.display);
-    shared.display = EGL_NO_DISPLAY;
-    shared.config = nullptr;
-  }
-}
+/// One user fewer. The display stays initialized when the last goes, for the next renderer and
+/// until the process ends: Mesa keeps about 23 kB of every eglInitialize that eglTerminate does
+/// not give back, which a trial loop (a renderer per trial, one at a time) paid once per trial
+/// (docs/BENCHMARKS.md, the soak). The caller holds the mutex.
+void releaseDisplay(SharedDisplay& shared) { --shared.users; }
 
 }  // namespace
 
@@ -192,6 +190,12 @@ GlRenderer::~GlRenderer() {
   mjv_freeScene(&scene_);
   eglDestroyContext(display_, context_);
   releaseDisplay(shared);
+}
+
+int GlRenderer::displayInitializations() {
+  SharedDisplay& shared = sharedDisplay();
+  const std::lock_guard lock(shared.mutex);
+  return shared.initializations;
 }
 
 int GlRenderer::liveCount() {

@@ -2,6 +2,10 @@
 
 #include <unistd.h>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -146,6 +150,11 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
     result.reason = e.what();
   }
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+#if defined(__GLIBC__)
+  // The trial's workcell is gone: hand the pages glibc keeps for reuse back to the system, so that
+  // a long run's resident memory is what is in use, not what fragmentation left behind.
+  malloc_trim(0);
+#endif
   result.rss_kb = residentKilobytes();
   return result;
 }
