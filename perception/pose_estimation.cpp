@@ -572,6 +572,11 @@ std::vector<world::Pose> ClassPoseEstimator::principalAxisSeeds(const Cloud& clo
   return seeds;
 }
 
+namespace {
+/// m: points whose lowest lie this far above the table may rest on another part.
+constexpr double kRaisedSupport = 0.015;
+}  // namespace
+
 std::vector<world::Pose> restingSeeds(const Cloud& cloud, const std::vector<int>& indices, const TablePlane& support,
                                       const world::ObjectClass& object_class) {
   std::vector<world::Pose> seeds;
@@ -607,19 +612,34 @@ std::vector<world::Pose> restingSeeds(const Cloud& cloud, const std::vector<int>
   if (away.norm() > 1e-9) {
     on_plane += away.normalized() * (0.25 * std::min(bounds.sizes().x(), bounds.sizes().y()));
   }
+  // What it rests on: the table, and, when even its lowest points are well above the table (a
+  // link on a node), a level under those points as well (their 5th percentile height).
+  std::vector<double> levels{0.0};
+  std::vector<double> heights;
+  heights.reserve(indices.size());
+  for (const int i : indices) {
+    heights.push_back(support.height(cloud.points[static_cast<std::size_t>(i)]));
+  }
+  const auto low = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 20);
+  std::nth_element(heights.begin(), low, heights.end());
+  if (*low > kRaisedSupport) {
+    levels.push_back(*low);
+  }
   constexpr double kStep = 15.0 * M_PI / 180.0;
-  for (int k = 0; k < 12; ++k) {  // 0 .. 165 degrees: a turn of 180 more is the same box
-    const double yaw = k * kStep;
-    Eigen::Matrix3d rotation;  // columns: the object's x, y, z in the camera frame
-    rotation.col(0) = std::cos(yaw) * axis + std::sin(yaw) * side;
-    rotation.col(2) = normal;
-    rotation.col(1) = rotation.col(2).cross(rotation.col(0));
-    world::Pose seed = world::Pose::Identity();
-    seed.linear() = rotation;
-    // The object's bottom face on the plane, its footprint's middle at on_plane.
-    const Eigen::Vector3d footprint_middle(bounds.center().x(), bounds.center().y(), bounds.min().z());
-    seed.translation() = on_plane - rotation * footprint_middle;
-    seeds.push_back(seed);
+  for (const double level : levels) {
+    for (int k = 0; k < 12; ++k) {  // 0 .. 165 degrees: a turn of 180 more is the same box
+      const double yaw = k * kStep;
+      Eigen::Matrix3d rotation;  // columns: the object's x, y, z in the camera frame
+      rotation.col(0) = std::cos(yaw) * axis + std::sin(yaw) * side;
+      rotation.col(2) = normal;
+      rotation.col(1) = rotation.col(2).cross(rotation.col(0));
+      world::Pose seed = world::Pose::Identity();
+      seed.linear() = rotation;
+      // The object's bottom face on the level, its footprint's middle above on_plane.
+      const Eigen::Vector3d footprint_middle(bounds.center().x(), bounds.center().y(), bounds.min().z());
+      seed.translation() = on_plane + level * normal - rotation * footprint_middle;
+      seeds.push_back(seed);
+    }
   }
   return seeds;
 }
@@ -775,12 +795,13 @@ std::vector<Detection> ClassPoseEstimator::estimateCluster(const Cloud& cloud, c
       for (const world::Pose& seed : principalAxisSeeds(cloud, remaining)) {
         candidates.push_back({seed, 0.0f});
       }
-      // The points' axes mislead when two faces are in view (a node's top and front): the
-      // object standing upright on the table, turned in steps, starts near the truth too.
-      if (support_plane_) {
-        for (const world::Pose& seed : restingSeeds(cloud, remaining, *support_plane_, model_.object_class)) {
-          candidates.push_back({seed, 0.0f});
-        }
+    }
+    // The points' axes mislead when two faces are in view (a node's top and front), and
+    // ObjRecRANSAC's hypotheses can all be wrong there too: on a retry, the object standing
+    // upright on the table, turned in steps, starts near the truth as well.
+    if (attempt > 0 && support_plane_) {
+      for (const world::Pose& seed : restingSeeds(cloud, remaining, *support_plane_, model_.object_class)) {
+        candidates.push_back({seed, 0.0f});
       }
     }
     local.recognition += seconds(start);
