@@ -258,4 +258,31 @@ double fingertipPositionFor(const AdaptiveGripperDescription& description, Gripp
   return best;
 }
 
+double fingerReachAcross(const AdaptiveGripperDescription& description, GripperMode mode) {
+  double reach = 0.0;
+  // Open, and in a fingertip mode closed too (the only modes whose closed fingers are modelled).
+  std::vector<double> positions{0.0};
+  if (description.mode(mode).fingertip) {
+    positions.push_back(1.0);
+  }
+  for (const double position : positions) {
+    for (const OrientedBox& box : fingerBoxesAt(description, mode, position)) {
+      // The box runs from the knuckle to past the tip along its longest side; the tip's face is
+      // the end farther along the approach (the flange's z).
+      int along = 0;
+      box.size.maxCoeff(&along);
+      const Eigen::Vector3d axis = box.pose.linear().col(along);
+      const Eigen::Vector3d tip = box.pose.translation() + (axis.z() >= 0.0 ? 0.5 : -0.5) * box.size[along] * axis;
+      double half = 0.0;
+      for (int side = 0; side < 3; ++side) {
+        if (side != along) {
+          half += 0.5 * std::abs(box.pose.linear()(0, side)) * box.size[side];
+        }
+      }
+      reach = std::max(reach, std::abs(tip.x()) + half);
+    }
+  }
+  return reach;
+}
+
 }  // namespace costar::gripper

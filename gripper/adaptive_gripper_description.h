@@ -89,4 +89,9 @@ double fingertipClearance(const AdaptiveGripperDescription& description, Gripper
 /// not a fingertip mode, or when even open fingers leave less.
 double fingertipPositionFor(const AdaptiveGripperDescription& description, GripperMode mode, double half_width);
 
+/// How far (m) the fingertips in `mode` reach along the flange's x either side of its z axis,
+/// open (and closed, in a fingertip mode): a grasp shifted along a part keeps them this far
+/// inside its end, so that the fingers still close on it.
+double fingerReachAcross(const AdaptiveGripperDescription& description, GripperMode mode);
+
 }  // namespace costar::gripper

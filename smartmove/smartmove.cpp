@@ -605,15 +605,29 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
     return {};
   };
   Selection selection = selectGoal(matches.objects, *object, grasp, armModel(), config_.weights, feasible);
-  if (!selection.ok() && with_approach && config_.fingers) {
-    selection = withShiftedGrasps(std::move(selection), *object, feasible);
+  if (const auto reach = fingerReachAcross(mode); !selection.ok() && with_approach && reach) {
+    selection = withShiftedGrasps(std::move(selection), *object, *reach, feasible);
   }
   addRejected(selection, matches);
   return selection;
 }
 
+std::optional<double> SmartMoveComponent::fingerReachAcross(const std::string& mode) const {
+  if (config_.fingers) {
+    double pad = 0.0;
+    for (const gripper::FingerBox& box : config_.fingers->closed) {
+      pad = std::max(pad, std::abs(box.centre.x()) + 0.5 * box.size.x());
+    }
+    return pad;
+  }
+  if (config_.mode_fingers && config_.mode_fingers->reach_across && !mode.empty()) {
+    return config_.mode_fingers->reach_across(mode);
+  }
+  return std::nullopt;
+}
+
 std::vector<double> SmartMoveComponent::graspShifts(const world::Pose& tcp, const world::Pose& object,
-                                                    const world::ObjectClass& object_class) const {
+                                                    const world::ObjectClass& object_class, double reach) const {
   // The part's extent along the tool's x (across the fingers) and the pads' half width.
   const Eigen::AlignedBox3d bounds = object_class.bounds();
   const world::Pose part_in_tool = tcp.inverse() * object;
@@ -624,10 +638,7 @@ std::vector<double> SmartMoveComponent::graspShifts(const world::Pose& tcp, cons
     low = std::min(low, p.x());
     high = std::max(high, p.x());
   }
-  double pad = 0.0;
-  for (const gripper::FingerBox& box : config_.fingers->closed) {
-    pad = std::max(pad, std::abs(box.centre.x()) + 0.5 * box.size.x());
-  }
+  const double pad = reach;
   const double keep = config_.grasp_shift_keep;
   std::vector<double> shifts;
   for (int k = 1; k * config_.grasp_shift_step <= config_.grasp_shift_max + 1e-9; ++k) {
@@ -643,7 +654,7 @@ std::vector<double> SmartMoveComponent::graspShifts(const world::Pose& tcp, cons
   return shifts;
 }
 
-Selection SmartMoveComponent::withShiftedGrasps(Selection centred, const world::ObjectClass& object_class,
+Selection SmartMoveComponent::withShiftedGrasps(Selection centred, const world::ObjectClass& object_class, double reach,
                                                 const FeasibilityCheck& feasible) {
   // Grasps shifted across the fingers, nearest the centre first, of the centred candidates
   // that failed for something in the way (not reach, not width).
@@ -654,7 +665,7 @@ Selection SmartMoveComponent::withShiftedGrasps(Selection centred, const world::
       continue;
     }
     const auto pose = world_.worldPose(candidate.object);
-    for (const double shift : graspShifts(candidate.goal, *pose, object_class)) {
+    for (const double shift : graspShifts(candidate.goal, *pose, object_class, reach)) {
       Candidate shifted;
       shifted.object = candidate.object;
       shifted.symmetry = candidate.symmetry;

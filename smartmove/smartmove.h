@@ -89,6 +89,9 @@ struct SmartMoveConfig {
     /// The most closed position in mode that leaves half_width (m) clear either side of the
     /// tool's axis between the fingertips; 0 when the fingers cannot close part way.
     std::function<double(const std::string& mode, double half_width)> position_for;
+    /// How far (m) the fingers in mode reach along the tool's x, either side of its axis: a
+    /// grasp shifted along a part keeps them that far inside its end. Empty: no shifted grasps.
+    std::function<double(const std::string& mode)> reach_across;
   };
   std::optional<ModeFingers> mode_fingers;
   /// m added to the part's width between the fingers: covers perception error (a few mm, a few
@@ -97,7 +100,7 @@ struct SmartMoveConfig {
   /// When no centred grasp is feasible, grasps shifted across the fingers (along the tool's x)
   /// are tried, nearest the centre first: in steps of grasp_shift_step up to grasp_shift_max,
   /// keeping the pads grasp_shift_keep inside the part's end (a link gripped off its middle, a
-  /// node off its centre line). Only with `fingers`.
+  /// node off its centre line). With `fingers`, or `mode_fingers` that give `reach_across`.
   double grasp_shift_step = 0.01;
   double grasp_shift_max = 0.04;
   double grasp_shift_keep = 0.003;
@@ -188,11 +191,16 @@ class SmartMoveComponent final : public component::TableComponent {
   /// Runs a plan with the arm's FollowJointPath (called `what` in messages), or an operation
   /// that fails with the plan's reason.
   std::unique_ptr<component::RunningOperation> follow(const arm::MotionPlan& plan, const std::string& what);
-  /// Shifts (m along the tool's x) of a grasp at `tcp` that keep the pads on the part.
+  /// How far (m) the fingers reach along the tool's x either side of its axis when they hold a
+  /// part (in gripper mode `mode` for an adaptive gripper); nullopt when it is not modelled (no
+  /// shifted grasps then).
+  std::optional<double> fingerReachAcross(const std::string& mode) const;
+  /// Shifts (m along the tool's x) of a grasp at `tcp` that keep fingers reaching `reach` either
+  /// side of the tool's axis on the part.
   std::vector<double> graspShifts(const world::Pose& tcp, const world::Pose& object,
-                                  const world::ObjectClass& object_class) const;
+                                  const world::ObjectClass& object_class, double reach) const;
   /// `centred` (none feasible) with the shifted grasps of its candidates tried after it.
-  Selection withShiftedGrasps(Selection centred, const world::ObjectClass& object_class,
+  Selection withShiftedGrasps(Selection centred, const world::ObjectClass& object_class, double reach,
                               const FeasibilityCheck& feasible);
   /// Puts the fingers' shapes of gripper mode `mode` at `position` in the collision world
   /// (nothing when the mode's fingers are not given): before planning a motion in that mode.

@@ -210,6 +210,10 @@ class SimWorkcell final : public Workcell {
           [this](const std::string& name, double half_width) {
             const auto mode = gripper::modeFromString(name);
             return mode ? gripper::fingertipPositionFor(*adaptive_, *mode, half_width) : 0.0;
+          },
+          [this](const std::string& name) {
+            const auto mode = gripper::modeFromString(name);
+            return mode ? gripper::fingerReachAcross(*adaptive_, *mode) : 0.0;
           }};
     }
     smartmove_ =

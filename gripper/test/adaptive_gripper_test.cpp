@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -260,6 +261,30 @@ TEST(AdaptiveGripperDescriptionTest, PinchFingersClosedPartWayClearAPartAndStayS
   EXPECT_TRUE(boxes[0].pose.isApprox(at_zero[0].pose));
   EXPECT_EQ(fingertipPositionFor(description, GripperMode::kBasic, 0.0205), 0.0);
   EXPECT_THROW(fingerBoxesAt(description, GripperMode::kBasic, 0.3), std::invalid_argument);
+}
+
+TEST(AdaptiveGripperDescriptionTest, FingertipsReachAcrossNoFartherThanTheFingers) {
+  const AdaptiveGripperDescription description = robotiq3f();
+  for (const GripperMode mode : {GripperMode::kBasic, GripperMode::kPinch, GripperMode::kWide, GripperMode::kScissor}) {
+    const std::string name(toString(mode));
+    const double reach = fingerReachAcross(description, mode);
+    // No farther than the open fingers' boxes reach, corner by corner.
+    double furthest = 0.0;
+    for (const OrientedBox& box : openFingerBoxes(description, mode)) {
+      for (int corner = 0; corner < 8; ++corner) {
+        const Eigen::Vector3d local(((corner & 1) ? 0.5 : -0.5) * box.size.x(),
+                                    ((corner & 2) ? 0.5 : -0.5) * box.size.y(),
+                                    ((corner & 4) ? 0.5 : -0.5) * box.size.z());
+        furthest = std::max(furthest, std::abs((box.pose * local).x()));
+      }
+    }
+    EXPECT_LE(reach, furthest + 1e-9) << name;
+    EXPECT_GE(reach, 0.5 * description.finger_width) << name;
+    std::printf("%s: the fingertips reach %.1f mm across (the fingers %.1f mm)\n", name.c_str(), 1000 * reach,
+                1000 * furthest);
+  }
+  // Basic: fingers 1 and 2 stand straight at x = +-28 mm, 24 mm wide: their tips reach 40 mm.
+  EXPECT_NEAR(fingerReachAcross(description, GripperMode::kBasic), 0.028 + 0.012, 1e-6);
 }
 
 TEST_F(AdaptiveGripperTest, ModeChangeWithClosedFingersFailsAndSaysWhy) {

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
 #include <random>
 #include <set>
 
@@ -158,6 +159,40 @@ TEST_P(IiwaAdaptiveGripper, PicksAPartUpInEachMode) {
 INSTANTIATE_TEST_SUITE_P(Modes, IiwaAdaptiveGripper,
                          ::testing::Combine(::testing::Values("basic", "pinch", "wide", "scissor"),
                                             ::testing::Values("node", "link")));
+
+// A link with a node beside it, 3.5 cm from its middle along it: the 3-finger gripper's
+// centred Pinch grasp puts a finger on the node either way round, so the link is taken off its
+// middle (the fingertips kept on the link), and put down centred on another node all the same
+// (the grasp is remembered as it was). The parts seen by a TEST ONLY oracle.
+TEST(IiwaSimWorkcell, TheThreeFingerGripperTakesALinkOffItsMiddleBesideANeighbourAndPlacesItCentred) {
+  const auto scene = std::filesystem::temp_directory_path() / "costar_iiwa_3f_shifted_link.json";
+  std::ofstream(scene) << R"({"parts": [{"class": "link", "color": "wood", "at": [0.50, -0.15, 0]},
+                                       {"class": "node", "color": "red", "at": [0.535, -0.0925, 0]},
+                                       {"class": "node", "color": "blue", "at": [0.45, 0.2, 20]}]})";
+  const auto cell =
+      makeWorkcell({.name = "iiwa-3f-sim", .scene = scene, .memory_only = true, .test_oracle_perception = true});
+  const auto plan = bt::loadPlanText(R"x(<root BTCPP_format="4"><BehaviorTree ID="m"><Sequence>
+      <SmartGrasp object_class="link" grasp="middle"/>
+      <SmartRelease target_class="node" predicates="left_of(table_center)"/>
+      <Home/></Sequence></BehaviorTree></root>)x",
+                                     "shifted.xml");
+  bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
+  bt::Executor executor(tree, cell->clock(), {.time_limit = std::chrono::seconds(120)});
+  executor.setBeforeTick([&cell] { cell->beforeTick(); });
+  const bt::RunResult result = executor.run();
+  ASSERT_EQ(result.status, bt::Status::kSuccess) << result.failure_path << ": " << result.failure_reason;
+  sim::Simulation& simulation = *cell->simulation();
+  simulation.stepTo(simulation.time() + std::chrono::seconds(1));
+  std::map<std::string, sim::PartState> parts;
+  for (const sim::PartState& part : simulation.parts()) {
+    parts[part.name] = part;
+  }
+  const sim::PartState& link = parts.at("link_0");
+  EXPECT_NEAR(link.pose.translation().z(), 0.05 + 0.0125, 0.004);  // on the blue node
+  EXPECT_LT((link.pose.translation() - parts.at("node_1").pose.translation()).head<2>().norm(), 0.015);
+  EXPECT_LT((parts.at("node_0").pose.translation() - Eigen::Vector3d(0.535, -0.0925, 0.025)).norm(), 0.003);
+  EXPECT_EQ(simulation.armTableContactSteps(), 0u);
+}
 
 // The paper's first task, the UR5's plan file unchanged: pick up any feasible node and lift it.
 TEST(IiwaSimWorkcell, ThePapersPickUpPlanLiftsANode) {
