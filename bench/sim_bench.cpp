@@ -10,6 +10,7 @@
 #include "arm/trajectory.h"
 #include "core/paths.h"
 #include "sim/simulation.h"
+#include "workcell/grippers.h"
 #include "workcell/sim_cell_description.h"
 
 namespace costar::bench {
@@ -19,14 +20,22 @@ std::unique_ptr<sim::Simulation> assembly() {
   return sim::Simulation::create(sim::loadScene(dataRoot() / "sim/scenes/assembly.json"));
 }
 
-/// The iiwa-sim cell's simulation (workcells/iiwa-sim.json) with the assembly scene.
-std::unique_ptr<sim::Simulation> iiwaAssembly() {
-  const workcell::SimCellDescription cell = workcell::loadSimCellDescription(workcell::simCellFile("iiwa-sim"));
+/// A cell's simulation (workcells/NAME.json: its arm, gripper and cell) with its scene, the
+/// assembly's.
+std::unique_ptr<sim::Simulation> cellAssembly(const std::string& name) {
+  const workcell::SimCellDescription cell = workcell::loadSimCellDescription(workcell::simCellFile(name));
+  const workcell::GripperModel& gripper = workcell::gripperModel(cell.gripper);
   sim::SimulationOptions options;
   options.robot = arm::loadRobotDescription(arm::robotDescriptionFile(cell.robot));
   options.robot_base = cell.robot_base;
+  options.cell_model = cell.cell_model;
+  options.gripper_model = dataRoot() / gripper.mjcf;
+  options.adaptive_gripper = gripper.adaptive;
   return sim::Simulation::create(sim::loadScene(cell.scene), options);
 }
+
+/// The iiwa-sim cell's simulation (workcells/iiwa-sim.json) with the assembly scene.
+std::unique_ptr<sim::Simulation> iiwaAssembly() { return cellAssembly("iiwa-sim"); }
 
 /// Swings the arm between its home and `away` at full speed within `limits`, for ever.
 void swing(sim::Simulation& simulation, const arm::JointVector& away, const arm::JointLimits& limits) {
@@ -93,6 +102,25 @@ void BM_PhysicsArmMoving_Iiwa(benchmark::State& state) {
   simulateSeconds(state, *simulation);
 }
 BENCHMARK(BM_PhysicsArmMoving_Iiwa)->Unit(benchmark::kMillisecond);
+
+// The iiwa with the 3-finger adaptive gripper (workcells/iiwa-3f-sim.json): 15 phalanges, a
+// scissor axis and their tendons on the flange.
+void BM_PhysicsArmHolding_Iiwa3f(benchmark::State& state) {
+  const auto simulation = cellAssembly("iiwa-3f-sim");
+  simulateSeconds(state, *simulation);
+}
+BENCHMARK(BM_PhysicsArmHolding_Iiwa3f)->Unit(benchmark::kMillisecond);
+
+void BM_PhysicsArmMoving_Iiwa3f(benchmark::State& state) {
+  const auto simulation = cellAssembly("iiwa-3f-sim");
+  const arm::RobotDescription iiwa = arm::loadRobotDescription(arm::robotDescriptionFile("iiwa14"));
+  arm::JointVector away = iiwa.home;
+  away[0] = -1.2;
+  away[1] = 0.6;
+  swing(*simulation, away, iiwa.limits);
+  simulateSeconds(state, *simulation);
+}
+BENCHMARK(BM_PhysicsArmMoving_Iiwa3f)->Unit(benchmark::kMillisecond);
 
 /// One frame as a plan's DetectObjects takes its last one: colour and depth, noise on 2 threads.
 /// "CPU" is the main thread's; the /process_time variant counts every thread (Mesa's
