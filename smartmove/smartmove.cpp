@@ -621,7 +621,9 @@ std::optional<double> SmartMoveComponent::fingerReachAcross(const std::string& m
     return pad;
   }
   if (config_.mode_fingers && config_.mode_fingers->reach_across && !mode.empty()) {
-    return config_.mode_fingers->reach_across(mode);
+    if (const double reach = config_.mode_fingers->reach_across(mode); reach > 0.0) {
+      return reach;
+    }
   }
   return std::nullopt;
 }

@@ -90,7 +90,8 @@ struct SmartMoveConfig {
     /// tool's axis between the fingertips; 0 when the fingers cannot close part way.
     std::function<double(const std::string& mode, double half_width)> position_for;
     /// How far (m) the fingers in mode reach along the tool's x, either side of its axis: a
-    /// grasp shifted along a part keeps them that far inside its end. Empty: no shifted grasps.
+    /// grasp shifted along a part keeps them that far inside its end. Empty, or 0 for a mode it
+    /// does not model: no shifted grasps.
     std::function<double(const std::string& mode)> reach_across;
   };
   std::optional<ModeFingers> mode_fingers;
