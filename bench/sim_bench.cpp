@@ -5,6 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <string>
 
 #include "arm/robot_description.h"
 #include "arm/trajectory.h"
@@ -33,9 +34,6 @@ std::unique_ptr<sim::Simulation> cellAssembly(const std::string& name) {
   options.adaptive_gripper = gripper.adaptive;
   return sim::Simulation::create(sim::loadScene(cell.scene), options);
 }
-
-/// The iiwa-sim cell's simulation (workcells/iiwa-sim.json) with the assembly scene.
-std::unique_ptr<sim::Simulation> iiwaAssembly() { return cellAssembly("iiwa-sim"); }
 
 /// Swings the arm between its home and `away` at full speed within `limits`, for ever.
 void swing(sim::Simulation& simulation, const arm::JointVector& away, const arm::JointLimits& limits) {
@@ -86,40 +84,31 @@ void BM_PhysicsArmMoving(benchmark::State& state) {
 }
 BENCHMARK(BM_PhysicsArmMoving)->Unit(benchmark::kMillisecond);
 
-void BM_PhysicsArmHolding_Iiwa(benchmark::State& state) {
-  const auto simulation = iiwaAssembly();
+/// The iiwa arm of cell `name` held still, or swung between its home and a pose over the table.
+void iiwaPhysics(benchmark::State& state, const std::string& name, bool swinging) {
+  const auto simulation = cellAssembly(name);
+  if (swinging) {
+    const arm::RobotDescription iiwa = arm::loadRobotDescription(arm::robotDescriptionFile("iiwa14"));
+    arm::JointVector away = iiwa.home;
+    away[0] = -1.2;
+    away[1] = 0.6;
+    swing(*simulation, away, iiwa.limits);
+  }
   simulateSeconds(state, *simulation);
 }
+
+void BM_PhysicsArmHolding_Iiwa(benchmark::State& state) { iiwaPhysics(state, "iiwa-sim", false); }
 BENCHMARK(BM_PhysicsArmHolding_Iiwa)->Unit(benchmark::kMillisecond);
 
-void BM_PhysicsArmMoving_Iiwa(benchmark::State& state) {
-  const auto simulation = iiwaAssembly();
-  const arm::RobotDescription iiwa = arm::loadRobotDescription(arm::robotDescriptionFile("iiwa14"));
-  arm::JointVector away = iiwa.home;
-  away[0] = -1.2;
-  away[1] = 0.6;
-  swing(*simulation, away, iiwa.limits);
-  simulateSeconds(state, *simulation);
-}
+void BM_PhysicsArmMoving_Iiwa(benchmark::State& state) { iiwaPhysics(state, "iiwa-sim", true); }
 BENCHMARK(BM_PhysicsArmMoving_Iiwa)->Unit(benchmark::kMillisecond);
 
-// The iiwa with the 3-finger adaptive gripper (workcells/iiwa-3f-sim.json): 15 phalanges, a
-// scissor axis and their tendons on the flange.
-void BM_PhysicsArmHolding_Iiwa3f(benchmark::State& state) {
-  const auto simulation = cellAssembly("iiwa-3f-sim");
-  simulateSeconds(state, *simulation);
-}
+// The iiwa with the 3-finger adaptive gripper (workcells/iiwa-3f-sim.json): three fingers of
+// three phalanges, a scissor axis and their tendons on the flange.
+void BM_PhysicsArmHolding_Iiwa3f(benchmark::State& state) { iiwaPhysics(state, "iiwa-3f-sim", false); }
 BENCHMARK(BM_PhysicsArmHolding_Iiwa3f)->Unit(benchmark::kMillisecond);
 
-void BM_PhysicsArmMoving_Iiwa3f(benchmark::State& state) {
-  const auto simulation = cellAssembly("iiwa-3f-sim");
-  const arm::RobotDescription iiwa = arm::loadRobotDescription(arm::robotDescriptionFile("iiwa14"));
-  arm::JointVector away = iiwa.home;
-  away[0] = -1.2;
-  away[1] = 0.6;
-  swing(*simulation, away, iiwa.limits);
-  simulateSeconds(state, *simulation);
-}
+void BM_PhysicsArmMoving_Iiwa3f(benchmark::State& state) { iiwaPhysics(state, "iiwa-3f-sim", true); }
 BENCHMARK(BM_PhysicsArmMoving_Iiwa3f)->Unit(benchmark::kMillisecond);
 
 /// One frame as a plan's DetectObjects takes its last one: colour and depth, noise on 2 threads.
