@@ -605,8 +605,10 @@ Selection SmartMoveComponent::selectGrasp(const std::string& object_class,
     return {};
   };
   Selection selection = selectGoal(matches.objects, *object, grasp, armModel(), config_.weights, feasible);
-  if (const auto reach = fingerReachAcross(mode); !selection.ok() && with_approach && reach) {
-    selection = withShiftedGrasps(std::move(selection), *object, *reach, feasible);
+  if (!selection.ok() && with_approach) {
+    if (const auto reach = fingerReachAcross(mode)) {
+      selection = withShiftedGrasps(std::move(selection), *object, *reach, feasible);
+    }
   }
   addRejected(selection, matches);
   return selection;
@@ -630,7 +632,7 @@ std::optional<double> SmartMoveComponent::fingerReachAcross(const std::string& m
 
 std::vector<double> SmartMoveComponent::graspShifts(const world::Pose& tcp, const world::Pose& object,
                                                     const world::ObjectClass& object_class, double reach) const {
-  // The part's extent along the tool's x (across the fingers) and the pads' half width.
+  // The part's extent along the tool's x (across the fingers); the fingers reach `reach` either side.
   const Eigen::AlignedBox3d bounds = object_class.bounds();
   const world::Pose part_in_tool = tcp.inverse() * object;
   double low = 0.0;
@@ -640,13 +642,12 @@ std::vector<double> SmartMoveComponent::graspShifts(const world::Pose& tcp, cons
     low = std::min(low, p.x());
     high = std::max(high, p.x());
   }
-  const double pad = reach;
   const double keep = config_.grasp_shift_keep;
   std::vector<double> shifts;
   for (int k = 1; k * config_.grasp_shift_step <= config_.grasp_shift_max + 1e-9; ++k) {
     const double shift = k * config_.grasp_shift_step;
     for (const double d : {shift, -shift}) {
-      const double limited = d > 0 ? std::min(d, high - pad - keep) : std::max(d, low + pad + keep);
+      const double limited = d > 0 ? std::min(d, high - reach - keep) : std::max(d, low + reach + keep);
       if (limited * d > 1e-6 &&
           std::none_of(shifts.begin(), shifts.end(), [&](double s) { return std::abs(s - limited) < 1e-6; })) {
         shifts.push_back(limited);
