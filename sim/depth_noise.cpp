@@ -88,6 +88,21 @@ struct Scratch {
 
 int roundToInt(double x) { return static_cast<int>(std::floor(x + 0.5)); }
 
+/// acos(c) for c in [0, 1]: Abramowitz and Stegun 4.4.46 (|error| <= 2e-8 rad, below a float's
+/// rounding of the angle), branch-free so that a row of them vectorizes; libm's acosf was a
+/// quarter of the noise model's time.
+inline float acosUnit(float c) {
+  float p = -0.0012624911f;
+  p = p * c + 0.0066700901f;
+  p = p * c - 0.0170881256f;
+  p = p * c + 0.0308918810f;
+  p = p * c - 0.0501743046f;
+  p = p * c + 0.0889789874f;
+  p = p * c - 0.2145988016f;
+  p = p * c + 1.5707963050f;
+  return std::sqrt(1.0f - c) * p;
+}
+
 /// Runs `rows(v_begin, v_end)` over [0, height) on `threads` threads (the calling one included).
 template <typename Rows>
 void parallelRows(int height, int threads, const Rows& rows) {
@@ -169,41 +184,97 @@ void noisyPointCloud(const std::vector<float>& depth, const camera::Intrinsics& 
   incidence.resize(pixels);
   std::vector<std::uint32_t>& reading_rows = scratch.reading_rows;
   reading_rows.assign(static_cast<std::size_t>(h) + 1, 0);
+  const auto near_limit = static_cast<float>(o.min_range);
+  const auto far_limit = static_cast<float>(o.max_range);
   parallelRows(h, threads, [&](int v_begin, int v_end) {
+    std::vector<float> grazing_row(static_cast<std::size_t>(w));
     for (int v = v_begin; v < v_end; ++v) {
-      std::uint32_t reading = 0;
-      for (int u = 0; u < w; ++u) {
+      // First the cosine of each pixel's incidence angle (-1: no reading), then the angles of
+      // the whole row at once.
+      float* const cosines = incidence.data() + static_cast<std::size_t>(v) * w;
+      // A pixel at the image's border, one neighbour at a time.
+      const auto border_cosine = [&](int u) {
         const std::size_t i = static_cast<std::size_t>(v) * w + u;
-        float& theta_out = incidence[i];
-        theta_out = nan;
-        if (ok[i] == 0) {
-          continue;
+        if (ok[i] == 0 || z_at[i] < near_limit || z_at[i] > far_limit) {
+          return -1.0f;
         }
-        const float z_clean = z_at[i];
-        if (z_clean < o.min_range || z_clean > o.max_range) {
-          continue;
-        }
-        // Surface normal from the neighbours (central differences where possible); the
-        // incidence angle between it and the viewing ray.
         const int u0 = valid(u - 1, v) ? u - 1 : u;
         const int u1 = valid(u + 1, v) ? u + 1 : u;
         const int v0 = valid(u, v - 1) ? v - 1 : v;
         const int v1 = valid(u, v + 1) ? v + 1 : v;
-        float theta = 0.0f;
-        if (u0 != u1 && v0 != v1) {
-          const Eigen::Vector3f normal = (point(u1, v) - point(u0, v)).cross(point(u, v1) - point(u, v0));
-          const Eigen::Vector3f ray(ray_x[u], ray_y[v], 1.0f);
-          const float scale = normal.norm() * ray.norm();
-          if (scale > 0.0f) {
-            const float cosine = std::min(1.0f, std::abs(normal.dot(ray)) / scale);
-            if (cosine < cos_max) {
-              continue;  // grazing: the projected pattern is not seen
-            }
-            theta = std::acos(cosine);
-          }
+        if (u0 == u1 || v0 == v1) {
+          return 1.0f;  // no normal: read as frontal
         }
-        theta_out = theta;
-        ++reading;
+        const Eigen::Vector3f normal = (point(u1, v) - point(u0, v)).cross(point(u, v1) - point(u, v0));
+        const Eigen::Vector3f ray(ray_x[u], ray_y[v], 1.0f);
+        const float squared_scale = normal.squaredNorm() * ray.squaredNorm();
+        return squared_scale > 0.0f ? std::min(1.0f, std::abs(normal.dot(ray)) / std::sqrt(squared_scale)) : 1.0f;
+      };
+      if (v == 0 || v + 1 == h) {
+        for (int u = 0; u < w; ++u) {
+          cosines[u] = border_cosine(u);
+        }
+      } else {
+        cosines[0] = border_cosine(0);
+        cosines[w - 1] = border_cosine(w - 1);
+        // Inside the image: the same as border_cosine, written with selects instead of
+        // branches so that GCC vectorizes the row. A neighbour without a surface is replaced
+        // by the pixel itself (a one-sided difference); none on either side: no normal.
+        const float* const z = z_at + static_cast<std::size_t>(v) * w;
+        const float* const z_up = z - w;
+        const float* const z_down = z + w;
+        const float ray_v = ray_y[v];
+        const float ray_up = ray_y[v - 1];
+        const float ray_down = ray_y[v + 1];
+        constexpr float kInfinity = std::numeric_limits<float>::infinity();
+        for (int u = 1; u + 1 < w; ++u) {
+          // Every value read up front (a read only under a condition keeps GCC from vectorizing).
+          const float zc = z[u];
+          const float z_left = z[u - 1];
+          const float z_right = z[u + 1];
+          const float z_above = z_up[u];
+          const float z_below = z_down[u];
+          const float ray_left = ray_x[u - 1];
+          const float ray_centre = ray_x[u];
+          const float ray_right = ray_x[u + 1];
+          const bool left = (z_left > 0.0f) & (z_left < kInfinity);
+          const bool right = (z_right > 0.0f) & (z_right < kInfinity);
+          const bool up = (z_above > 0.0f) & (z_above < kInfinity);
+          const bool down = (z_below > 0.0f) & (z_below < kInfinity);
+          // Along the row: from (x0, z0) to (x1, z1).
+          const float z1 = right ? z_right : zc;
+          const float x1 = (right ? ray_right : ray_centre) * z1;
+          const float z0 = left ? z_left : zc;
+          const float x0 = (left ? ray_left : ray_centre) * z0;
+          const Eigen::Vector3f along_row(x1 - x0, ray_v * (z1 - z0), z1 - z0);
+          // Along the column.
+          const float z3 = down ? z_below : zc;
+          const float y3 = (down ? ray_down : ray_v) * z3;
+          const float z2 = up ? z_above : zc;
+          const float y2 = (up ? ray_up : ray_v) * z2;
+          const Eigen::Vector3f along_column(ray_centre * (z3 - z2), y3 - y2, z3 - z2);
+          const Eigen::Vector3f normal = along_row.cross(along_column);
+          const Eigen::Vector3f ray(ray_centre, ray_v, 1.0f);
+          const float squared_scale = normal.squaredNorm() * ray.squaredNorm();
+          const float cosine = std::min(1.0f, std::abs(normal.dot(ray)) / std::sqrt(std::max(squared_scale, 1e-30f)));
+          const bool has_normal = (left | right) & (up | down) & (squared_scale > 0.0f);
+          const bool reads = (zc > 0.0f) & (zc < kInfinity) & (zc >= near_limit) & (zc <= far_limit);
+          cosines[u] = reads ? (has_normal ? cosine : 1.0f) : -1.0f;
+        }
+      }
+      // Each reading pixel's ratio theta / (pi/2 - theta), which both sigmas of the model use
+      // (lateralSigma, axialSigma), for the whole row (no branches: it vectorizes); then NaN
+      // for grazing pixels (cosine below cos_max) and those without a reading.
+      float* const grazings = grazing_row.data();
+      for (int u = 0; u < w; ++u) {
+        const float theta = acosUnit(std::max(cosines[u], cos_max));
+        grazings[u] = theta / (static_cast<float>(M_PI / 2) - theta);
+      }
+      std::uint32_t reading = 0;
+      for (int u = 0; u < w; ++u) {
+        const bool reads = cosines[u] >= cos_max;
+        cosines[u] = reads ? grazings[u] : nan;
+        reading += reads ? 1 : 0;
       }
       reading_rows[static_cast<std::size_t>(v) + 1] = reading;
     }
@@ -221,43 +292,94 @@ void noisyPointCloud(const std::vector<float>& depth, const camera::Intrinsics& 
     bits = random.next();
   }
 
-  // Pass 3: lateral jitter, axial noise, disparity quantization.
+  // Pass 3: lateral jitter, axial noise, disparity quantization; a row at a time in three
+  // steps, so that the arithmetic (four divisions and a square root per pixel, which one
+  // pixel after another would wait on) runs over whole rows: (a) the jittered source pixel of
+  // each reading, (b) its noisy, quantized depth, (c) the points.
   const NormalTable& normal = normals();
   const double focal_baseline = in.fx * o.baseline;
+  const double inverse_step = 1.0 / o.disparity_step;
+  const bool quantize = o.quantize_disparity;
+  const double reference_depth = o.axial_reference_depth;
+  const double lateral_constant = o.lateral_constant;
+  const double lateral_angular = o.lateral_angular;
+  const int width = w;
+  const int height = h;
+  const std::uint8_t* const surface_at = surface.data();
+  const double axial_constant = o.axial_constant;
+  const double axial_quadratic = o.axial_quadratic;
+  const double step = o.disparity_step;
+  const double min_range = o.min_range;
+  const double max_range = o.max_range;
   parallelRows(h, threads, [&](int v_begin, int v_end) {
+    std::vector<double> depth_row(static_cast<std::size_t>(w));  // (a): the source's clean depth
+    std::vector<double> grazing_row(static_cast<std::size_t>(w));
+    std::vector<double> axial_row(static_cast<std::size_t>(w));  // the standard normal for the depth
+    std::vector<int> column(static_cast<std::size_t>(w));        // the reading's own pixel
     for (int v = v_begin; v < v_end; ++v) {
-      std::size_t next_draw = reading_rows[static_cast<std::size_t>(v)];
-      for (int u = 0; u < w; ++u) {
-        const std::size_t i = static_cast<std::size_t>(v) * w + u;
-        Eigen::Vector3f& out = points[i];
-        out = Eigen::Vector3f(nan, nan, nan);
-        const float theta_f = incidence[i];
-        if (std::isnan(theta_f)) {
+      const std::uint64_t* draw = draws.data() + reading_rows[static_cast<std::size_t>(v)];
+      const float* const grazing_at = incidence.data() + static_cast<std::size_t>(v) * width;
+      int readings = 0;
+      for (int u = 0; u < width; ++u) {
+        const float grazing = grazing_at[u];
+        if (std::isnan(grazing)) {
           continue;
         }
-        const double theta = theta_f;
         // Lateral noise: the reading comes from a jittered pixel.
-        const std::uint64_t bits = draws[next_draw++];
-        const double sigma_l = lateralSigma(o, theta);
+        const std::uint64_t bits = *draw++;
+        const double sigma_l = lateral_constant + lateral_angular * static_cast<double>(grazing);
         const int su = roundToInt(u + sigma_l * normal[bits]);
         const int sv = roundToInt(v + sigma_l * normal[bits >> 16]);
-        if (!valid(su, sv)) {
-          continue;  // the jitter fell off the surface: no reading
-        }
-        double z = z_at[static_cast<std::size_t>(sv) * w + su];
-        z += axialSigma(o, z, theta) * normal[bits >> 32];
-        if (o.quantize_disparity && z > 0) {
-          const double disparity = std::round(focal_baseline / z / o.disparity_step) * o.disparity_step;
-          if (disparity <= 0) {
-            continue;
-          }
-          z = focal_baseline / disparity;
-        }
-        if (z < o.min_range || z > o.max_range) {
+        // Off the image or off the surface: no reading.
+        if (static_cast<unsigned>(su) >= static_cast<unsigned>(width) ||
+            static_cast<unsigned>(sv) >= static_cast<unsigned>(height)) {
           continue;
         }
-        out =
-            Eigen::Vector3f(static_cast<float>(ray_x[u] * z), static_cast<float>(ray_y[v] * z), static_cast<float>(z));
+        const std::size_t source = static_cast<std::size_t>(sv) * width + su;
+        if (surface_at[source] == 0) {
+          continue;
+        }
+        depth_row[readings] = z_at[source];
+        grazing_row[readings] = grazing;
+        axial_row[readings] = normal[bits >> 32];
+        column[readings] = u;
+        ++readings;
+      }
+      // (b) Axial noise and quantization, without branches so that it vectorizes. A reading
+      // nearer than the sensor's range (the noise can take it below zero) quantizes to a depth
+      // far below it; one beyond 630 m to 315 m: (c) drops both.
+      double* const depths = depth_row.data();
+      const double* const grazings = grazing_row.data();
+      const double* const axials = axial_row.data();
+      for (int k = 0; k < readings; ++k) {
+        const double z = depths[k];
+        const double grazing = grazings[k];
+        const double dz = z - reference_depth;
+        const double sigma_z = axial_constant + axial_quadratic * dz * dz + 0.0001 / std::sqrt(z) * grazing * grazing;
+        depths[k] = z + sigma_z * axials[k];
+      }
+      if (quantize) {
+        for (int k = 0; k < readings; ++k) {
+          // The disparity in steps, rounded to the nearest: floor(scaled + 0.5), the floor
+          // taken by adding and taking away 1.5 * 2^52 (which rounds to an integer) and
+          // stepping down where that rounded up (SSE2 has no vector floor).
+          const double scaled = std::min(focal_baseline / std::max(depths[k], 1e-9) * inverse_step, 2e9);
+          const double half_up = scaled + 0.5;
+          const double nearest = (half_up + 6755399441055744.0) - 6755399441055744.0;
+          const double steps = nearest - (nearest > half_up ? 1.0 : 0.0);
+          depths[k] = focal_baseline / (std::max(steps, 1.0) * step);
+        }
+      }
+      // (c) The points; every other pixel reads nothing.
+      Eigen::Vector3f* const out = points.data() + static_cast<std::size_t>(v) * w;
+      std::fill(out, out + w, Eigen::Vector3f(nan, nan, nan));
+      for (int k = 0; k < readings; ++k) {
+        const double z = depths[k];
+        if (z >= min_range && z <= max_range) {
+          const int u = column[k];
+          out[u] = Eigen::Vector3f(static_cast<float>(ray_x[u] * z), static_cast<float>(ray_y[v] * z),
+                                   static_cast<float>(z));
+        }
       }
     }
   });

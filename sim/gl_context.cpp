@@ -229,7 +229,17 @@ void GlRenderer::render(const mjModel* model, mjData* data, int camera_id, int w
   scene_.flags[mjRND_SKYBOX] = colour ? 1 : 0;
   scene_.flags[mjRND_SEGMENT] = colour ? 0 : 1;
   const mjrRect viewport{0, 0, width, height};
+  // Depth alone: no colour written (llvmpipe's fragment code then only tests and writes depth).
+  // glColorMask from EGL, as MuJoCo takes its GL functions: this library links no GL library.
+  using ColorMask = void (*)(unsigned char, unsigned char, unsigned char, unsigned char);
+  static const auto color_mask = reinterpret_cast<ColorMask>(eglGetProcAddress("glColorMask"));
+  if (!colour && color_mask != nullptr) {
+    color_mask(0, 0, 0, 0);
+  }
   mjr_render(viewport, &scene_, &render_context_);
+  if (!colour && color_mask != nullptr) {
+    color_mask(1, 1, 1, 1);
+  }
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   if (colour) {
     rgb_buffer_.resize(pixels * 3);
@@ -253,12 +263,13 @@ void GlRenderer::render(const mjModel* model, mjData* data, int camera_id, int w
     const double near = model->vis.map.znear * extent;
     const double far = model->vis.map.zfar * extent;
     depth->resize(pixels);
+    const double scale = 1.0 - near / far;
     for (int y = 0; y < height; ++y) {
       const float* row = &depth_buffer_[static_cast<std::size_t>(height - 1 - y) * width];
       float* out = depth->data() + static_cast<std::size_t>(y) * width;
       for (int x = 0; x < width; ++x) {
         const double d = row[x];
-        out[x] = d >= 1.0 ? 0.0f : static_cast<float>(near / (1.0 - d * (1.0 - near / far)));
+        out[x] = d >= 1.0 ? 0.0f : static_cast<float>(near / (1.0 - d * scale));
       }
     }
   }
