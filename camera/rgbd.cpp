@@ -20,4 +20,8 @@ std::size_t RgbdFrame::validCount() const {
       std::count_if(points.begin(), points.end(), [](const Eigen::Vector3f& p) { return std::isfinite(p.z()); }));
 }
 
+bool RgbdFrame::anyValid() const {
+  return std::any_of(points.begin(), points.end(), [](const Eigen::Vector3f& p) { return std::isfinite(p.z()); });
+}
+
 }  // namespace costar::camera

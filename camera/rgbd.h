@@ -43,6 +43,8 @@ struct RgbdFrame {
   }
   bool valid(int u, int v) const { return std::isfinite(point(u, v).z()); }
   std::size_t validCount() const;
+  /// Whether any point is valid (stops at the first).
+  bool anyValid() const;
 };
 
 /// What a camera's stream says about its newest frame, without the frame itself.

@@ -86,7 +86,7 @@ class DetectObjectsOperation final : public component::RunningOperation {
       const std::size_t pixels = static_cast<std::size_t>(frame.intrinsics.width) * frame.intrinsics.height;
       if (frame.points.empty() || frame.points.size() != pixels) {
         done_ = OperationResult::failure("DetectObjects: the camera sent an empty frame");
-      } else if (frame.validCount() == 0) {
+      } else if (!frame.anyValid()) {
         done_ = OperationResult::failure(
             "DetectObjects: the camera sent a frame without any valid depth (is it covered, broken, or not looking "
             "at the table?)");

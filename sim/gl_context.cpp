@@ -31,7 +31,16 @@ struct SharedDisplay {
   int initializations = 0;
   EGLDisplay display = EGL_NO_DISPLAY;
   EGLConfig config = nullptr;
+  /// Contexts of renderers that are gone, current nowhere, kept for the next renderers: a
+  /// context keeps the shaders Mesa compiled for it (llvmpipe compiles each GL state's shaders
+  /// with LLVM the first time a context draws with it, ~0.15 s of CPU per new context), which
+  /// a trial loop (a renderer per trial) paid once per trial.
+  std::vector<EGLContext> spare_contexts;
+  int contexts_created = 0;
 };
+
+/// At most this many contexts kept for reuse (a thread each, for `trials -j N`).
+constexpr std::size_t kSpareContexts = 8;
 
 SharedDisplay& sharedDisplay() {
   static auto* shared = new SharedDisplay;  // never destroyed, see above
@@ -146,7 +155,13 @@ GlRenderer::GlRenderer(const mjModel* model) {
   display_ = shared.display;
   try {
     eglBindAPI(EGL_OPENGL_API);
-    context_ = eglCreateContext(display_, shared.config, EGL_NO_CONTEXT, nullptr);
+    if (!shared.spare_contexts.empty()) {
+      context_ = shared.spare_contexts.back();
+      shared.spare_contexts.pop_back();
+    } else {
+      context_ = eglCreateContext(display_, shared.config, EGL_NO_CONTEXT, nullptr);
+      shared.contexts_created += context_ != EGL_NO_CONTEXT ? 1 : 0;
+    }
     if (context_ == EGL_NO_CONTEXT) {
       throw std::runtime_error(eglError("eglCreateContext"));
     }
@@ -179,16 +194,24 @@ GlRenderer::GlRenderer(const mjModel* model) {
 GlRenderer::~GlRenderer() {
   SharedDisplay& shared = sharedDisplay();
   const std::lock_guard lock(shared.mutex);
+  bool freed = false;
   try {
     const Current current(display_, context_);
     mjr_freeContext(&render_context_);
+    freed = true;
   } catch (const std::exception& e) {
     // Only when the context is current on another thread, which this class never leaves it:
     // its GL objects go with the context.
     std::fprintf(stderr, "warning: %s (while freeing a renderer)\n", e.what());
   }
   mjv_freeScene(&scene_);
-  eglDestroyContext(display_, context_);
+  // A context emptied of MuJoCo's objects is kept for the next renderer (it keeps its compiled
+  // shaders); one that could not be emptied, or beyond the spares kept, is destroyed.
+  if (freed && shared.spare_contexts.size() < kSpareContexts) {
+    shared.spare_contexts.push_back(context_);
+  } else {
+    eglDestroyContext(display_, context_);
+  }
   releaseDisplay(shared);
 }
 
@@ -196,6 +219,12 @@ int GlRenderer::displayInitializations() {
   SharedDisplay& shared = sharedDisplay();
   const std::lock_guard lock(shared.mutex);
   return shared.initializations;
+}
+
+int GlRenderer::contextsCreated() {
+  SharedDisplay& shared = sharedDisplay();
+  const std::lock_guard lock(shared.mutex);
+  return shared.contexts_created;
 }
 
 int GlRenderer::liveCount() {

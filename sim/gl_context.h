@@ -12,8 +12,9 @@
 //   is created and destroyed): at any other time it is current on no thread. A renderer may
 //   therefore be created, used and destroyed on different threads, one thread at a time; two
 //   renderers render on two threads at once.
-// - Teardown order: MuJoCo's GL objects, then the context, then (with the last renderer) the
-//   display. The destructor never throws.
+// - Teardown order: MuJoCo's GL objects, then the context (kept, current nowhere, for the next
+//   renderer, up to a few), then (with the last renderer) the display's user count. The
+//   destructor never throws.
 
 #include <EGL/egl.h>
 #include <mujoco/mujoco.h>
@@ -48,6 +49,10 @@ class GlRenderer {
   static int liveCount();
   /// How many times this process initialized the EGL display (1 once any renderer was made).
   static int displayInitializations();
+  /// GL contexts this process created. A renderer takes the context of one that is gone when
+  /// there is one (emptied of MuJoCo's objects; Mesa's compiled shaders stay with it), so a
+  /// trial loop makes one context per thread, not one per trial.
+  static int contextsCreated();
 
  private:
   class Current;  // makes the context current on this thread for a scope
