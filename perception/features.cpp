@@ -1,6 +1,6 @@
 #include "perception/features.h"
 
-#include <pcl/features/fpfh.h>
+#include <pcl/features/fpfh_omp.h>
 #include <pcl/point_types.h>
 #include <pcl/search/kdtree.h>
 
@@ -87,7 +87,8 @@ VoxelFeatures computeFeatures(const Cloud& points, const FeatureOptions& options
   if (voxels == 0) {
     return out;
   }
-  pcl::FPFHEstimation<pcl::PointXYZ, pcl::Normal, pcl::FPFHSignature33> fpfh;
+  pcl::FPFHEstimationOMP<pcl::PointXYZ, pcl::Normal, pcl::FPFHSignature33> fpfh(
+      static_cast<unsigned>(std::clamp(options.threads, 1, 16)));
   pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
   fpfh.setInputCloud(cloud);
   fpfh.setInputNormals(normals);

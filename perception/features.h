@@ -16,6 +16,8 @@ struct FeatureOptions {
   double voxel_size = 0.008;
   /// Neighbourhood radius of the FPFH histograms (m).
   double fpfh_radius = 0.02;
+  /// Threads computing the histograms (PCL's OpenMP estimator; the same histograms for any).
+  int threads = 1;
 };
 
 /// FPFH bins, colour values, and their total.

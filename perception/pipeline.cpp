@@ -90,6 +90,7 @@ Pipeline::Pipeline(std::vector<ObjectModel> models, SvmClassifier classifier, Pi
     label_of_model_.push_back(label);
   }
   options_.threads = std::clamp(options_.threads, 1, 8);
+  options_.segmentation.features.threads = options_.threads;
   workers_->estimators.resize(static_cast<std::size_t>(options_.threads));
   for (auto& per_thread : workers_->estimators) {
     for (const auto& model : models_) {

@@ -51,7 +51,8 @@ struct PipelineOptions {
   /// A detection's colour is the mean of its class's points within this distance of its
   /// boxes (m).
   double color_margin = 0.004;
-  /// Worker threads of the median filter and the pose estimation (results do not depend on it).
+  /// Worker threads of the median filter, the FPFH histograms and the pose estimation
+  /// (results do not depend on it; it sets segmentation.features.threads).
   int threads = 2;
 };
 

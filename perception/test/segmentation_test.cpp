@@ -174,6 +174,10 @@ TEST(Features, VoxelsGetFpfhHistogramsAndColour) {
     const int v = voxels.voxel_of_point[i];
     EXPECT_LT((voxels.voxels.points[static_cast<std::size_t>(v)] - workspace.cloud.points[i]).norm(), 0.011f);
   }
+  // PCL's OpenMP estimator on 2 threads (as the pipeline runs it): the same histograms.
+  FeatureOptions two_threads;
+  two_threads.threads = 2;
+  EXPECT_EQ(computeFeatures(workspace.cloud, two_threads).features, voxels.features);
   Cloud no_normals;
   no_normals.points = {Eigen::Vector3f::Zero()};
   EXPECT_THROW(computeFeatures(no_normals), std::invalid_argument);
