@@ -14,13 +14,15 @@ int main(int argc, char** argv) {
   costar::faults::CampaignOptions options;
   options.count = 1000;
   std::string json;
-  CLI::App app("Runs the paper's UR5 plans with one injected fault each and judges every run");
+  CLI::App app("Runs the paper's three plans with one injected fault each and judges every run");
   app.add_option("-n,--n", options.count, "runs (faults)")->check(CLI::Range(1, 1000000))->capture_default_str();
   app.add_option("--seed", options.seed, "seed of the first run (run i: seed + i)")->capture_default_str();
   app.add_option("-j,--jobs", options.jobs, "runs at once")->check(CLI::Range(1, 64))->capture_default_str();
   app.add_option("--window", options.window_s, "timed faults: moment in [0, WINDOW) simulated s")
       ->capture_default_str();
-  app.add_option("-w,--workcell", options.workcell, "ur5-sim, or test (components only)")->capture_default_str();
+  app.add_option("-w,--workcell", options.workcell,
+                 "a simulated workcell (ur5-sim, iiwa-sim, iiwa-3f-sim: `costar workcells`), or test (components only)")
+      ->capture_default_str();
   std::vector<std::string> plans;
   app.add_option("--plan", plans, "plan(s) to run in place of the paper's three tasks");
   app.add_option("--fault", options.faults, "KIND:TARGET to cycle through, or KIND:TARGET@WHEN (default: all)");

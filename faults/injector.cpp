@@ -91,6 +91,50 @@ class FaultyGripperDriver final : public gripper::GripperDriver {
   mutable gripper::FingerReading last_;
 };
 
+/// A 3-finger adaptive gripper's finger sensors, likewise (every finger's position, speed and
+/// force); finger and mode commands still reach the gripper.
+class FaultyAdaptiveGripperDriver final : public gripper::AdaptiveGripperDriver {
+ public:
+  FaultyAdaptiveGripperDriver(gripper::AdaptiveGripperDriver& inner, Injector& injector, std::size_t fault)
+      : inner_(inner), injector_(injector), fault_(fault) {}
+
+  gripper::AdaptiveGripperReading read() const override {
+    if (!injector_.active(fault_, false)) {
+      last_ = inner_.read();
+      return last_;
+    }
+    injector_.effect(fault_);
+    const FaultRecord& record = injector_.record(fault_);
+    switch (record.spec.kind) {
+      case FaultKind::kThrow:
+        throw std::runtime_error("gripper driver: reading the fingers failed" + injected(record));
+      case FaultKind::kHang:
+        return last_;
+      default: {
+        gripper::AdaptiveGripperReading reading = inner_.read();
+        for (auto& finger : reading.fingers) {
+          finger.position = finger.speed = finger.force = kNaN;
+        }
+        return reading;
+      }
+    }
+  }
+  void commandFingers(const std::array<double, gripper::kFingerCount>& positions, double speed, double force) override {
+    injector_.active(fault_, true);
+    inner_.commandFingers(positions, speed, force);
+  }
+  void commandMode(gripper::GripperMode mode) override {
+    injector_.active(fault_, true);
+    inner_.commandMode(mode);
+  }
+
+ private:
+  gripper::AdaptiveGripperDriver& inner_;
+  Injector& injector_;
+  std::size_t fault_;
+  mutable gripper::AdaptiveGripperReading last_;
+};
+
 /// The RGB-D camera: its frames fail, repeat, come empty or all NaN, and its stream's status
 /// (what a health monitor sees between frames) says so too.
 class FaultyCamera final : public camera::RgbdCamera {
@@ -312,6 +356,10 @@ arm::ArmDriver& Injector::wrap(arm::ArmDriver& driver) {
 
 gripper::GripperDriver& Injector::wrap(gripper::GripperDriver& driver) {
   return chain<FaultyGripperDriver>(driver, "gripper-driver", gripper_wrappers_);
+}
+
+gripper::AdaptiveGripperDriver& Injector::wrap(gripper::AdaptiveGripperDriver& driver) {
+  return chain<FaultyAdaptiveGripperDriver>(driver, "gripper-driver", adaptive_wrappers_);
 }
 
 camera::RgbdCamera& Injector::wrap(camera::RgbdCamera& camera) {

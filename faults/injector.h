@@ -24,6 +24,7 @@
 #include "component/component.h"
 #include "core/clock.h"
 #include "faults/fault.h"
+#include "gripper/adaptive_gripper_driver.h"
 #include "gripper/gripper_driver.h"
 
 namespace costar::faults {
@@ -57,6 +58,8 @@ class Injector {
   /// driver itself. The injector owns the wrappers: it must outlive their users.
   arm::ArmDriver& wrap(arm::ArmDriver& driver);
   gripper::GripperDriver& wrap(gripper::GripperDriver& driver);
+  /// A 3-finger adaptive gripper's driver: the same target, "gripper-driver".
+  gripper::AdaptiveGripperDriver& wrap(gripper::AdaptiveGripperDriver& driver);
   camera::RgbdCamera& wrap(camera::RgbdCamera& camera);
   /// The component wrapped once per fault that targets its name, or itself.
   std::shared_ptr<component::Component> wrap(std::shared_ptr<component::Component> component);
@@ -88,6 +91,7 @@ class Injector {
   std::vector<std::string> wrapped_targets_;
   std::vector<std::unique_ptr<arm::ArmDriver>> arm_wrappers_;
   std::vector<std::unique_ptr<gripper::GripperDriver>> gripper_wrappers_;
+  std::vector<std::unique_ptr<gripper::AdaptiveGripperDriver>> adaptive_wrappers_;
   std::vector<std::unique_ptr<camera::RgbdCamera>> camera_wrappers_;
 };
 

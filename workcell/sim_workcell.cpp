@@ -139,13 +139,14 @@ class SimWorkcell final : public Workcell {
     }
     // The drivers and components as the cell uses them: wrapped by the fault injector, if any.
     arm::ArmDriver& arm_driver = faults_ ? faults_->wrap(arm_driver_) : arm_driver_;
-    // The gripper's driver: the 2-finger fingers (wrapped by the fault injector, if any) or the
-    // adaptive gripper the simulation drives.
+    // The gripper's driver: the 2-finger fingers or the adaptive gripper the simulation drives,
+    // either wrapped by the fault injector, if any.
     GripperDrivers gripper_drivers;
     if (gripper_model_.adaptive.empty()) {
       gripper_drivers.parallel = faults_ ? &faults_->wrap(gripper_driver_) : &gripper_driver_;
     } else {
-      gripper_drivers.adaptive = simulation_->adaptiveGripper();
+      gripper::AdaptiveGripperDriver* adaptive = simulation_->adaptiveGripper();
+      gripper_drivers.adaptive = faults_ && adaptive != nullptr ? &faults_->wrap(*adaptive) : adaptive;
     }
     cell_gripper_driver_ = gripper_drivers.parallel;
     if (!gripper_model_.adaptive.empty()) {

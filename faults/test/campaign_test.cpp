@@ -89,5 +89,25 @@ TEST(FaultCampaign, AGripperThatThrowsAsItClosesEndsTheGraspAtOnce) {
   EXPECT_TRUE(trial.waypoints_intact);
 }
 
+TEST(FaultCampaign, TheThreeFingerGrippersDriverBreaksAndTheCellStops) {
+  // The iiwa with the adaptive gripper: its driver's readings go NaN, stop updating or fail
+  // (`--inject KIND:gripper-driver` had no target on this cell before).
+  CampaignOptions options;
+  options.workcell = "iiwa-3f-sim";
+  options.tasks = {paperTasks().front()};
+  options.faults = {"nan:gripper-driver", "hang:gripper-driver", "throw:gripper-driver"};
+  options.count = 3;
+  options.seed = 100;
+  const CampaignSummary summary = runCampaign(options);
+  ASSERT_EQ(summary.trials.size(), 3u);
+  for (const FaultTrial& trial : summary.trials) {
+    SCOPED_TRACE(trial.fault + ": " + trial.outcome + " at " + trial.failure_path + ": " + trial.reason);
+    EXPECT_EQ(trial.outcome, "stopped");
+    EXPECT_NE(trial.reason.find("gripper driver"), std::string::npos);
+    EXPECT_LE(trial.latency_s, 0.25);
+    EXPECT_LT(trial.final_speed, 0.01);
+  }
+}
+
 }  // namespace
 }  // namespace costar::faults

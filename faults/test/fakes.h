@@ -8,6 +8,7 @@
 #include "camera/rgbd.h"
 #include "component/component.h"
 #include "core/clock.h"
+#include "gripper/adaptive_gripper_driver.h"
 #include "gripper/gripper_driver.h"
 
 namespace costar::faults::test {
@@ -39,6 +40,25 @@ class GoodFingers final : public gripper::GripperDriver {
   gripper::FingerReading read() const override { return {0.085, 0.0, 0.0, false, clock_.now()}; }
   void command(double, double, double) override { ++commands; }
   double maxOpening() const override { return 0.085; }
+  int commands = 0;
+
+ private:
+  const Clock& clock_;
+};
+
+class GoodAdaptiveFingers final : public gripper::AdaptiveGripperDriver {
+ public:
+  explicit GoodAdaptiveFingers(const Clock& clock) : clock_(clock) {}
+  gripper::AdaptiveGripperReading read() const override {
+    gripper::AdaptiveGripperReading reading;
+    for (auto& finger : reading.fingers) {
+      finger.position = 0.25;
+    }
+    reading.stamp = clock_.now();
+    return reading;
+  }
+  void commandFingers(const std::array<double, gripper::kFingerCount>&, double, double) override { ++commands; }
+  void commandMode(gripper::GripperMode) override { ++commands; }
   int commands = 0;
 
  private:

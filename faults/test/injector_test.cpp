@@ -9,6 +9,7 @@
 namespace costar::faults {
 namespace {
 
+using test::GoodAdaptiveFingers;
 using test::GoodArm;
 using test::GoodCamera;
 using test::GoodComponent;
@@ -73,6 +74,42 @@ TEST(Injector, AThrowingDriverThrowsFromNowOnNamingTheFault) {
     } catch (const std::runtime_error& e) {
       EXPECT_NE(std::string(e.what()).find("throw:gripper-driver@op=2"), std::string::npos) << e.what();
     }
+  }
+}
+
+TEST(Injector, BreaksAThreeFingerGrippersReadingsAsThoseOfTwoFingers) {
+  // The same target, "gripper-driver", on a cell with the adaptive gripper (iiwa-3f-sim).
+  SimClock clock;
+  GoodAdaptiveFingers fingers(clock);
+  auto nan = injector({"nan:gripper-driver@op=2"}, clock);
+  gripper::AdaptiveGripperDriver& wrapped = nan->wrap(fingers);
+  ASSERT_NE(&wrapped, &fingers);
+  EXPECT_NO_THROW(nan->checkTargets());
+  wrapped.commandMode(gripper::GripperMode::kPinch);
+  EXPECT_DOUBLE_EQ(wrapped.read().fingers[2].position, 0.25);
+  wrapped.commandFingers({1.0, 1.0, 1.0}, 0.5, 20.0);  // the 2nd command makes it due
+  EXPECT_EQ(fingers.commands, 2);                      // commands still reach the gripper
+  for (const auto& finger : wrapped.read().fingers) {
+    EXPECT_TRUE(std::isnan(finger.position));
+    EXPECT_TRUE(std::isnan(finger.force));
+  }
+  ASSERT_TRUE(nan->records()[0].first_effect);
+
+  GoodAdaptiveFingers other(clock);
+  auto hang = injector({"hang:gripper-driver@t=1s"}, clock);
+  gripper::AdaptiveGripperDriver& hung = hang->wrap(other);
+  clock.advanceTo(TimePoint(fromSeconds(0.5)));
+  hung.read();
+  clock.advanceTo(TimePoint(fromSeconds(2.0)));
+  EXPECT_DOUBLE_EQ(toSeconds(hung.read().stamp), 0.5);
+
+  auto broken = injector({"throw:gripper-driver@t=0s"}, clock);
+  gripper::AdaptiveGripperDriver& throwing = broken->wrap(other);
+  try {
+    throwing.read();
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("throw:gripper-driver@t=0s"), std::string::npos) << e.what();
   }
 }
 
