@@ -81,7 +81,7 @@ struct Scratch {
   std::vector<float> ray_x;
   std::vector<float> ray_y;
   std::vector<std::uint8_t> surface;
-  std::vector<float> incidence;
+  std::vector<float> incidence;  // per pixel: theta / (pi/2 - theta), NaN where nothing reads
   std::vector<std::uint32_t> reading_rows;
   std::vector<std::uint64_t> draws;
 };
@@ -123,10 +123,13 @@ void parallelRows(int height, int threads, const Rows& rows) {
 }  // namespace
 
 // Three passes, so that the expensive ones run on several threads while the noise stays a
-// function of the seed alone: (1) per pixel, whether it gets a reading and its incidence angle
-// (parallel); (2) the random bits, drawn in pixel order for the pixels that read (serial, cheap);
-// (3) the jittered, noisy, quantized reading (parallel). The result is the same for any number
-// of threads, and the same as drawing while scanning the image once.
+// function of the seed alone: (1) per pixel, whether it gets a reading and the ratio
+// theta / (pi/2 - theta) of its incidence angle theta, which both sigmas use (parallel); (2) the
+// random bits, drawn in pixel order for the pixels that read (serial, cheap); (3) the jittered,
+// noisy, quantized reading (parallel). The result is the same for any number of threads, and
+// the same as drawing while scanning the image once. Passes 1 and 3 work on whole rows with
+// branch-free loops that GCC vectorizes (this file is built with -fno-math-errno
+// -fno-trapping-math: sim/CMakeLists.txt).
 void noisyPointCloud(const std::vector<float>& depth, const camera::Intrinsics& in, const DepthNoiseOptions& o,
                      std::uint64_t seed, std::vector<Eigen::Vector3f>& points, int threads) {
   const int w = in.width;
@@ -177,7 +180,7 @@ void noisyPointCloud(const std::vector<float>& depth, const camera::Intrinsics& 
     return;
   }
 
-  // Pass 1: the incidence angle of each pixel that reads (NaN: no reading), and how many read
+  // Pass 1: the incidence ratio of each pixel that reads (NaN: no reading), and how many read
   // in each row.
   const float cos_max = static_cast<float>(std::cos(o.max_incidence_deg * M_PI / 180.0));
   std::vector<float>& incidence = scratch.incidence;
