@@ -13,6 +13,31 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string injected(const FaultRecord& record) { return " (injected: " + record.spec.text + ")"; }
 
+/// A driver's reading under fault `fault`: `read()`'s until the fault is due, then a failure
+/// (`failure`, naming the fault), the last good reading again (hang: same values, same stamp),
+/// or a fresh reading with `spoil` applied (nan).
+template <class Reading, class Read, class Spoil>
+Reading readingUnder(Injector& injector, std::size_t fault, Reading& last, const Read& read, const Spoil& spoil,
+                     const char* failure) {
+  if (!injector.active(fault, false)) {
+    last = read();
+    return last;
+  }
+  injector.effect(fault);
+  const FaultRecord& record = injector.record(fault);
+  switch (record.spec.kind) {
+    case FaultKind::kThrow:
+      throw std::runtime_error(failure + injected(record));
+    case FaultKind::kHang:
+      return last;
+    default: {
+      Reading reading = read();
+      spoil(reading);
+      return reading;
+    }
+  }
+}
+
 /// The arm's joint encoders: fail, freeze or read NaN once the fault is due. Trajectories
 /// still reach the controller.
 class FaultyArmDriver final : public arm::ArmDriver {
@@ -21,24 +46,13 @@ class FaultyArmDriver final : public arm::ArmDriver {
       : inner_(inner), injector_(injector), fault_(fault) {}
 
   arm::ArmState read() const override {
-    if (!injector_.active(fault_, false)) {
-      last_ = inner_.read();
-      return last_;
-    }
-    injector_.effect(fault_);
-    const FaultRecord& record = injector_.record(fault_);
-    switch (record.spec.kind) {
-      case FaultKind::kThrow:
-        throw std::runtime_error("arm driver: reading the joint state failed" + injected(record));
-      case FaultKind::kHang:
-        return last_;  // the state stops updating: same values, same stamp
-      default: {
-        arm::ArmState state = inner_.read();
-        state.position.fill(kNaN);
-        state.velocity.fill(kNaN);
-        return state;
-      }
-    }
+    return readingUnder(
+        injector_, fault_, last_, [this] { return inner_.read(); },
+        [](arm::ArmState& state) {
+          state.position.fill(kNaN);
+          state.velocity.fill(kNaN);
+        },
+        "arm driver: reading the joint state failed");
   }
 
   void execute(std::shared_ptr<const arm::JointTrajectory> trajectory, TimePoint start) override {
@@ -60,23 +74,10 @@ class FaultyGripperDriver final : public gripper::GripperDriver {
       : inner_(inner), injector_(injector), fault_(fault) {}
 
   gripper::FingerReading read() const override {
-    if (!injector_.active(fault_, false)) {
-      last_ = inner_.read();
-      return last_;
-    }
-    injector_.effect(fault_);
-    const FaultRecord& record = injector_.record(fault_);
-    switch (record.spec.kind) {
-      case FaultKind::kThrow:
-        throw std::runtime_error("gripper driver: reading the fingers failed" + injected(record));
-      case FaultKind::kHang:
-        return last_;
-      default: {
-        gripper::FingerReading reading = inner_.read();
-        reading.opening = reading.opening_speed = reading.force = kNaN;
-        return reading;
-      }
-    }
+    return readingUnder(
+        injector_, fault_, last_, [this] { return inner_.read(); },
+        [](gripper::FingerReading& reading) { reading.opening = reading.opening_speed = reading.force = kNaN; },
+        "gripper driver: reading the fingers failed");
   }
   void command(double opening, double speed, double force) override {
     injector_.active(fault_, true);
@@ -99,25 +100,14 @@ class FaultyAdaptiveGripperDriver final : public gripper::AdaptiveGripperDriver 
       : inner_(inner), injector_(injector), fault_(fault) {}
 
   gripper::AdaptiveGripperReading read() const override {
-    if (!injector_.active(fault_, false)) {
-      last_ = inner_.read();
-      return last_;
-    }
-    injector_.effect(fault_);
-    const FaultRecord& record = injector_.record(fault_);
-    switch (record.spec.kind) {
-      case FaultKind::kThrow:
-        throw std::runtime_error("gripper driver: reading the fingers failed" + injected(record));
-      case FaultKind::kHang:
-        return last_;
-      default: {
-        gripper::AdaptiveGripperReading reading = inner_.read();
-        for (auto& finger : reading.fingers) {
-          finger.position = finger.speed = finger.force = kNaN;
-        }
-        return reading;
-      }
-    }
+    return readingUnder(
+        injector_, fault_, last_, [this] { return inner_.read(); },
+        [](gripper::AdaptiveGripperReading& reading) {
+          for (auto& finger : reading.fingers) {
+            finger.position = finger.speed = finger.force = kNaN;
+          }
+        },
+        "gripper driver: reading the fingers failed");
   }
   void commandFingers(const std::array<double, gripper::kFingerCount>& positions, double speed, double force) override {
     injector_.active(fault_, true);
