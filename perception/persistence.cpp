@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <span>
+#include <thread>
 #include <tuple>
 
 #include "perception/canonical_orientation.h"
@@ -29,6 +30,23 @@ Point toPoint(const Eigen::Vector3d& p) { return Point(p.x(), p.y(), p.z()); }
 
 /// How many detections ahead a matched previous object is fetched into the cache.
 constexpr std::size_t kPrefetchAhead = 8;
+
+/// From this many detections on, the queries, the objects' poses and the next trees are made on
+/// two threads (below it a thread costs more than it saves; a scene has a handful of parts).
+constexpr std::size_t kParallelFrom = 2048;
+
+/// Runs `work(begin, end)` over [0, count): on two threads (the calling one and one more) when
+/// `parallel`, else on the calling one. The halves are the same for a given count.
+template <typename Work>
+void inHalves(std::size_t count, bool parallel, const Work& work) {
+  if (!parallel) {
+    work(std::size_t{0}, count);
+    return;
+  }
+  std::thread second(work, count / 2, count);
+  work(std::size_t{0}, count / 2);
+  second.join();
+}
 
 }  // namespace
 
@@ -67,33 +85,43 @@ const std::vector<TrackedObject>& PersistenceFilter::update(const std::vector<De
       return std::tie(squared, detection, previous) < std::tie(other.squared, other.detection, other.previous);
     }
   };
+  const bool parallel = detections.size() >= kParallelFrom;
+  // Each half of the detections collects its pairs; the first half's then the second's is the
+  // detections' order, as one pass would give.
   std::vector<Pair> pairs;
+  std::vector<Pair> second_pairs;
   pairs.reserve(detections.size());
   std::vector<Entry>& hits = index_->hits;
-  const Tree* tree = nullptr;
-  const std::string* tree_class = nullptr;
-  for (std::size_t d = 0; d < detections.size(); ++d) {
-    const std::string& object_class = detections[d].object_class;
-    if (tree_class == nullptr || *tree_class != object_class) {
-      const auto found = index_->trees.find(object_class);
-      tree = found == index_->trees.end() ? nullptr : &found->second;
-      tree_class = &object_class;
-    }
-    if (tree == nullptr || tree->empty()) {
-      continue;
-    }
-    const Point p = toPoint(detections[d].pose.translation());
-    const Box around(Point(p.get<0>() - max_distance, p.get<1>() - max_distance, p.get<2>() - max_distance),
-                     Point(p.get<0>() + max_distance, p.get<1>() + max_distance, p.get<2>() + max_distance));
-    hits.clear();
-    tree->query(bgi::intersects(around), std::back_inserter(hits));
-    for (const Entry& hit : hits) {
-      const double squared = bg::comparable_distance(p, hit.first);
-      if (squared <= max_squared) {
-        pairs.push_back({squared, static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(hit.second)});
+  std::vector<Entry> second_hits;
+  inHalves(detections.size(), parallel, [&](std::size_t begin, std::size_t end) {
+    std::vector<Pair>& found = begin == 0 ? pairs : second_pairs;
+    std::vector<Entry>& buffer = begin == 0 ? hits : second_hits;
+    const Tree* tree = nullptr;
+    const std::string* tree_class = nullptr;
+    for (std::size_t d = begin; d < end; ++d) {
+      const std::string& object_class = detections[d].object_class;
+      if (tree_class == nullptr || *tree_class != object_class) {
+        const auto tree_found = index_->trees.find(object_class);
+        tree = tree_found == index_->trees.end() ? nullptr : &tree_found->second;
+        tree_class = &object_class;
+      }
+      if (tree == nullptr || tree->empty()) {
+        continue;
+      }
+      const Point p = toPoint(detections[d].pose.translation());
+      const Box around(Point(p.get<0>() - max_distance, p.get<1>() - max_distance, p.get<2>() - max_distance),
+                       Point(p.get<0>() + max_distance, p.get<1>() + max_distance, p.get<2>() + max_distance));
+      buffer.clear();
+      tree->query(bgi::intersects(around), std::back_inserter(buffer));
+      for (const Entry& hit : buffer) {
+        const double squared = bg::comparable_distance(p, hit.first);
+        if (squared <= max_squared) {
+          found.push_back({squared, static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(hit.second)});
+        }
       }
     }
-  }
+  });
+  pairs.insert(pairs.end(), second_pairs.begin(), second_pairs.end());
   // Closest pairs first: a pair counts when neither side is matched yet. A pair whose detection
   // and previous object are in no other pair is taken whatever the order, so only the
   // contested pairs need sorting.
@@ -128,47 +156,56 @@ const std::vector<TrackedObject>& PersistenceFilter::update(const std::vector<De
     }
     return nullptr;
   };
+  // Fresh names first, in the detections' order (the counters count up); then each object,
+  // its canonical orientation included, on its own (two threads for many).
+  objects_.resize(detections.size());
   for (std::size_t d = 0; d < detections.size(); ++d) {
-    // The matched previous objects are read in the detections' order, scattered over memory:
-    // ask for the one a few detections ahead now, so it is in the cache when it is read.
-    if (const std::size_t ahead = d + kPrefetchAhead; ahead < detections.size() && match[ahead]) {
-      const auto* bytes = reinterpret_cast<const char*>(&previous[*match[ahead]]);
-      for (std::size_t offset = 0; offset < sizeof(TrackedObject); offset += 64) {
-        __builtin_prefetch(bytes + offset);
-      }
-    }
-    const Detection& detection = detections[d];
-    TrackedObject object;
-    object.object_class = detection.object_class;
-    object.confidence = detection.confidence;
-    object.pose = detection.pose;
-    object.color = detection.color;
-    Eigen::Matrix3d reference = options_.new_object_reference;
-    if (match[d]) {
-      const TrackedObject& before = previous[*match[d]];
-      object.name = before.name;
-      object.seen = before.seen + 1;
-      if (!object.color) {
-        object.color = before.color;
-      }
-      reference = before.pose.linear();
-    } else {
+    if (!match[d]) {
+      const std::string& object_class = detections[d].object_class;
       auto counter = std::find_if(counters_.begin(), counters_.end(),
-                                  [&](const auto& entry) { return entry.first == detection.object_class; });
+                                  [&](const auto& entry) { return entry.first == object_class; });
       if (counter == counters_.end()) {
-        counters_.emplace_back(detection.object_class, 0);
+        counters_.emplace_back(object_class, 0);
         counter = counters_.end() - 1;
       }
-      object.name = detection.object_class + "_" + std::to_string(++counter->second);
-      object.seen = 1;
+      objects_[d].name = object_class + "_" + std::to_string(++counter->second);
     }
-    if (options_.canonical_orientation) {
-      if (const world::ObjectClass* object_class = find_class(detection.object_class)) {
-        object.pose = setCanonicalOrientation(object.pose, *object_class, reference).pose;
+  }
+  inHalves(detections.size(), parallel, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t d = begin; d < end; ++d) {
+      // The matched previous objects are read in the detections' order, scattered over memory:
+      // ask for the one a few detections ahead now, so it is in the cache when it is read.
+      if (const std::size_t ahead = d + kPrefetchAhead; ahead < end && match[ahead]) {
+        const auto* bytes = reinterpret_cast<const char*>(&previous[*match[ahead]]);
+        for (std::size_t offset = 0; offset < sizeof(TrackedObject); offset += 64) {
+          __builtin_prefetch(bytes + offset);
+        }
+      }
+      const Detection& detection = detections[d];
+      TrackedObject& object = objects_[d];
+      object.object_class = detection.object_class;
+      object.confidence = detection.confidence;
+      object.pose = detection.pose;
+      object.color = detection.color;
+      Eigen::Matrix3d reference = options_.new_object_reference;
+      if (match[d]) {
+        const TrackedObject& before = previous[*match[d]];
+        object.name = before.name;
+        object.seen = before.seen + 1;
+        if (!object.color) {
+          object.color = before.color;
+        }
+        reference = before.pose.linear();
+      } else {
+        object.seen = 1;
+      }
+      if (options_.canonical_orientation) {
+        if (const world::ObjectClass* object_class = find_class(detection.object_class)) {
+          object.pose = setCanonicalOrientation(object.pose, *object_class, reference).pose;
+        }
       }
     }
-    objects_.push_back(std::move(object));
-  }
+  });
   // Previous objects nobody matched: kept for a while, or dropped.
   for (std::size_t p = 0; p < previous.size(); ++p) {
     if (!taken[p] && previous[p].missed < options_.keep_for) {
@@ -191,8 +228,18 @@ const std::vector<TrackedObject>& PersistenceFilter::update(const std::vector<De
   }
   index_->trees.clear();
   for (auto& [name, values] : entries) {
-    index_->trees.emplace(name, Tree(values.begin(), values.end()));
+    index_->trees.emplace(name, Tree());
   }
+  // The trees are independent: the classes split over two threads for many objects.
+  std::vector<std::pair<std::vector<Entry>*, Tree*>> builds;
+  for (auto& [name, values] : entries) {
+    builds.emplace_back(&values, &index_->trees.find(name)->second);
+  }
+  inHalves(builds.size(), parallel && builds.size() > 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t b = begin; b < end; ++b) {
+      *builds[b].second = Tree(builds[b].first->begin(), builds[b].first->end());
+    }
+  });
   return objects_;
 }
 
