@@ -89,6 +89,22 @@ TEST(FaultCampaign, AGripperThatThrowsAsItClosesEndsTheGraspAtOnce) {
   EXPECT_TRUE(trial.waypoints_intact);
 }
 
+TEST(FaultCampaign, AnUnknownCellIsRefusedBeforeAnyRun) {
+  // Each of the runs failed alike ("error"), as many times as -n asked.
+  CampaignOptions options;
+  options.workcell = "ur6-sim";
+  options.count = 50;
+  int runs = 0;
+  try {
+    runCampaign(options, [&](const FaultTrial&, int) { ++runs; });
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown workcell 'ur6-sim'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("iiwa-3f-sim"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(runs, 0);
+}
+
 TEST(FaultCampaign, TheThreeFingerGrippersDriverBreaksAndTheCellStops) {
   // The iiwa with the adaptive gripper: its driver's readings go NaN, stop updating or fail
   // (`--inject KIND:gripper-driver` had no target on this cell before).
