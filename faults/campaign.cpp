@@ -202,15 +202,7 @@ CampaignSummary runCampaign(const CampaignOptions& options,
                                                     : fault + "@t=0");  // @throws FaultSpecError, before any run
   }
   // An unknown cell is refused before any run too (each run would fail the same way).
-  std::string known;
-  bool found = false;
-  for (const auto& info : workcell::knownWorkcells()) {
-    found = found || info.name == options.workcell;
-    known += (known.empty() ? "" : ", ") + info.name;
-  }
-  if (!found) {
-    throw std::invalid_argument("unknown workcell '" + options.workcell + "' (known: " + known + ")");
-  }
+  workcell::requireKnownWorkcell(options.workcell);
   std::vector<bt::Plan> plans;
   for (const CampaignTask& task : options.tasks) {
     plans.push_back(bt::loadPlan(task.plan));

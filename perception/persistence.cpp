@@ -226,14 +226,11 @@ const std::vector<TrackedObject>& PersistenceFilter::update(const std::vector<De
     }
     current->emplace_back(toPoint(objects_[i].pose.translation()), i);
   }
-  index_->trees.clear();
-  for (auto& [name, values] : entries) {
-    index_->trees.emplace(name, Tree());
-  }
   // The trees are independent: the classes split over two threads for many objects.
+  index_->trees.clear();
   std::vector<std::pair<std::vector<Entry>*, Tree*>> builds;
   for (auto& [name, values] : entries) {
-    builds.emplace_back(&values, &index_->trees.find(name)->second);
+    builds.emplace_back(&values, &index_->trees.emplace(name, Tree()).first->second);
   }
   inHalves(builds.size(), parallel && builds.size() > 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {

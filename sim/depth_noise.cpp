@@ -9,15 +9,45 @@
 
 namespace costar::sim {
 
-double axialSigma(const DepthNoiseOptions& o, double z, double theta) {
-  const double dz = z - o.axial_reference_depth;
-  const double grazing = theta / (M_PI / 2 - theta);
-  return o.axial_constant + o.axial_quadratic * dz * dz + 0.0001 / std::sqrt(z) * grazing * grazing;
+namespace {
+
+/// theta / (pi/2 - theta): the incidence term of both sigmas (the noise computes it once per
+/// pixel and passes it to both).
+template <typename T>
+T incidenceRatio(T theta) {
+  return theta / (static_cast<T>(M_PI / 2) - theta);
 }
 
-double lateralSigma(const DepthNoiseOptions& o, double theta) {
-  return o.lateral_constant + o.lateral_angular * theta / (M_PI / 2 - theta);
+/// The model's two sigmas from the incidence ratio, with a copy of the options' coefficients
+/// (a row's loop then keeps them in registers, which it does not for fields it reads through a
+/// reference while storing to memory).
+struct Sigmas {
+  explicit Sigmas(const DepthNoiseOptions& o)
+      : axial_constant(o.axial_constant),
+        axial_quadratic(o.axial_quadratic),
+        reference_depth(o.axial_reference_depth),
+        lateral_constant(o.lateral_constant),
+        lateral_angular(o.lateral_angular) {}
+  double axial(double z, double ratio) const {
+    const double dz = z - reference_depth;
+    return axial_constant + axial_quadratic * dz * dz + 0.0001 / std::sqrt(z) * ratio * ratio;
+  }
+  double lateral(double ratio) const { return lateral_constant + lateral_angular * ratio; }
+
+  double axial_constant;
+  double axial_quadratic;
+  double reference_depth;
+  double lateral_constant;
+  double lateral_angular;
+};
+
+}  // namespace
+
+double axialSigma(const DepthNoiseOptions& o, double z, double theta) {
+  return Sigmas(o).axial(z, incidenceRatio(theta));
 }
+
+double lateralSigma(const DepthNoiseOptions& o, double theta) { return Sigmas(o).lateral(incidenceRatio(theta)); }
 
 namespace {
 
@@ -271,7 +301,7 @@ void noisyPointCloud(const std::vector<float>& depth, const camera::Intrinsics& 
       float* const grazings = grazing_row.data();
       for (int u = 0; u < w; ++u) {
         const float theta = acosUnit(std::max(cosines[u], cos_max));
-        grazings[u] = theta / (static_cast<float>(M_PI / 2) - theta);
+        grazings[u] = incidenceRatio(theta);
       }
       std::uint32_t reading = 0;
       for (int u = 0; u < w; ++u) {
@@ -303,14 +333,10 @@ void noisyPointCloud(const std::vector<float>& depth, const camera::Intrinsics& 
   const double focal_baseline = in.fx * o.baseline;
   const double inverse_step = 1.0 / o.disparity_step;
   const bool quantize = o.quantize_disparity;
-  const double reference_depth = o.axial_reference_depth;
-  const double lateral_constant = o.lateral_constant;
-  const double lateral_angular = o.lateral_angular;
+  const Sigmas sigmas(o);
   const int width = w;
   const int height = h;
   const std::uint8_t* const surface_at = surface.data();
-  const double axial_constant = o.axial_constant;
-  const double axial_quadratic = o.axial_quadratic;
   const double step = o.disparity_step;
   const double min_range = o.min_range;
   const double max_range = o.max_range;
@@ -330,7 +356,7 @@ void noisyPointCloud(const std::vector<float>& depth, const camera::Intrinsics& 
         }
         // Lateral noise: the reading comes from a jittered pixel.
         const std::uint64_t bits = *draw++;
-        const double sigma_l = lateral_constant + lateral_angular * static_cast<double>(grazing);
+        const double sigma_l = sigmas.lateral(grazing);
         const int su = roundToInt(u + sigma_l * normal[bits]);
         const int sv = roundToInt(v + sigma_l * normal[bits >> 16]);
         // Off the image or off the surface: no reading.
@@ -356,10 +382,7 @@ void noisyPointCloud(const std::vector<float>& depth, const camera::Intrinsics& 
       const double* const axials = axial_row.data();
       for (int k = 0; k < readings; ++k) {
         const double z = depths[k];
-        const double grazing = grazings[k];
-        const double dz = z - reference_depth;
-        const double sigma_z = axial_constant + axial_quadratic * dz * dz + 0.0001 / std::sqrt(z) * grazing * grazing;
-        depths[k] = z + sigma_z * axials[k];
+        depths[k] = z + sigmas.axial(z, grazings[k]) * axials[k];
       }
       if (quantize) {
         for (int k = 0; k < readings; ++k) {

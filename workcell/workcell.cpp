@@ -146,10 +146,15 @@ std::unique_ptr<Workcell> makeLightWorkcell(const WorkcellOptions& options) {
   if (name == "none") {
     return std::make_unique<BareWorkcell>();
   }
+  requireKnownWorkcell(name);
+  return nullptr;  // a robot cell: makeWorkcell() builds it
+}
+
+void requireKnownWorkcell(const std::string& name) {
   std::string known;
   for (const auto& info : knownWorkcells()) {
     if (info.name == name) {
-      return nullptr;  // a robot cell: makeWorkcell() builds it
+      return;
     }
     known += (known.empty() ? "" : ", ") + info.name;
   }

@@ -102,6 +102,8 @@ struct WorkcellInfo {
 
 /// The workcells this build knows.
 std::vector<WorkcellInfo> knownWorkcells();
+/// @throws std::invalid_argument naming the known workcells when `name` is not one of them.
+void requireKnownWorkcell(const std::string& name);
 
 /// Creates a workcell. @throws std::invalid_argument naming the known ones for an unknown
 /// name; std::runtime_error when its files cannot be read. In costar_workcell, which links
