@@ -329,7 +329,11 @@ SmartMoveComponent::SmartMoveComponent(const arm::MotionService& motion, compone
                   {object_class, {"grasp", ValueType::kString, "name of the new grasp", {}}},
                   component::OperationKind::kKnowledge},
                  [this](const Params& params) { return beginTeachGrasp(params); });
-  description.predicates = {{"holding", 1, "holding(o): the gripper holds part o"}};
+  description.predicates = {{"holding", 1, "holding(o): the gripper holds part o"},
+                            {"misplaced", 1,
+                             "misplaced(o): o, the part put down last, is seen more than " +
+                                 std::to_string(static_cast<int>(std::lround(config_.misplaced_distance * 1000.0))) +
+                                 " mm from where it was put (look again, then grasp it and put it again)"}};
   declare(std::move(description), std::move(operations));
 }
 
@@ -347,7 +351,36 @@ world::Report SmartMoveComponent::report() const {
   if (held_ && world_.holds("gripper_holding", {})) {
     report.predicates.push_back({"holding", {*held_}, true, ""});
   }
+  if (const auto misplaced = misplacedPart()) {
+    report.predicates.push_back({"misplaced", {*misplaced}, true, ""});
+  }
   return report;
+}
+
+std::optional<std::string> SmartMoveComponent::misplacedPart() const {
+  if (!put_) {
+    return std::nullopt;
+  }
+  // Perception renames a part that moved farther than it tracks, so the part put down is found
+  // by where it is: the nearest of its class to where it was put, among those seen where none was.
+  std::optional<std::pair<std::string, double>> nearest;
+  for (const std::string& object : world_.match("is_a", std::vector<std::string>{"?", put_->object_class})) {
+    const auto pose = world_.worldPose(object);
+    if (!pose || (held_ && object == *held_) ||
+        std::any_of(put_->known.begin(), put_->known.end(), [&](const Eigen::Vector3d& known) {
+          return (known - pose->translation()).norm() <= config_.misplaced_distance;
+        })) {
+      continue;
+    }
+    const double distance = (pose->translation() - put_->pose.translation()).norm();
+    if (!nearest || distance < nearest->second) {
+      nearest = {object, distance};
+    }
+  }
+  if (!nearest || nearest->second <= config_.misplaced_distance || nearest->second > config_.misplaced_search) {
+    return std::nullopt;
+  }
+  return nearest->first;
 }
 
 void SmartMoveComponent::syncObstacles() {
@@ -913,6 +946,7 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
                        return {};  // held once squared up
                      }
                      held_ = object;
+                     put_.reset();
                      held_class_ = object_class;
                      held_grasp_ = object_pose.inverse() * chosen.goal;
                      held_opening_ = opening;
@@ -957,6 +991,7 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginMoveOrGrasp(bool gras
              return "the fingers closed on nothing: " + object + " was lost while squaring it up";
            }
            held_ = object;
+           put_.reset();
            held_class_ = object_class;
            // Centred both ways and square with the pads: as planned, turned.
            held_grasp_ = object_pose.inverse() * chosen.goal * centring->turn;
@@ -1175,19 +1210,26 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginRelease(const compone
                                    "lower");
                    },
                    nullptr});
-  steps.push_back({"release " + released,
-                   [this, opening = held_opening_, position = held_finger_position_] {
-                     if (position > 0.0) {  // a fingertip mode: as far as the part needs
-                       component::ParamMap params = gripperDefaults(gripper_, "Open");
-                       params["position"] = position;
-                       return std::make_unique<ComponentStep>(gripper_, "Open", params);
-                     }
-                     return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening));
-                   },
-                   [this](const OperationResult&) -> std::string {
-                     held_.reset();
-                     return {};
-                   }});
+  steps.push_back(
+      {"release " + released,
+       [this, opening = held_opening_, position = held_finger_position_] {
+         if (position > 0.0) {  // a fingertip mode: as far as the part needs
+           component::ParamMap params = gripperDefaults(gripper_, "Open");
+           params["position"] = position;
+           return std::make_unique<ComponentStep>(gripper_, "Open", params);
+         }
+         return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening));
+       },
+       [this, part = chosen.goal * held_grasp_.inverse()](const OperationResult&) -> std::string {
+         put_ = PutDown{held_class_, part, {}};
+         for (const std::string& object : world_.match("is_a", std::vector<std::string>{"?", held_class_})) {
+           if (const auto pose = world_.worldPose(object)) {
+             put_->known.push_back(pose->translation());
+           }
+         }
+         held_.reset();
+         return {};
+       }});
   steps.push_back({"lift away",
                    [this, approach, support_object, mode = held_mode_, position = held_finger_position_] {
                      fingersInMode(mode, position);

@@ -68,6 +68,15 @@ struct SmartMoveConfig {
   /// part, once put down and detected again (placement and perception error), still satisfies
   /// them rather than sitting in the predicates' dead band.
   double table_spot_margin = 0.02;
+  /// misplaced(o): the part SmartRelease put down last, seen again, is more than
+  /// misplaced_distance from where it was put (m). It is found by place (perception renames a
+  /// part that moved): the part of its class nearest where it was put, within misplaced_search,
+  /// that is not where a part of the class was believed to be at the release (a part seen where
+  /// one was: not the one put down; the part put down, before it is seen again: its old belief).
+  /// Perception's error is a few mm; a part held off where its grasp was planned (moved as the
+  /// fingers closed) lands 1-3 cm off, one that slipped out farther.
+  double misplaced_distance = 0.012;
+  double misplaced_search = 0.15;
   /// Robot links that may touch the part being grasped (the gripper): the robot
   /// description's links.gripper (arm/robot_description.h).
   std::vector<std::string> gripper_links;
@@ -159,6 +168,8 @@ class SmartMoveComponent final : public component::TableComponent {
 
   /// The part held since the last SmartGrasp, if the gripper still holds something.
   const std::optional<std::string>& held() const { return held_; }
+  /// The part misplaced(o) holds for (SmartMoveConfig::misplaced_distance), if any.
+  std::optional<std::string> misplacedPart() const;
 
   /// Objects of a class that satisfy every pattern, with the patterns that others fail.
   struct Matches {
@@ -250,7 +261,16 @@ class SmartMoveComponent final : public component::TableComponent {
   double held_opening_ = 0.0;                         // the opening of its grasp, m (0: fully)
   std::string held_mode_;                             // the gripper mode it was grasped in (mode_fingers)
   double held_finger_position_ = 0.0;                 // where its fingers release to in that mode (0: open)
-  double synced_opening_ = -1.0;                      // the fingers' shapes are at this opening
+  /// The part SmartRelease put down last: its class, where it was put (the part's frame in the
+  /// world), and where the parts of its class were believed to be then (the part itself where it
+  /// was seen before it was grasped); cleared by the next grasp.
+  struct PutDown {
+    std::string object_class;
+    world::Pose pose = world::Pose::Identity();
+    std::vector<Eigen::Vector3d> known;
+  };
+  std::optional<PutDown> put_;
+  double synced_opening_ = -1.0;  // the fingers' shapes are at this opening
   std::vector<std::string> obstacles_;
   std::shared_ptr<PatternCheck> pattern_check_ = std::make_shared<PatternCheck>();
 };

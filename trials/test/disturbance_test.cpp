@@ -14,6 +14,7 @@
 
 #include <unistd.h>
 
+#include "core/paths.h"
 #include "sim/scene.h"
 #include "trials/trials.h"
 
@@ -164,6 +165,57 @@ TEST_F(DisturbedTrials, ADisturbanceNeverDueIsListedAsNotApplied) {
   const Summary read = Summary::fromJson(summary.toJson());
   EXPECT_EQ(read.trials[0].disturbances, summary.trials[0].disturbances);
   EXPECT_EQ(read.options.disturb, summary.options.disturb);
+}
+
+// A link nudged along its length as the fingers go down is held 2-3 cm off its middle, which the
+// fingers cannot feel, and put down that far off the base node's centre (the judge allows 2 cm).
+// The recovering plan looks after each release: the link is seen misplaced, grasped where it is
+// now and put again. The same trial without the looks after the releases fails. Seed 9518 of the
+// nudge runs in docs/BENCHMARKS.md: the link, nudged 23 mm.
+TEST_F(DisturbedTrials, ALinkHeldOffItsMiddleIsSeenMisplacedAndPutAgain) {
+  std::ifstream file(dataRoot() / "examples/ur5/assemble_structure_recovering.xml");
+  const std::string recovering((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  ASSERT_NE(recovering.find("until the link sits where it was put"), std::string::npos);
+  // The plan without its three "until ... sits where it was put" fallbacks.
+  const std::string blind = std::regex_replace(
+      recovering, std::regex(R"(<Fallback name="until the [a-z ]+ sits where it was put">[\s\S]*?</Fallback>)"), "");
+  ASSERT_EQ(blind.find("CheckPredicate"), std::string::npos);
+  const auto run = [&](const std::string& plan) {
+    std::ofstream(folder / "plan.xml") << plan;
+    TrialOptions trial;
+    trial.plan = folder / "plan.xml";
+    trial.scene = dataRoot() / "sim/scenes/assembly.json";
+    trial.judge = "assembly";
+    trial.count = 1;
+    trial.seed = 9518;
+    trial.disturb = {"nudge"};
+    trial.trace_dir = folder;
+    return runTrials(trial).trials.at(0);
+  };
+  const auto traced = [&] {
+    std::ifstream trace(folder / "trial_9518.jsonl");
+    return std::string((std::istreambuf_iterator<char>(trace)), std::istreambuf_iterator<char>());
+  };
+
+  const TrialResult without = run(blind);
+  ASSERT_EQ(without.disturbances.size(), 1u);
+  EXPECT_NE(without.disturbances[0].find("nudge link_"), std::string::npos) << without.disturbances[0];
+  EXPECT_FALSE(without.success);
+  EXPECT_NE(without.reason.find("no link rests on the base node"), std::string::npos) << without.reason;
+
+  const TrialResult with = run(recovering);
+  // The same nudge (later: the plan looked at the base node first).
+  const auto nudged = [](const TrialResult& trial) {
+    return trial.disturbances.empty() ? std::string()
+                                      : trial.disturbances[0].substr(0, trial.disturbances[0].find(" at "));
+  };
+  EXPECT_EQ(nudged(with), nudged(without));
+  EXPECT_TRUE(with.success) << with.failure_path << ": " << with.reason;
+  const std::string trace = traced();
+  EXPECT_NE(
+      trace.find(R"x(CheckPredicate \"the link is where it was put\"","reason":"some symbol satisfies misplaced(?)")x"),
+      std::string::npos);
+  EXPECT_NE(trace.find(R"x(SmartRelease \"put it on the base node again\"","t":)x"), std::string::npos);
 }
 
 TEST(Trials, ResidentMemoryIsSampledEveryHundredTrials) {
