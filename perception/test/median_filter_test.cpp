@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -107,6 +108,68 @@ TEST(MedianFilter, RefusesAnEmptyOrMixedFrameSet) {
   EXPECT_THROW(medianFrame(std::vector<camera::RgbdFrame>{}), std::invalid_argument);
   std::vector<camera::RgbdFrame> frames{blankFrame(4, 4), blankFrame(5, 4)};
   EXPECT_THROW(medianFrame(frames), std::invalid_argument);
+}
+
+// Any number of frames up to 16 goes through a sorting network several pixels at a time, more
+// through a sort of each pixel: both give, for every pixel, the valid sample of lower median
+// depth, the first frame's with that depth (depths repeat: quantized), or NaN when no more than
+// half are valid. Checked against that definition on pixels of random depths, some invalid.
+TEST(MedianFilter, EveryFrameCountGivesTheLowerMedianSampleOfEachPixel) {
+  std::mt19937 random(11);
+  std::uniform_int_distribution<int> step(0, 12);  // depths on a 1 mm grid: ties are common
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (const int count : {1, 2, 3, 7, 8, 15, 16, 17, 31}) {
+    const int width = 37;  // not a multiple of the lanes
+    const int height = 5;
+    std::vector<camera::RgbdFrame> frames;
+    const float invalid_share = count % 2 == 0 ? 0.3f : 0.5f;
+    for (int f = 0; f < count; ++f) {
+      camera::RgbdFrame frame = blankFrame(width, height);
+      for (auto& p : frame.points) {
+        if (unit(random) >= invalid_share) {
+          const float z = 1.0f + 0.001f * static_cast<float>(step(random));
+          p = Eigen::Vector3f(unit(random), static_cast<float>(f), z);  // x, y tell the samples apart
+        }
+      }
+      frames.push_back(std::move(frame));
+    }
+    std::vector<std::uint8_t> mask(static_cast<std::size_t>(width) * height, 1);
+    for (std::size_t pixel = 0; pixel < mask.size(); pixel += 3) {
+      mask[pixel] = 0;
+    }
+    for (int threads : {1, 2}) {
+      const camera::RgbdFrame whole = medianFrame(frames, PixelRect{}, threads);
+      const camera::RgbdFrame masked = medianFrame(frames, mask, threads);
+      for (std::size_t pixel = 0; pixel < mask.size(); ++pixel) {
+        std::vector<float> depths;
+        for (const auto& frame : frames) {
+          if (!std::isnan(frame.points[pixel].z())) {
+            depths.push_back(frame.points[pixel].z());
+          }
+        }
+        std::sort(depths.begin(), depths.end());
+        Eigen::Vector3f expected(kNan, kNan, kNan);
+        if (2 * depths.size() > frames.size()) {
+          const float median = depths[(depths.size() - 1) / 2];
+          for (const auto& frame : frames) {
+            if (frame.points[pixel].z() == median) {
+              expected = frame.points[pixel];
+              break;
+            }
+          }
+        }
+        const auto same = [&](const Eigen::Vector3f& got) {
+          return std::isnan(expected.z()) ? std::isnan(got.z()) : got == expected;
+        };
+        ASSERT_TRUE(same(whole.points[pixel])) << count << " frames, pixel " << pixel;
+        if (mask[pixel] != 0) {
+          ASSERT_TRUE(same(masked.points[pixel])) << count << " frames, pixel " << pixel << " (mask)";
+        } else {
+          ASSERT_TRUE(std::isnan(masked.points[pixel].z()));
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
