@@ -577,8 +577,11 @@ namespace {
 constexpr double kRaisedSupport = 0.015;
 }  // namespace
 
-std::vector<world::Pose> restingSeeds(const Cloud& cloud, const std::vector<int>& indices, const TablePlane& support,
-                                      const world::ObjectClass& object_class) {
+namespace {
+
+/// restingSeeds (ends false) or restingSeedsAtEnds (ends true).
+std::vector<world::Pose> seedsResting(const Cloud& cloud, const std::vector<int>& indices, const TablePlane& support,
+                                      const world::ObjectClass& object_class, bool ends) {
   std::vector<world::Pose> seeds;
   if (indices.size() < 10) {
     return seeds;
@@ -607,10 +610,38 @@ std::vector<world::Pose> restingSeeds(const Cloud& cloud, const std::vector<int>
   // Under the points, on the plane: the seen faces are the top and the side facing the camera,
   // so the middle lies a little further away, horizontally.
   const Eigen::AlignedBox3d bounds = object_class.bounds();
-  Eigen::Vector3d on_plane = mean - support.height(mean.cast<float>()) * normal;
-  Eigen::Vector3d away = on_plane - on_plane.dot(normal) * normal;  // the camera is at the origin
-  if (away.norm() > 1e-9) {
-    on_plane += away.normalized() * (0.25 * std::min(bounds.sizes().x(), bounds.sizes().y()));
+  const auto onPlane = [&](const Eigen::Vector3d& point) {
+    Eigen::Vector3d on_plane = point - support.height(point.cast<float>()) * normal;
+    const Eigen::Vector3d away = on_plane - on_plane.dot(normal) * normal;  // the camera is at the origin
+    if (away.norm() > 1e-9) {
+      on_plane += away.normalized() * (0.25 * std::min(bounds.sizes().x(), bounds.sizes().y()));
+    }
+    return on_plane;
+  };
+  std::vector<Eigen::Vector3d> places;
+  if (!ends) {
+    places.push_back(onPlane(mean));
+  } else {
+    // Points spread along their main axis over more than one and a half objects are more than
+    // one (touching parts of a class): their mean lies between them; these stand at both ends,
+    // half an object in from the points' extremes (their 2nd and 98th percentiles).
+    const double span = bounds.sizes().head<2>().maxCoeff();
+    std::vector<double> along;
+    along.reserve(indices.size());
+    for (const int i : indices) {
+      along.push_back((cloud.points[static_cast<std::size_t>(i)].cast<double>() - mean).dot(axis));
+    }
+    const auto first = along.begin() + static_cast<std::ptrdiff_t>(along.size() / 50);
+    const auto last = along.begin() + static_cast<std::ptrdiff_t>(along.size() - 1 - along.size() / 50);
+    std::nth_element(along.begin(), first, along.end());
+    const double from = *first;
+    std::nth_element(along.begin(), last, along.end());
+    const double to = *last;
+    if (to - from <= 1.5 * span) {
+      return seeds;
+    }
+    places.push_back(onPlane(mean + (from + 0.5 * span) * axis));
+    places.push_back(onPlane(mean + (to - 0.5 * span) * axis));
   }
   // What it rests on: the table, and, when even its lowest points are well above the table (a
   // link on a node), a level under those points as well (their 5th percentile height).
@@ -626,22 +657,36 @@ std::vector<world::Pose> restingSeeds(const Cloud& cloud, const std::vector<int>
     levels.push_back(*low);
   }
   constexpr double kStep = 15.0 * M_PI / 180.0;
-  for (const double level : levels) {
-    for (int k = 0; k < 12; ++k) {  // 0 .. 165 degrees: a turn of 180 more is the same box
-      const double yaw = k * kStep;
-      Eigen::Matrix3d rotation;  // columns: the object's x, y, z in the camera frame
-      rotation.col(0) = std::cos(yaw) * axis + std::sin(yaw) * side;
-      rotation.col(2) = normal;
-      rotation.col(1) = rotation.col(2).cross(rotation.col(0));
-      world::Pose seed = world::Pose::Identity();
-      seed.linear() = rotation;
-      // The object's bottom face on the level, its footprint's middle above on_plane.
-      const Eigen::Vector3d footprint_middle(bounds.center().x(), bounds.center().y(), bounds.min().z());
-      seed.translation() = on_plane + level * normal - rotation * footprint_middle;
-      seeds.push_back(seed);
+  for (const Eigen::Vector3d& on_plane : places) {
+    for (const double level : levels) {
+      for (int k = 0; k < 12; ++k) {  // 0 .. 165 degrees: a turn of 180 more is the same box
+        const double yaw = k * kStep;
+        Eigen::Matrix3d rotation;  // columns: the object's x, y, z in the camera frame
+        rotation.col(0) = std::cos(yaw) * axis + std::sin(yaw) * side;
+        rotation.col(2) = normal;
+        rotation.col(1) = rotation.col(2).cross(rotation.col(0));
+        world::Pose seed = world::Pose::Identity();
+        seed.linear() = rotation;
+        // The object's bottom face on the level, its footprint's middle above on_plane.
+        const Eigen::Vector3d footprint_middle(bounds.center().x(), bounds.center().y(), bounds.min().z());
+        seed.translation() = on_plane + level * normal - rotation * footprint_middle;
+        seeds.push_back(seed);
+      }
     }
   }
   return seeds;
+}
+
+}  // namespace
+
+std::vector<world::Pose> restingSeeds(const Cloud& cloud, const std::vector<int>& indices, const TablePlane& support,
+                                      const world::ObjectClass& object_class) {
+  return seedsResting(cloud, indices, support, object_class, false);
+}
+
+std::vector<world::Pose> restingSeedsAtEnds(const Cloud& cloud, const std::vector<int>& indices,
+                                            const TablePlane& support, const world::ObjectClass& object_class) {
+  return seedsResting(cloud, indices, support, object_class, true);
 }
 
 std::vector<int> ClassPoseEstimator::unexplainedPoints(const Cloud& cloud, const std::vector<int>& cluster,
@@ -804,6 +849,14 @@ std::vector<Detection> ClassPoseEstimator::estimateCluster(const Cloud& cloud, c
         candidates.push_back({seed, 0.0f});
       }
     }
+    // Points of touching parts of the class: upright at both ends of the points too, tried after
+    // every other candidate (a start between them fits neither).
+    const std::size_t last_resort = candidates.size();
+    if (attempt > 0 && support_plane_) {
+      for (const world::Pose& seed : restingSeedsAtEnds(cloud, remaining, *support_plane_, model_.object_class)) {
+        candidates.push_back({seed, 0.0f});
+      }
+    }
     local.recognition += seconds(start);
     ++local.runs;
     local.candidates += static_cast<int>(candidates.size());
@@ -818,7 +871,11 @@ std::vector<Detection> ClassPoseEstimator::estimateCluster(const Cloud& cloud, c
       const DepthAgreement raw = compareWithDepth(model_, candidates[c].pose, frame, 2 * options_.depth_tolerance, 7);
       order.emplace_back(raw.agreement() * raw.visibleFraction(), c);
     }
-    std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::stable_sort(order.begin(), order.end(), [last_resort](const auto& a, const auto& b) {
+      const bool a_last = a.second >= last_resort;
+      const bool b_last = b.second >= last_resort;
+      return a_last != b_last ? b_last : a.first > b.first;
+    });
     for (const auto& [raw_score, c] : order) {
       const auto& candidate = candidates[c];
       const bool explained = std::any_of(accepted.begin(), accepted.end(), [&](const Detection& other) {

@@ -126,6 +126,13 @@ double overlapFraction(const ObjectModel& a, const world::Pose& pose_a, const Ob
 std::vector<world::Pose> restingSeeds(const Cloud& points, const std::vector<int>& indices, const TablePlane& support,
                                       const world::ObjectClass& object_class);
 
+/// The same poses at both ends of the points instead of under their middle, when the points
+/// spread along their main horizontal axis over more than one and a half times the object's
+/// length (touching parts of a class, whose middle lies between them): half an object in from
+/// the points' extremes (2nd and 98th percentiles); 24 poses (48 raised), else none.
+std::vector<world::Pose> restingSeedsAtEnds(const Cloud& points, const std::vector<int>& indices,
+                                            const TablePlane& support, const world::ObjectClass& object_class);
+
 /// ObjRecRANSAC loaded with one class's model. Building it hashes the model's point pairs
 /// (milliseconds). One instance must not be used by two threads at once; distinct instances
 /// may run in parallel.
