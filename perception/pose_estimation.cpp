@@ -579,12 +579,17 @@ constexpr double kRaisedSupport = 0.015;
 
 namespace {
 
-/// restingSeeds (ends false) or restingSeedsAtEnds (ends true).
-std::vector<world::Pose> seedsResting(const Cloud& cloud, const std::vector<int>& indices, const TablePlane& support,
-                                      const world::ObjectClass& object_class, bool ends) {
-  std::vector<world::Pose> seeds;
+/// restingSeeds (`middle`) and restingSeedsAtEnds (`ends`) from one pass over the points.
+struct RestingStarts {
+  std::vector<world::Pose> middle;
+  std::vector<world::Pose> ends;
+};
+
+RestingStarts restingStarts(const Cloud& cloud, const std::vector<int>& indices, const TablePlane& support,
+                            const world::ObjectClass& object_class) {
+  RestingStarts starts;
   if (indices.size() < 10) {
-    return seeds;
+    return starts;
   }
   const Eigen::Vector3d normal = support.normal.normalized();  // out of the table, toward the camera
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -603,7 +608,7 @@ std::vector<world::Pose> seedsResting(const Cloud& cloud, const std::vector<int>
   Eigen::Vector3d axis = solver.eigenvectors().col(2);
   axis -= axis.dot(normal) * normal;
   if (axis.norm() < 1e-9) {
-    return seeds;
+    return starts;
   }
   axis.normalize();
   const Eigen::Vector3d side = normal.cross(axis);
@@ -618,13 +623,11 @@ std::vector<world::Pose> seedsResting(const Cloud& cloud, const std::vector<int>
     }
     return on_plane;
   };
-  std::vector<Eigen::Vector3d> places;
-  if (!ends) {
-    places.push_back(onPlane(mean));
-  } else {
-    // Points spread along their main axis over more than one and a half objects are more than
-    // one (touching parts of a class): their mean lies between them; these stand at both ends,
-    // half an object in from the points' extremes (their 2nd and 98th percentiles).
+  // Points spread along their main axis over more than one and a half objects are more than one
+  // (touching parts of a class): their mean lies between them; the ends' starts stand half an
+  // object in from the points' extremes (their 2nd and 98th percentiles).
+  std::vector<Eigen::Vector3d> ends;
+  {
     const double span = bounds.sizes().head<2>().maxCoeff();
     std::vector<double> along;
     along.reserve(indices.size());
@@ -637,11 +640,9 @@ std::vector<world::Pose> seedsResting(const Cloud& cloud, const std::vector<int>
     const double from = *first;
     std::nth_element(along.begin(), last, along.end());
     const double to = *last;
-    if (to - from <= 1.5 * span) {
-      return seeds;
+    if (to - from > 1.5 * span) {
+      ends = {onPlane(mean + (from + 0.5 * span) * axis), onPlane(mean + (to - 0.5 * span) * axis)};
     }
-    places.push_back(onPlane(mean + (from + 0.5 * span) * axis));
-    places.push_back(onPlane(mean + (to - 0.5 * span) * axis));
   }
   // What it rests on: the table, and, when even its lowest points are well above the table (a
   // link on a node), a level under those points as well (their 5th percentile height).
@@ -657,7 +658,7 @@ std::vector<world::Pose> seedsResting(const Cloud& cloud, const std::vector<int>
     levels.push_back(*low);
   }
   constexpr double kStep = 15.0 * M_PI / 180.0;
-  for (const Eigen::Vector3d& on_plane : places) {
+  const auto addStarts = [&](const Eigen::Vector3d& on_plane, std::vector<world::Pose>& seeds) {
     for (const double level : levels) {
       for (int k = 0; k < 12; ++k) {  // 0 .. 165 degrees: a turn of 180 more is the same box
         const double yaw = k * kStep;
@@ -673,20 +674,24 @@ std::vector<world::Pose> seedsResting(const Cloud& cloud, const std::vector<int>
         seeds.push_back(seed);
       }
     }
+  };
+  addStarts(onPlane(mean), starts.middle);
+  for (const Eigen::Vector3d& end : ends) {
+    addStarts(end, starts.ends);
   }
-  return seeds;
+  return starts;
 }
 
 }  // namespace
 
 std::vector<world::Pose> restingSeeds(const Cloud& cloud, const std::vector<int>& indices, const TablePlane& support,
                                       const world::ObjectClass& object_class) {
-  return seedsResting(cloud, indices, support, object_class, false);
+  return restingStarts(cloud, indices, support, object_class).middle;
 }
 
 std::vector<world::Pose> restingSeedsAtEnds(const Cloud& cloud, const std::vector<int>& indices,
                                             const TablePlane& support, const world::ObjectClass& object_class) {
-  return seedsResting(cloud, indices, support, object_class, true);
+  return restingStarts(cloud, indices, support, object_class).ends;
 }
 
 std::vector<int> ClassPoseEstimator::unexplainedPoints(const Cloud& cloud, const std::vector<int>& cluster,
@@ -843,17 +848,17 @@ std::vector<Detection> ClassPoseEstimator::estimateCluster(const Cloud& cloud, c
     }
     // The points' axes mislead when two faces are in view (a node's top and front), and
     // ObjRecRANSAC's hypotheses can all be wrong there too: on a retry, the object standing
-    // upright on the table, turned in steps, starts near the truth as well.
+    // upright on the table, turned in steps, starts near the truth as well. Points of touching
+    // parts of the class: upright at both ends of the points too, tried after every other
+    // candidate (a start between them fits neither).
+    std::size_t last_resort = candidates.size();
     if (attempt > 0 && support_plane_) {
-      for (const world::Pose& seed : restingSeeds(cloud, remaining, *support_plane_, model_.object_class)) {
+      const RestingStarts starts = restingStarts(cloud, remaining, *support_plane_, model_.object_class);
+      for (const world::Pose& seed : starts.middle) {
         candidates.push_back({seed, 0.0f});
       }
-    }
-    // Points of touching parts of the class: upright at both ends of the points too, tried after
-    // every other candidate (a start between them fits neither).
-    const std::size_t last_resort = candidates.size();
-    if (attempt > 0 && support_plane_) {
-      for (const world::Pose& seed : restingSeedsAtEnds(cloud, remaining, *support_plane_, model_.object_class)) {
+      last_resort = candidates.size();
+      for (const world::Pose& seed : starts.ends) {
         candidates.push_back({seed, 0.0f});
       }
     }

@@ -364,15 +364,13 @@ std::optional<std::string> SmartMoveComponent::misplacedPart() const {
   // Perception renames a part that moved farther than it tracks, so the part put down is found
   // by where it is: the nearest of its class to where it was put, among those seen where none was.
   std::optional<std::pair<std::string, double>> nearest;
-  for (const std::string& object : world_.match("is_a", std::vector<std::string>{"?", put_->object_class})) {
-    const auto pose = world_.worldPose(object);
-    if (!pose || (held_ && object == *held_) ||
-        std::any_of(put_->known.begin(), put_->known.end(), [&](const Eigen::Vector3d& known) {
-          return (known - pose->translation()).norm() <= config_.misplaced_distance;
+  for (const auto& [object, pose] : matching(put_->object_class, {}).objects) {
+    if (std::any_of(put_->known.begin(), put_->known.end(), [&](const Eigen::Vector3d& known) {
+          return (known - pose.translation()).norm() <= config_.misplaced_distance;
         })) {
       continue;
     }
-    const double distance = (pose->translation() - put_->pose.translation()).norm();
+    const double distance = (pose.translation() - put_->pose.translation()).norm();
     if (!nearest || distance < nearest->second) {
       nearest = {object, distance};
     }
@@ -1210,26 +1208,23 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginRelease(const compone
                                    "lower");
                    },
                    nullptr});
-  steps.push_back(
-      {"release " + released,
-       [this, opening = held_opening_, position = held_finger_position_] {
-         if (position > 0.0) {  // a fingertip mode: as far as the part needs
-           component::ParamMap params = gripperDefaults(gripper_, "Open");
-           params["position"] = position;
-           return std::make_unique<ComponentStep>(gripper_, "Open", params);
-         }
-         return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening));
-       },
-       [this, part = chosen.goal * held_grasp_.inverse()](const OperationResult&) -> std::string {
-         put_ = PutDown{held_class_, part, {}};
-         for (const std::string& object : world_.match("is_a", std::vector<std::string>{"?", held_class_})) {
-           if (const auto pose = world_.worldPose(object)) {
-             put_->known.push_back(pose->translation());
-           }
-         }
-         held_.reset();
-         return {};
-       }});
+  steps.push_back({"release " + released,
+                   [this, opening = held_opening_, position = held_finger_position_] {
+                     if (position > 0.0) {  // a fingertip mode: as far as the part needs
+                       component::ParamMap params = gripperDefaults(gripper_, "Open");
+                       params["position"] = position;
+                       return std::make_unique<ComponentStep>(gripper_, "Open", params);
+                     }
+                     return std::make_unique<ComponentStep>(gripper_, "Open", openParams(opening));
+                   },
+                   [this, part = chosen.goal * held_grasp_.inverse()](const OperationResult&) -> std::string {
+                     put_ = PutDown{held_class_, part, {}};
+                     for (const auto& [object, pose] : matching(held_class_, {}).objects) {
+                       put_->known.push_back(pose.translation());
+                     }
+                     held_.reset();
+                     return {};
+                   }});
   steps.push_back({"lift away",
                    [this, approach, support_object, mode = held_mode_, position = held_finger_position_] {
                      fingersInMode(mode, position);
