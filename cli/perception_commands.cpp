@@ -323,7 +323,8 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   eval_command->add_option("--json", eval_options->json, "write the summary as JSON to this file");
   eval_command->add_option("--out", eval_options->eval.pictures,
-                           "folder for a PNG per scene with the detections drawn");
+                           "folder for a PNG per scene with the detections drawn, and each scene's file (and each "
+                           "push's) to run again with `perception detect`");
   eval_command
       ->add_option("--repeats", eval_options->eval.repeats, "DetectObjects runs per scene while the parts stay still")
       ->capture_default_str()

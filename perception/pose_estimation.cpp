@@ -339,7 +339,7 @@ IcpResult refinePose(const ObjectModel& model, const std::vector<Eigen::Vector3f
 // --- scoring ---------------------------------------------------------------------------------
 
 DepthAgreement compareWithDepth(const ObjectModel& model, const world::Pose& pose, const camera::RgbdFrame& frame,
-                                double tolerance, int stride) {
+                                double tolerance, int stride, const std::vector<std::uint8_t>* claimed) {
   DepthAgreement agreement;
   const camera::Intrinsics& in = frame.intrinsics;
   const Eigen::Isometry3f transform = pose.cast<float>();
@@ -364,7 +364,11 @@ DepthAgreement compareWithDepth(const ObjectModel& model, const world::Pose& pos
       continue;  // no reading: cannot judge
     }
     if (std::abs(depth - p.z()) <= tol) {
-      ++agreement.confirmed;
+      if (claimed == nullptr || (*claimed)[static_cast<std::size_t>(v) * in.width + u] == 0) {
+        ++agreement.confirmed;
+      } else {
+        ++agreement.contradicted;  // another detection's surface: the two would overlap
+      }
     } else if (depth > p.z() + tol) {
       ++agreement.contradicted;  // the camera sees through where the model has surface
     }
@@ -717,7 +721,8 @@ std::vector<int> ClassPoseEstimator::unexplainedPoints(const Cloud& cloud, const
 }
 
 std::optional<world::Pose> ClassPoseEstimator::slideAlongLongAxes(const world::Pose& pose,
-                                                                  const camera::RgbdFrame& frame) const {
+                                                                  const camera::RgbdFrame& frame,
+                                                                  const std::vector<std::uint8_t>* claimed) const {
   // Point-to-plane ICP cannot tell where along its faces an elongated object lies when an
   // end hides behind a neighbour: try shifts along each long axis and keep the one the depth
   // image agrees with best (surface seen where the model has it, minus three times the
@@ -725,16 +730,20 @@ std::optional<world::Pose> ClassPoseEstimator::slideAlongLongAxes(const world::P
   const Eigen::Vector3d size = model_.object_class.bounds().sizes();
   const double shortest = size.minCoeff();
   const auto score = [&](const world::Pose& candidate) {
-    const DepthAgreement agreement = compareWithDepth(model_, candidate, frame, options_.depth_tolerance, 2);
+    const DepthAgreement agreement =
+        compareWithDepth(model_, candidate, frame, options_.depth_tolerance, claimed == nullptr ? 2 : 1, claimed);
     return agreement.confirmed - 3 * agreement.contradicted;
   };
+  // Against claimed surface, farther: a part slid into its neighbour can lie a third of its
+  // length off.
+  const int steps = claimed == nullptr ? 12 : 20;
   std::optional<world::Pose> best;
   int best_score = score(pose);
   for (int axis = 0; axis < 3; ++axis) {
     if (size[axis] < 1.5 * shortest) {
       continue;
     }
-    for (int step = -12; step <= 12; ++step) {
+    for (int step = -steps; step <= steps; ++step) {
       if (step == 0) {
         continue;
       }
@@ -778,6 +787,146 @@ double ClassPoseEstimator::meanSupport(const std::vector<Detection>& detections)
   return sum / static_cast<double>(detections.size());
 }
 
+std::optional<Detection> ClassPoseEstimator::verify(const Cloud& cloud, const world::Pose& start, double raw_score,
+                                                    const camera::RgbdFrame& frame, const std::vector<bool>& taken,
+                                                    const std::vector<Detection>& accepted, int* checked) const {
+  const auto overlapsAccepted = [&](const world::Pose& pose) {
+    return std::any_of(accepted.begin(), accepted.end(), [&](const Detection& other) {
+      return overlapFraction(model_, pose, model_, other.pose_in_camera) > 0.2;
+    });
+  };
+  if (overlapsAccepted(start)) {
+    return std::nullopt;  // explained already
+  }
+  // Points already explained by an accepted neighbour do not pull this one.
+  const std::vector<Eigen::Vector3f> coarse_points =
+      pointsNear(cloud, start.translation().cast<float>(), model_.radius + options_.icp_initial_distance, 150, &taken);
+  if (coarse_points.size() < 10) {
+    return std::nullopt;
+  }
+  if (checked != nullptr) {
+    ++*checked;
+  }
+  // A raw pose that already fits needs a small correction only (a narrow ICP cannot drift
+  // onto a touching neighbour); otherwise, or if that fails, a wide one.
+  const auto passes = [this](const DepthAgreement& quick) {
+    return quick.agreement() >= options_.min_confidence - 0.1 &&
+           quick.visibleFraction() >= options_.min_visible_fraction * 0.8;
+  };
+  IcpResult coarse;
+  DepthAgreement quick;
+  bool ok = false;
+  if (raw_score >= 0.25) {
+    coarse = refinePose(model_, coarse_points, start, 8, 0.01, options_.icp_final_distance + 0.001);
+    quick = compareWithDepth(model_, coarse.pose, frame, options_.depth_tolerance, 5);
+    ok = passes(quick);
+  }
+  if (!ok) {
+    coarse = refinePose(model_, coarse_points, start, 10, options_.icp_initial_distance,
+                        options_.icp_coarse_final_distance, 0.2);
+    quick = compareWithDepth(model_, coarse.pose, frame, options_.depth_tolerance, 5);
+    ok = passes(quick);
+  }
+  if (!ok || !aboveSupport(coarse.pose) || overlapsAccepted(coarse.pose)) {
+    return std::nullopt;
+  }
+  const std::vector<Eigen::Vector3f> fine_points =
+      pointsNear(cloud, coarse.pose.translation().cast<float>(), model_.radius + 0.01, 1500, &taken);
+  IcpResult refined = refinePose(model_, fine_points, coarse.pose, options_.icp_iterations,
+                                 options_.icp_coarse_final_distance, options_.icp_final_distance);
+  if (const std::optional<world::Pose> slid = slideAlongLongAxes(refined.pose, frame)) {
+    refined = refinePose(model_, fine_points, *slid, options_.icp_iterations / 2 + 1,
+                         options_.icp_final_distance + 0.002, options_.icp_final_distance);
+  }
+  const DepthAgreement agreement = compareWithDepth(model_, refined.pose, frame, options_.depth_tolerance);
+  Detection detection;
+  detection.object_class = model_.name();
+  detection.pose_in_camera = refined.pose;
+  detection.confidence = agreement.agreement();
+  detection.visible_fraction = agreement.visibleFraction();
+  detection.fit_rms = refined.rms;
+  detection.support = refined.inliers;
+  if (detection.confidence < options_.min_confidence || detection.visible_fraction < options_.min_visible_fraction ||
+      !aboveSupport(refined.pose)) {
+    return std::nullopt;
+  }
+  return detection;
+}
+
+std::vector<std::pair<double, std::size_t>> ClassPoseEstimator::rankStarts(const std::vector<world::Pose>& starts,
+                                                                           const camera::RgbdFrame& frame,
+                                                                           std::size_t last_resort) const {
+  std::vector<std::pair<double, std::size_t>> order;
+  order.reserve(starts.size());
+  for (std::size_t c = 0; c < starts.size(); ++c) {
+    const DepthAgreement raw = compareWithDepth(model_, starts[c], frame, 2 * options_.depth_tolerance, 7);
+    order.emplace_back(raw.agreement() * raw.visibleFraction(), c);
+  }
+  std::stable_sort(order.begin(), order.end(), [last_resort](const auto& a, const auto& b) {
+    const bool a_last = a.second >= last_resort;
+    const bool b_last = b.second >= last_resort;
+    return a_last != b_last ? b_last : a.first > b.first;
+  });
+  return order;
+}
+
+bool ClassPoseEstimator::explained(std::size_t unexplained, const std::vector<Detection>& accepted) const {
+  return static_cast<double>(unexplained) <
+         std::max<double>(options_.min_cluster_points, options_.unexplained_fraction * meanSupport(accepted));
+}
+
+void ClassPoseEstimator::splitStraddling(const Cloud& cloud, const std::vector<int>& cluster,
+                                         const camera::RgbdFrame& frame, std::vector<Detection>& accepted,
+                                         int* checked) const {
+  // Two touching parts of the class lying end to end: a detection straddling them (half of
+  // each) fits the depth image well enough to be accepted, and every later start on either
+  // part overlaps it, so the cluster stays unexplained on both sides. Try each detection
+  // replaced by detections started upright on the table under the points it and no other
+  // explains (with the points nobody explains), in the middle and, when they span more than
+  // one object, at both ends; keep them when they explain more of the cluster.
+  if (!support_plane_ || accepted.empty()) {
+    return;
+  }
+  const std::size_t unexplained = unexplainedPoints(cloud, cluster, accepted).size();
+  if (explained(unexplained, accepted)) {
+    return;
+  }
+  std::vector<Detection> best = accepted;
+  std::size_t best_unexplained = unexplained;
+  for (std::size_t a = 0; a < accepted.size(); ++a) {
+    std::vector<Detection> others = accepted;
+    others.erase(others.begin() + static_cast<std::ptrdiff_t>(a));
+    std::vector<bool> others_taken(cloud.size(), false);
+    for (const Detection& other : others) {
+      markExplained(cloud, other, others_taken);
+    }
+    const RestingStarts resting =
+        restingStarts(cloud, unexplainedPoints(cloud, cluster, others), *support_plane_, model_.object_class);
+    // The ends on their own (a start in the middle would find the straddling pose again), then
+    // the middle (one part, when the replaced detection lay partly on a neighbour).
+    for (const std::vector<world::Pose>* starts : {&resting.ends, &resting.middle}) {
+      if (starts->empty()) {
+        continue;
+      }
+      std::vector<Detection> trial = others;
+      std::vector<bool> taken = others_taken;
+      for (const auto& [raw_score, c] : rankStarts(*starts, frame, starts->size())) {
+        std::optional<Detection> detection = verify(cloud, (*starts)[c], raw_score, frame, taken, trial, checked);
+        if (detection) {
+          trial.push_back(*detection);
+          markExplained(cloud, *detection, taken);
+        }
+      }
+      const std::size_t left = unexplainedPoints(cloud, cluster, trial).size();
+      if (trial.size() >= accepted.size() && left < best_unexplained) {
+        best = std::move(trial);
+        best_unexplained = left;
+      }
+    }
+  }
+  accepted = std::move(best);
+}
+
 std::vector<Detection> ClassPoseEstimator::estimateCluster(const Cloud& cloud, const std::vector<int>& cluster,
                                                            const camera::RgbdFrame& frame, std::uint32_t task,
                                                            Timing* timing) {
@@ -787,7 +936,6 @@ std::vector<Detection> ClassPoseEstimator::estimateCluster(const Cloud& cloud, c
     return accepted;
   }
   const ClassParameters& parameters = model_.parameters;
-  const double reach = model_.radius + options_.icp_initial_distance;
   std::vector<int> remaining = cluster;
   std::vector<bool> taken(cloud.size(), false);  // points explained by accepted detections
   for (int attempt = 0; attempt < std::max(1, options_.max_attempts); ++attempt) {
@@ -870,86 +1018,22 @@ std::vector<Detection> ClassPoseEstimator::estimateCluster(const Cloud& cloud, c
     // each is refined by a coarse ICP and checked again, and one that passes is refined and
     // checked in full. The run stops once the cluster's points are explained.
     start = std::chrono::steady_clock::now();
-    std::vector<std::pair<double, std::size_t>> order;
-    order.reserve(candidates.size());
-    for (std::size_t c = 0; c < candidates.size(); ++c) {
-      const DepthAgreement raw = compareWithDepth(model_, candidates[c].pose, frame, 2 * options_.depth_tolerance, 7);
-      order.emplace_back(raw.agreement() * raw.visibleFraction(), c);
+    std::vector<world::Pose> starts;
+    starts.reserve(candidates.size());
+    for (const auto& candidate : candidates) {
+      starts.push_back(candidate.pose);
     }
-    std::stable_sort(order.begin(), order.end(), [last_resort](const auto& a, const auto& b) {
-      const bool a_last = a.second >= last_resort;
-      const bool b_last = b.second >= last_resort;
-      return a_last != b_last ? b_last : a.first > b.first;
-    });
+    const auto order = rankStarts(starts, frame, last_resort);
     for (const auto& [raw_score, c] : order) {
-      const auto& candidate = candidates[c];
-      const bool explained = std::any_of(accepted.begin(), accepted.end(), [&](const Detection& other) {
-        return overlapFraction(model_, candidate.pose, model_, other.pose_in_camera) > 0.2;
-      });
-      if (explained) {
+      std::optional<Detection> detection =
+          verify(cloud, candidates[c].pose, raw_score, frame, taken, accepted, &local.checked);
+      if (!detection) {
         continue;
       }
-      // Points already explained by an accepted neighbour do not pull this one.
-      const std::vector<Eigen::Vector3f> coarse_points =
-          pointsNear(cloud, candidate.pose.translation().cast<float>(), reach, 150, &taken);
-      if (coarse_points.size() < 10) {
-        continue;
-      }
-      ++local.checked;
-      // A raw pose that already fits needs a small correction only (a narrow ICP cannot drift
-      // onto a touching neighbour); otherwise, or if that fails, a wide one.
-      const auto passes = [this](const DepthAgreement& quick) {
-        return quick.agreement() >= options_.min_confidence - 0.1 &&
-               quick.visibleFraction() >= options_.min_visible_fraction * 0.8;
-      };
-      IcpResult coarse;
-      DepthAgreement quick;
-      bool ok = false;
-      if (raw_score >= 0.25) {
-        coarse = refinePose(model_, coarse_points, candidate.pose, 8, 0.01, options_.icp_final_distance + 0.001);
-        quick = compareWithDepth(model_, coarse.pose, frame, options_.depth_tolerance, 5);
-        ok = passes(quick);
-      }
-      if (!ok) {
-        coarse = refinePose(model_, coarse_points, candidate.pose, 10, options_.icp_initial_distance,
-                            options_.icp_coarse_final_distance, 0.2);
-        quick = compareWithDepth(model_, coarse.pose, frame, options_.depth_tolerance, 5);
-        ok = passes(quick);
-      }
-      if (!ok || !aboveSupport(coarse.pose)) {
-        continue;
-      }
-      const bool duplicate = std::any_of(accepted.begin(), accepted.end(), [&](const Detection& other) {
-        return overlapFraction(model_, coarse.pose, model_, other.pose_in_camera) > 0.2;
-      });
-      if (duplicate) {
-        continue;
-      }
-      const std::vector<Eigen::Vector3f> fine_points =
-          pointsNear(cloud, coarse.pose.translation().cast<float>(), model_.radius + 0.01, 1500, &taken);
-      IcpResult refined = refinePose(model_, fine_points, coarse.pose, options_.icp_iterations,
-                                     options_.icp_coarse_final_distance, options_.icp_final_distance);
-      if (const std::optional<world::Pose> slid = slideAlongLongAxes(refined.pose, frame)) {
-        refined = refinePose(model_, fine_points, *slid, options_.icp_iterations / 2 + 1,
-                             options_.icp_final_distance + 0.002, options_.icp_final_distance);
-      }
-      const DepthAgreement agreement = compareWithDepth(model_, refined.pose, frame, options_.depth_tolerance);
-      Detection detection;
-      detection.object_class = model_.name();
-      detection.pose_in_camera = refined.pose;
-      detection.confidence = agreement.agreement();
-      detection.visible_fraction = agreement.visibleFraction();
-      detection.recognition_score = candidate.match;
-      detection.fit_rms = refined.rms;
-      detection.support = refined.inliers;
-      if (detection.confidence < options_.min_confidence ||
-          detection.visible_fraction < options_.min_visible_fraction || !aboveSupport(refined.pose)) {
-        continue;
-      }
-      accepted.push_back(detection);
-      markExplained(cloud, detection, taken);
-      if (static_cast<double>(unexplainedPoints(cloud, cluster, accepted).size()) <
-          std::max<double>(options_.min_cluster_points, options_.unexplained_fraction * meanSupport(accepted))) {
+      detection->recognition_score = candidates[c].match;
+      accepted.push_back(*detection);
+      markExplained(cloud, *detection, taken);
+      if (explained(unexplainedPoints(cloud, cluster, accepted).size(), accepted)) {
         break;  // the cluster is explained
       }
     }
@@ -964,6 +1048,9 @@ std::vector<Detection> ClassPoseEstimator::estimateCluster(const Cloud& cloud, c
     }
     remaining = accepted.empty() ? cluster : unexplained;
   }
+  auto start = std::chrono::steady_clock::now();
+  splitStraddling(cloud, cluster, frame, accepted, &local.checked);
+  local.refinement += seconds(start);
   if (timing != nullptr) {
     timing->recognition += local.recognition;
     timing->refinement += local.refinement;
@@ -984,6 +1071,12 @@ void ClassPoseEstimator::refineTouching(const Cloud& cloud, std::vector<Detectio
     return nearest < 0 ? std::numeric_limits<float>::max()
                        : (model_.surface.points[static_cast<std::size_t>(nearest)] - q).norm();
   };
+  const Eigen::Vector3d size = model_.object_class.bounds().sizes();
+  const bool elongated = size.maxCoeff() >= 1.5 * size.minCoeff();
+  std::vector<std::uint8_t> claimed(
+      elongated ? static_cast<std::size_t>(frame.intrinsics.width) * static_cast<std::size_t>(frame.intrinsics.height)
+                : 0,
+      0);
   for (int round = 0; round < 2; ++round) {
     std::vector<Detection> updated = detections;
     std::vector<Eigen::Isometry3f> to_object;
@@ -1014,10 +1107,47 @@ void ClassPoseEstimator::refineTouching(const Cloud& cloud, std::vector<Detectio
           own.push_back(p);
         }
       }
-      const IcpResult refined = refinePose(model_, own, detections[i].pose_in_camera, 15,
-                                           options_.icp_final_distance + 0.002, options_.icp_final_distance);
+      IcpResult refined = refinePose(model_, own, detections[i].pose_in_camera, 15, options_.icp_final_distance + 0.002,
+                                     options_.icp_final_distance);
       if (refined.inliers < 10) {
         continue;
+      }
+      // An elongated part against a neighbour's side (a T of two links) can slide into it:
+      // the neighbour's top at the same height confirms the slid part as well as its own far
+      // end did. Slide it again with the neighbours' surface counted against it (the two
+      // would overlap), and refine on the points they do not explain.
+      if (elongated) {
+        std::vector<int> claimed_pixels;
+        std::vector<Eigen::Vector3f> unclaimed;
+        const float slide_reach = static_cast<float>(reach + 0.04);  // the slide's range
+        for (std::size_t k = 0; k < cloud.size(); ++k) {
+          const Eigen::Vector3f& p = cloud.points[k];
+          if ((p - centre).squaredNorm() > slide_reach * slide_reach) {
+            continue;
+          }
+          const bool theirs = std::any_of(neighbours.begin(), neighbours.end(), [&](std::size_t j) {
+            return distance(detections[j], to_object[j], p) <= static_cast<float>(0.5 * options_.depth_tolerance);
+          });
+          if (theirs) {
+            claimed_pixels.push_back(cloud.pixels[k]);
+          } else {
+            unclaimed.push_back(p);
+          }
+        }
+        for (const int pixel : claimed_pixels) {
+          claimed[static_cast<std::size_t>(pixel)] = 1;
+        }
+        const std::optional<world::Pose> slid = slideAlongLongAxes(refined.pose, frame, &claimed);
+        for (const int pixel : claimed_pixels) {
+          claimed[static_cast<std::size_t>(pixel)] = 0;
+        }
+        if (slid) {
+          const IcpResult again = refinePose(model_, unclaimed, *slid, options_.icp_iterations / 2 + 1,
+                                             options_.icp_final_distance + 0.002, options_.icp_final_distance);
+          if (again.inliers >= 10) {
+            refined = again;
+          }
+        }
       }
       const DepthAgreement agreement = compareWithDepth(model_, refined.pose, frame, options_.depth_tolerance);
       updated[i].pose_in_camera = refined.pose;

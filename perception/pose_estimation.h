@@ -106,9 +106,11 @@ struct DepthAgreement {
   }
   double visibleFraction() const { return facing == 0 ? 0.0 : double(confirmed) / facing; }
 };
-/// `stride` > 1 checks every stride-th sample only (a quick score).
+/// `stride` > 1 checks every stride-th sample only (a quick score). A sample confirmed on a
+/// `claimed` pixel (one per pixel of `frame`, non-zero: another detection's surface) counts
+/// as contradicted instead: the two objects would overlap.
 DepthAgreement compareWithDepth(const ObjectModel& model, const world::Pose& pose, const camera::RgbdFrame& frame,
-                                double tolerance, int stride = 1);
+                                double tolerance, int stride = 1, const std::vector<std::uint8_t>* claimed = nullptr);
 
 /// Fraction of `a`'s interior samples (under pose_a) that lie inside `b`'s boxes (under pose_b)
 /// shrunk by `margin` (m): how much of a's volume b claims too.
@@ -175,7 +177,8 @@ class ClassPoseEstimator {
 
   /// Refines detections of this class that touch each other: each refines on the points of
   /// `points` nearer its own surface than its neighbours' (two rounds), so that touching
-  /// parts do not pull each other. Confidence and visible fraction are updated.
+  /// parts do not pull each other; an elongated one then slides along its long axes with its
+  /// neighbours' surface counted against it. Confidence and visible fraction are updated.
   void refineTouching(const Cloud& points, std::vector<Detection>& detections, const camera::RgbdFrame& frame) const;
 
   /// All clusters in turn, refineTouching(), then mergeDetections(): the instances of the
@@ -191,8 +194,26 @@ class ClassPoseEstimator {
   std::vector<world::Pose> principalAxisSeeds(const Cloud& points, const std::vector<int>& indices) const;
 
   /// For an elongated model: the shift along its long axes (up to 24 mm) that the depth image
-  /// agrees with best, if better than `pose`; nullopt otherwise.
-  std::optional<world::Pose> slideAlongLongAxes(const world::Pose& pose, const camera::RgbdFrame& frame) const;
+  /// agrees with best, if better than `pose`; nullopt otherwise. With `claimed` pixels (see
+  /// compareWithDepth): up to 40 mm, every sample scored.
+  std::optional<world::Pose> slideAlongLongAxes(const world::Pose& pose, const camera::RgbdFrame& frame,
+                                                const std::vector<std::uint8_t>* claimed = nullptr) const;
+  /// Verifies a start pose: coarse ICP (narrow when its raw depth score already fits, else
+  /// wide) on the points not yet `taken`, a quick depth check, the fine ICP, the slide along
+  /// long axes and the full depth check. Nullopt when a check fails or the pose overlaps one of
+  /// `accepted`. Counts verified starts in `checked`.
+  std::optional<Detection> verify(const Cloud& points, const world::Pose& start, double raw_score,
+                                  const camera::RgbdFrame& frame, const std::vector<bool>& taken,
+                                  const std::vector<Detection>& accepted, int* checked) const;
+  /// (raw depth score, index) of `starts`, best first; those from `last_resort` on after all others.
+  std::vector<std::pair<double, std::size_t>> rankStarts(const std::vector<world::Pose>& starts,
+                                                         const camera::RgbdFrame& frame, std::size_t last_resort) const;
+  /// True when `unexplained` points of a cluster are few enough for `accepted` to explain it.
+  bool explained(std::size_t unexplained, const std::vector<Detection>& accepted) const;
+  /// A cluster left unexplained: each accepted detection tried replaced by detections started
+  /// at both ends of the points it alone explains (see estimateCluster).
+  void splitStraddling(const Cloud& points, const std::vector<int>& cluster, const camera::RgbdFrame& frame,
+                       std::vector<Detection>& accepted, int* checked) const;
   /// Marks the points of `points` near `detection`'s surface in `taken`.
   void markExplained(const Cloud& points, const Detection& detection, std::vector<bool>& taken) const;
 

@@ -490,4 +490,53 @@ ClutteredScene clutteredScene(const std::vector<world::ObjectClass>& classes,
   return out;
 }
 
+std::string sceneFileText(const Scene& scene) {
+  json file = json::object();
+  if (!scene.description.empty()) {
+    file["description"] = scene.description;
+  }
+  file["seed"] = scene.seed;
+  file["min_gap"] = scene.min_gap;
+  const auto defaults = defaultRegions();
+  for (const auto& [name, region] : scene.regions) {
+    const auto known = defaults.find(name);
+    if (known == defaults.end() || known->second.min != region.min || known->second.max != region.max) {
+      file["regions"][name] = {{"x", {region.min.x(), region.max.x()}}, {"y", {region.min.y(), region.max.y()}}};
+    }
+  }
+  if (scene.camera_offset) {
+    const CameraOffset& offset = *scene.camera_offset;
+    json value = json::object();
+    if (offset.random) {
+      value["distance"] = offset.distance;
+      value["angle_deg"] = offset.angle_deg;
+      if (offset.seed) {
+        value["seed"] = *offset.seed;
+      }
+    } else {
+      value["xyz"] = {offset.xyz.x(), offset.xyz.y(), offset.xyz.z()};
+      value["rpy_deg"] = {offset.rpy_deg.x(), offset.rpy_deg.y(), offset.rpy_deg.z()};
+    }
+    file["camera_offset"] = value;
+  }
+  json parts = json::array();
+  for (const PartRequest& part : scene.parts) {
+    json item = {{"class", part.object_class}};
+    if (!part.color.empty()) {
+      item["color"] = part.color;
+    }
+    if (part.at) {
+      item["at"] = {part.at->x(), part.at->y(), part.at->z()};
+    } else {
+      if (part.count != 1) {
+        item["count"] = part.count;
+      }
+      item["region"] = part.region;
+    }
+    parts.push_back(item);
+  }
+  file["parts"] = parts;
+  return file.dump(1) + "\n";
+}
+
 }  // namespace costar::sim

@@ -89,6 +89,10 @@ std::map<std::string, Region> defaultRegions();
 Scene loadScene(const std::filesystem::path& file);
 Scene parseScene(const std::string& json_text, const std::string& label);
 
+/// The scene as a scene file's text (parseScene reads it back to the same scene): description,
+/// seed, min_gap, custom regions, camera_offset and every part, fixed ("at") or in a region.
+std::string sceneFileText(const Scene& scene);
+
 /// A part as placed: its simulator name (node_0, link_1, ...), class, colour, and pose.
 struct PartPlacement {
   std::string name;

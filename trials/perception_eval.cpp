@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -197,6 +198,17 @@ RgbImage labelPicture(const perception::PipelineResult& result, const perception
   return perception::drawOverlaysZoomed(image, frame.intrinsics, frame.camera_pose, {},
                                         perception::workspaceRegion(frame.intrinsics, frame.camera_pose, pictureArea()),
                                         2.0);
+}
+
+/// A scene file `perception detect` can run again. @throws std::runtime_error when it cannot
+/// be written.
+void writeSceneFile(const std::filesystem::path& file, sim::Scene scene, const std::string& description) {
+  scene.description = description;
+  std::ofstream out(file);
+  out << sim::sceneFileText(scene);
+  if (!out.flush()) {
+    throw std::runtime_error("cannot write '" + file.string() + "'");
+  }
 }
 
 /// The parts of a simulation as a scene with fixed placements (to re-create it after a push).
@@ -458,6 +470,8 @@ PerceptionEvalSummary evaluatePerception(const PerceptionEvalOptions& options,
       const std::string stem = formatted("scene_%03d", s + 1);
       writePng(options.pictures / (stem + ".png"), pictureOf(*result.filtered, detected, truth, first, classes));
       writePng(options.pictures / (stem + "_labels.png"), labelPicture(result, *pipeline));
+      writeSceneFile(options.pictures / (stem + ".json"), generated.scene,
+                     "perception eval --seed " + std::to_string(options.seed) + ", " + label);
     }
     std::vector<std::string> names(truth.size());  // after the first look
     for (std::size_t p = 0; p < truth.size(); ++p) {
@@ -507,7 +521,12 @@ PerceptionEvalSummary evaluatePerception(const PerceptionEvalOptions& options,
       // One simulation at a time (destroying one ends the EGL display all renderers share).
       simulation.reset();
       sim_clock = std::make_unique<SimClock>();
-      simulation = sim::Simulation::create(sceneOf(parts, where));
+      const sim::Scene pushed_scene = sceneOf(parts, where);
+      if (!options.pictures.empty()) {
+        writeSceneFile(options.pictures / formatted("scene_%03d_push_%d.json", s + 1, push + 1), pushed_scene,
+                       "perception eval --seed " + std::to_string(options.seed) + ", " + where);
+      }
+      simulation = sim::Simulation::create(pushed_scene);
       simulation->attach(*sim_clock);
       camera.use(*simulation, random());
       clock.use(*sim_clock);

@@ -100,7 +100,8 @@ struct PerceptionEvalOptions {
   int pushes = 2;          // per scene: one part moved 1-2 cm and turned up to 10 degrees
   int frames = 15;         // per DetectObjects (the median filter's N)
   double touching = 0.4;   // chance that a part is placed against another
-  /// A PNG per scene (detections drawn; the SVM's labels) in this folder; empty: none.
+  /// A PNG per scene (detections drawn; the SVM's labels) and the scene files (scene_NNN.json,
+  /// scene_NNN_push_K.json: `perception detect` runs them again) in this folder; empty: none.
   std::filesystem::path pictures;
 };
 

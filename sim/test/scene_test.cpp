@@ -215,6 +215,45 @@ TEST(Scene, ProblemsAreNamed) {
 
 // Issue 10, bug 2: the regions loop iterated items() of a temporary (freed memory; valgrind and
 // AddressSanitizer report it) and failed with "cannot use at() with null".
+TEST(Scene, ASceneWrittenAsAFileReadsBackTheSame) {
+  // A cluttered scene (every part fixed) and one with regions, counts and a camera offset.
+  std::mt19937_64 random(5);
+  const Scene cluttered = clutteredScene(classes(), {{"node", 4}, {"link", 2}}, 0.4, random, "cluttered").scene;
+  const Scene mixed = parseScene(R"({"description": "mixed", "seed": 9, "min_gap": 0.01,
+      "regions": {"corner": {"x": [0.55, 0.7], "y": [0.2, 0.35]}},
+      "camera_offset": {"distance": 0.05, "angle_deg": 5, "seed": 7},
+      "parts": [{"class": "node", "color": "red", "at": [0.5, -0.2, 30]},
+                {"class": "node", "count": 2, "region": "corner"}, {"class": "link"}]})",
+                                 "mixed.json");
+  for (const Scene& scene : {cluttered, mixed}) {
+    const std::string text = sceneFileText(scene);
+    const Scene back = parseScene(text, "back.json");
+    EXPECT_EQ(back.description, scene.description);
+    EXPECT_EQ(back.seed, scene.seed);
+    EXPECT_EQ(back.min_gap, scene.min_gap);
+    EXPECT_EQ(back.regions.size(), scene.regions.size());
+    EXPECT_EQ(back.camera_offset.has_value(), scene.camera_offset.has_value());
+    ASSERT_EQ(back.parts.size(), scene.parts.size());
+    for (std::size_t i = 0; i < scene.parts.size(); ++i) {
+      EXPECT_EQ(back.parts[i].object_class, scene.parts[i].object_class);
+      EXPECT_EQ(back.parts[i].color, scene.parts[i].color);
+      EXPECT_EQ(back.parts[i].count, scene.parts[i].count);
+      EXPECT_EQ(back.parts[i].region, scene.parts[i].region);
+      EXPECT_EQ(back.parts[i].at, scene.parts[i].at);  // exactly: doubles written in full
+    }
+    // The same placements from both.
+    const auto placed_parts = placeParts(scene, classes());
+    const auto placed_back = placeParts(back, classes());
+    ASSERT_EQ(placed_back.size(), placed_parts.size());
+    for (std::size_t i = 0; i < placed_parts.size(); ++i) {
+      EXPECT_TRUE(placed_back[i].pose.isApprox(placed_parts[i].pose, 0.0)) << placed_parts[i].name;
+    }
+    EXPECT_EQ(sceneFileText(back), text);
+  }
+  EXPECT_EQ(parseScene(sceneFileText(mixed), "m").camera_offset->distance, 0.05);
+  EXPECT_EQ(parseScene(sceneFileText(mixed), "m").regions.at("corner").max, Eigen::Vector2d(0.7, 0.35));
+}
+
 TEST(Scene, CustomRegionsAreReadAndUsed) {
   const Scene scene = parseScene(R"({"seed": 4,
       "regions": {"corner": {"x": [0.55, 0.7], "y": [0.2, 0.35]}, "strip": {"x": [0.3, 0.35], "y": [-0.3, 0.3]}},
