@@ -167,7 +167,9 @@ int evaluate(const EvalOptions& options) {
       std::printf("\nwrote %s\n", options.json.c_str());
     }
     if (!eval.pictures.empty()) {
-      std::printf("pictures in %s (green: within 5 mm / 5 deg, red: not, orange: false detection, yellow: missed)\n",
+      std::printf("pictures in %s (green: within 5 mm / 5 deg, red: not, orange: false detection, yellow: missed);\n"
+                  "each scene's file beside its picture (scene_NNN.json, scene_NNN_push_K.json): "
+                  "`costar-robot perception detect FILE` runs it again\n",
                   eval.pictures.string().c_str());
     }
     const double found = summary.scores.foundWithinTolerance();
