@@ -720,6 +720,16 @@ std::vector<int> ClassPoseEstimator::unexplainedPoints(const Cloud& cloud, const
   return out;
 }
 
+namespace {
+
+/// An axis of a model's box at least this many times its shortest is long: point-to-plane ICP
+/// cannot tell where along it the object lies (slideAlongLongAxes).
+constexpr double kLongAxis = 1.5;
+
+bool isLongAxis(const Eigen::Vector3d& size, int axis) { return size[axis] >= kLongAxis * size.minCoeff(); }
+
+}  // namespace
+
 std::optional<world::Pose> ClassPoseEstimator::slideAlongLongAxes(const world::Pose& pose,
                                                                   const camera::RgbdFrame& frame,
                                                                   const std::vector<std::uint8_t>* claimed) const {
@@ -728,7 +738,6 @@ std::optional<world::Pose> ClassPoseEstimator::slideAlongLongAxes(const world::P
   // image agrees with best (surface seen where the model has it, minus three times the
   // surface seen through).
   const Eigen::Vector3d size = model_.object_class.bounds().sizes();
-  const double shortest = size.minCoeff();
   const auto score = [&](const world::Pose& candidate) {
     const DepthAgreement agreement =
         compareWithDepth(model_, candidate, frame, options_.depth_tolerance, claimed == nullptr ? 2 : 1, claimed);
@@ -740,7 +749,7 @@ std::optional<world::Pose> ClassPoseEstimator::slideAlongLongAxes(const world::P
   std::optional<world::Pose> best;
   int best_score = score(pose);
   for (int axis = 0; axis < 3; ++axis) {
-    if (size[axis] < 1.5 * shortest) {
+    if (!isLongAxis(size, axis)) {
       continue;
     }
     for (int step = -steps; step <= steps; ++step) {
@@ -1072,7 +1081,9 @@ void ClassPoseEstimator::refineTouching(const Cloud& cloud, std::vector<Detectio
                        : (model_.surface.points[static_cast<std::size_t>(nearest)] - q).norm();
   };
   const Eigen::Vector3d size = model_.object_class.bounds().sizes();
-  const bool elongated = size.maxCoeff() >= 1.5 * size.minCoeff();
+  Eigen::Index longest = 0;
+  size.maxCoeff(&longest);
+  const bool elongated = isLongAxis(size, static_cast<int>(longest));
   std::vector<std::uint8_t> claimed(
       elongated ? static_cast<std::size_t>(frame.intrinsics.width) * static_cast<std::size_t>(frame.intrinsics.height)
                 : 0,
@@ -1094,17 +1105,35 @@ void ClassPoseEstimator::refineTouching(const Cloud& cloud, std::vector<Detectio
       if (neighbours.empty()) {
         continue;
       }
+      // One pass over the points near it: its own (none nearer a neighbour's surface, within
+      // reach) for the refinement, and, for an elongated part, those a neighbour's surface
+      // explains (claimed) or not, within the slide's range.
       std::vector<Eigen::Vector3f> own;
+      std::vector<int> claimed_pixels;
+      std::vector<Eigen::Vector3f> unclaimed;
       const Eigen::Vector3f centre = detections[i].pose_in_camera.translation().cast<float>();
-      for (const auto& p : cloud.points) {
-        if ((p - centre).squaredNorm() > static_cast<float>(reach * reach)) {
+      const auto own_reach2 = static_cast<float>(reach * reach);
+      const auto slide_reach = static_cast<float>(reach + 0.04);  // the slide's range
+      const float scan_reach2 = elongated ? slide_reach * slide_reach : own_reach2;
+      for (std::size_t k = 0; k < cloud.size(); ++k) {
+        const Eigen::Vector3f& p = cloud.points[k];
+        const float squared = (p - centre).squaredNorm();
+        if (squared > scan_reach2) {
           continue;
         }
-        const float mine = distance(detections[i], to_object[i], p);
-        const bool theirs = std::any_of(neighbours.begin(), neighbours.end(),
-                                        [&](std::size_t j) { return distance(detections[j], to_object[j], p) < mine; });
-        if (!theirs) {
+        float theirs = std::numeric_limits<float>::max();  // the nearest neighbour surface
+        for (const std::size_t j : neighbours) {
+          theirs = std::min(theirs, distance(detections[j], to_object[j], p));
+        }
+        if (squared <= own_reach2 && !(theirs < distance(detections[i], to_object[i], p))) {
           own.push_back(p);
+        }
+        if (elongated) {
+          if (theirs <= static_cast<float>(0.5 * options_.depth_tolerance)) {
+            claimed_pixels.push_back(cloud.pixels[k]);
+          } else {
+            unclaimed.push_back(p);
+          }
         }
       }
       IcpResult refined = refinePose(model_, own, detections[i].pose_in_camera, 15, options_.icp_final_distance + 0.002,
@@ -1117,23 +1146,6 @@ void ClassPoseEstimator::refineTouching(const Cloud& cloud, std::vector<Detectio
       // end did. Slide it again with the neighbours' surface counted against it (the two
       // would overlap), and refine on the points they do not explain.
       if (elongated) {
-        std::vector<int> claimed_pixels;
-        std::vector<Eigen::Vector3f> unclaimed;
-        const float slide_reach = static_cast<float>(reach + 0.04);  // the slide's range
-        for (std::size_t k = 0; k < cloud.size(); ++k) {
-          const Eigen::Vector3f& p = cloud.points[k];
-          if ((p - centre).squaredNorm() > slide_reach * slide_reach) {
-            continue;
-          }
-          const bool theirs = std::any_of(neighbours.begin(), neighbours.end(), [&](std::size_t j) {
-            return distance(detections[j], to_object[j], p) <= static_cast<float>(0.5 * options_.depth_tolerance);
-          });
-          if (theirs) {
-            claimed_pixels.push_back(cloud.pixels[k]);
-          } else {
-            unclaimed.push_back(p);
-          }
-        }
         for (const int pixel : claimed_pixels) {
           claimed[static_cast<std::size_t>(pixel)] = 1;
         }
