@@ -15,6 +15,25 @@ std::string format(const char* pattern, double value) {
   return text;
 }
 
+/// How far (rad) beyond a limit a motion may start: an arm that was sent to a joint limit reads
+/// a hair beyond it (a tracking error of ~1e-7 rad in the simulator, an encoder count on
+/// hardware), and a motion from there must still be planned. Such a start is taken as at the
+/// limit; further out, the trajectory refuses it with the joint and the distance.
+constexpr double kStartBeyondLimitTolerance = 1e-3;
+
+/// `q` with each joint that lies beyond its limit by at most `tolerance` put on the limit.
+JointVector atLimitsWithin(const JointVector& q, const JointLimits& limits, double tolerance) {
+  JointVector result = q;
+  for (int j = 0; j < q.size(); ++j) {
+    if (q[j] > limits.max_position[j] && q[j] <= limits.max_position[j] + tolerance) {
+      result[j] = limits.max_position[j];
+    } else if (q[j] < limits.min_position[j] && q[j] >= limits.min_position[j] - tolerance) {
+      result[j] = limits.min_position[j];
+    }
+  }
+  return result;
+}
+
 }  // namespace
 
 std::string readingProblem(const ArmState& state, TimePoint now, Duration timeout,
@@ -104,13 +123,14 @@ MotionPlan MotionPlanner::timed(std::vector<JointVector> path, double speed) con
   return plan;
 }
 
-MotionPlan MotionPlanner::planToJoints(const JointVector& start, const JointVector& goal, double speed,
+MotionPlan MotionPlanner::planToJoints(const JointVector& from, const JointVector& goal, double speed,
                                        const AllowedContacts& allowed) const {
   const JointLimits& limits = kinematics_->limits();
-  if (goal.size() != limits.size() || start.size() != limits.size()) {
+  if (goal.size() != limits.size() || from.size() != limits.size()) {
     return MotionPlan::failed(goal, "the goal has " + std::to_string(goal.size()) + " joints and the start " +
-                                        std::to_string(start.size()) + ", the arm " + std::to_string(limits.size()));
+                                        std::to_string(from.size()) + ", the arm " + std::to_string(limits.size()));
   }
+  const JointVector start = atLimitsWithin(from, limits, kStartBeyondLimitTolerance);
   for (int j = 0; j < goal.size(); ++j) {
     if (goal[j] < limits.min_position[j] || goal[j] > limits.max_position[j]) {
       return MotionPlan::failed(goal, "joint " + std::to_string(j + 1) + " would leave its limits");
@@ -154,8 +174,11 @@ MotionPlan MotionPlanner::planToPose(const JointVector& from, const world::Pose&
                                       " arm configurations reaching the pose works (" + first_problem + ")");
 }
 
-MotionPlan MotionPlanner::planLine(const JointVector& current, const world::Pose& target, double speed,
+MotionPlan MotionPlanner::planLine(const JointVector& from, const world::Pose& target, double speed,
                                    const AllowedContacts& allowed) const {
+  const JointVector current = from.size() == kinematics_->limits().size()
+                                  ? atLimitsWithin(from, kinematics_->limits(), kStartBeyondLimitTolerance)
+                                  : from;
   const world::Pose start = toolAt(current);
   const double distance = (target.translation() - start.translation()).norm();
   const double angle = world::rotationAngle(start, target);

@@ -76,6 +76,8 @@ class MotionService {
 
   /// A collision-free joint-space motion from `from` to `goal` (straight when it is free, else
   /// planned around), timed at `speed` (a fraction of the joint speed and acceleration limits).
+  /// A `from` (here and in planLine) a hair beyond a joint limit, as an arm sent to the limit
+  /// reads, starts on the limit; further beyond it the plan fails naming the joint.
   virtual MotionPlan planToJoints(const JointVector& from, const JointVector& goal, double speed,
                                   const AllowedContacts& allowed = {}) const = 0;
   /// A straight Cartesian line of the TCP from the pose at `from` to `tcp_in_world`.

@@ -250,6 +250,36 @@ TEST_F(ArmTest, FollowsAPathPlannedByTheMotionServiceExactlyAsItWouldItsOwn) {
   EXPECT_EQ(arm.description().operation(kFollowJointPath)->kind, component::OperationKind::kInternal);
 }
 
+// An arm sent to a joint limit reads a hair beyond it (the iiwa's joint 5 at 2.96706 rad +
+// 2e-7 after a grasp, seed 1835 of the 3-finger assembly); the next motion from there must be
+// planned, starting on the limit. Further beyond it, the plan fails naming the joint.
+TEST_F(ArmTest, AMotionStartingAHairBeyondAJointLimitStartsOnTheLimit) {
+  const double limit = JointLimits::ur5().max_position[5];
+  for (const double beyond : {2e-7, 5e-4, 0.01}) {
+    JointVector start = kHome;
+    start[5] = limit + beyond;
+    const IdealDriver at_limit(clock, start);
+    const MotionPlanner service(at_limit, clock, collisions, std::make_shared<Ur5Kinematics>(), config());
+    JointVector goal = kHome;
+    goal[5] = limit - 0.5;
+    const MotionPlan joints = service.planToJoints(service.joints(), goal, 0.4);
+    const MotionPlan line = service.planLine(
+        service.joints(), service.toolAt(start) * world::Pose(Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitZ())), 0.4);
+    if (beyond < 1e-3) {
+      ASSERT_TRUE(joints.ok()) << joints.failure;
+      EXPECT_EQ(joints.path.front()[5], limit);
+      EXPECT_LT(maxAbsDifference(joints.trajectory->sample(Duration{}).position, start), 1e-3);
+      ASSERT_TRUE(line.ok()) << line.failure;
+      EXPECT_EQ(line.path.front()[5], limit);
+    } else {
+      EXPECT_FALSE(joints.ok());
+      EXPECT_NE(joints.failure.find("joint 6 of the start is"), std::string::npos) << joints.failure;
+      EXPECT_NE(joints.failure.find("above its maximum"), std::string::npos) << joints.failure;
+      EXPECT_FALSE(line.ok());
+    }
+  }
+}
+
 TEST_F(ArmTest, FollowJointPathRefusesABadPathOrOneFromElsewhereAndCancelStopsIt) {
   const auto follow = [this](const std::string& path) {
     return run(std::string(kFollowJointPath), {{"path", path}, {"label", "approach"}});
