@@ -728,6 +728,12 @@ constexpr double kLongAxis = 1.5;
 
 bool isLongAxis(const Eigen::Vector3d& size, int axis) { return size[axis] >= kLongAxis * size.minCoeff(); }
 
+bool isElongated(const Eigen::Vector3d& size) { return size.maxCoeff() >= kLongAxis * size.minCoeff(); }
+
+/// A coarse pose of an elongated part that the depth image agrees with this much less than a
+/// detection needs is slid along its length before it is rejected (verify).
+constexpr double kSlideBeforeRejecting = 0.3;
+
 }  // namespace
 
 std::optional<world::Pose> ClassPoseEstimator::slideAlongLongAxes(const world::Pose& pose,
@@ -835,6 +841,21 @@ std::optional<Detection> ClassPoseEstimator::verify(const Cloud& cloud, const wo
                         options_.icp_coarse_final_distance, 0.2);
     quick = compareWithDepth(model_, coarse.pose, frame, options_.depth_tolerance, 5);
     ok = passes(quick);
+  }
+  // An elongated part whose points are partly another class's (a link lying across a node, its
+  // end over the node labelled node) is pulled along its length by them: slid back to where the
+  // depth image has it, it may pass.
+  if (!ok && isElongated(model_.object_class.bounds().sizes()) &&
+      quick.agreement() >= options_.min_confidence - kSlideBeforeRejecting &&
+      quick.visibleFraction() >= options_.min_visible_fraction * 0.8) {
+    if (const std::optional<world::Pose> slid = slideAlongLongAxes(coarse.pose, frame)) {
+      const DepthAgreement again = compareWithDepth(model_, *slid, frame, options_.depth_tolerance, 5);
+      if (passes(again)) {
+        coarse.pose = *slid;
+        quick = again;
+        ok = true;
+      }
+    }
   }
   if (!ok || !aboveSupport(coarse.pose) || overlapsAccepted(coarse.pose)) {
     return std::nullopt;

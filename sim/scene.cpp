@@ -141,7 +141,7 @@ std::string knownRegions(const std::map<std::string, Region>& regions) {
 }
 
 PartRequest parsePart(const json& item, const std::string& field, const std::map<std::string, Region>& regions) {
-  onlyKnownFields(object(item, field), field, {"class", "color", "count", "at", "region"});
+  onlyKnownFields(object(item, field), field, {"class", "color", "count", "at", "height", "region"});
   PartRequest request;
   if (!item.contains("class")) {
     fail(field + ".class", "missing (the object class, e.g. \"node\")");
@@ -165,7 +165,17 @@ PartRequest parsePart(const json& item, const std::string& field, const std::map
     if (!inside(tableTop(), request.at->head<2>())) {
       fail(field + ".at", "lies off the table top (" + describeTable() + ")");
     }
+    if (item.contains("height")) {
+      const double height = number(item.at("height"), field + ".height");
+      if (!(height >= 0.0 && height <= 0.5)) {
+        fail(field + ".height", "must be within 0 .. 0.5 m above the table, got " + format(height));
+      }
+      request.height = height;
+    }
   } else {
+    if (item.contains("height")) {
+      fail(field + ".height", "only a part placed with \"at\" has a height");
+    }
     request.region = item.contains("region") ? stringField(item.at("region"), field + ".region") : "table";
     if (!regions.contains(request.region)) {
       fail(field + ".region", "unknown region '" + request.region + "' (known: " + knownRegions(regions) + ")");
@@ -402,7 +412,7 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
         }
       }
       footprints.push_back(Footprint::of(object, xy.x(), xy.y(), yaw));
-      part.pose = world::poseFromXyzRpy(xy.x(), xy.y(), object.rest_height + 0.0005, 0, 0, yaw);
+      part.pose = world::poseFromXyzRpy(xy.x(), xy.y(), request.height + object.rest_height + 0.0005, 0, 0, yaw);
       placed.push_back(std::move(part));
     }
   }
@@ -527,6 +537,9 @@ std::string sceneFileText(const Scene& scene) {
     }
     if (part.at) {
       item["at"] = {part.at->x(), part.at->y(), part.at->z()};
+      if (part.height != 0.0) {
+        item["height"] = part.height;
+      }
     } else {
       if (part.count != 1) {
         item["count"] = part.count;

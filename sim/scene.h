@@ -6,7 +6,9 @@
 //    "parts": [{"class": "node", "color": "red", "at": [0.5, -0.2, 30]},
 //              {"class": "node", "count": 2, "region": "right"},
 //              {"class": "link", "region": "right"}]}
-// "at" is x, y (m, world frame: the robot's base, table top z = 0) and yaw (degrees).
+// "at" is x, y (m, world frame: the robot's base, table top z = 0) and yaw (degrees); with
+// "height" (m, 0 to 0.5) such a part starts that far above the table and falls onto what lies
+// under it: {"class": "link", "at": [0.6, 0.05, 90], "height": 0.05} across a node at (0.6, 0.05).
 // Optional: "min_gap" (m, 0 to 0.5, default 0.02) between randomly placed parts. Custom
 // regions add to (or replace) the default ones. A field the format does not know, a value of
 // the wrong type or out of range (a count of 4294967297, a negative min_gap, a region or an
@@ -41,6 +43,9 @@ struct PartRequest {
   int count = 1;
   /// Fixed placement: x, y (m) and yaw (degrees).
   std::optional<Eigen::Vector3d> at;
+  /// With `at`: how high above the table its underside starts (m; 0: on the table). A part put
+  /// over another falls onto it when the simulation starts (a link across a node, a stack).
+  double height = 0.0;
   /// Random placement in this region (any yaw), when `at` is absent.
   std::string region;
 };

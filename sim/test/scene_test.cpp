@@ -223,6 +223,7 @@ TEST(Scene, ASceneWrittenAsAFileReadsBackTheSame) {
       "regions": {"corner": {"x": [0.55, 0.7], "y": [0.2, 0.35]}},
       "camera_offset": {"distance": 0.05, "angle_deg": 5, "seed": 7},
       "parts": [{"class": "node", "color": "red", "at": [0.5, -0.2, 30]},
+                {"class": "link", "at": [0.5, -0.2, 120], "height": 0.05},
                 {"class": "node", "count": 2, "region": "corner"}, {"class": "link"}]})",
                                  "mixed.json");
   for (const Scene& scene : {cluttered, mixed}) {
@@ -240,6 +241,7 @@ TEST(Scene, ASceneWrittenAsAFileReadsBackTheSame) {
       EXPECT_EQ(back.parts[i].count, scene.parts[i].count);
       EXPECT_EQ(back.parts[i].region, scene.parts[i].region);
       EXPECT_EQ(back.parts[i].at, scene.parts[i].at);  // exactly: doubles written in full
+      EXPECT_EQ(back.parts[i].height, scene.parts[i].height);
     }
     // The same placements from both.
     const auto placed_parts = placeParts(scene, classes());
@@ -251,6 +253,9 @@ TEST(Scene, ASceneWrittenAsAFileReadsBackTheSame) {
     EXPECT_EQ(sceneFileText(back), text);
   }
   EXPECT_EQ(parseScene(sceneFileText(mixed), "m").camera_offset->distance, 0.05);
+  // A part with a height starts that far up: the link over the node, the node on the table.
+  const auto stacked = placeParts(mixed, classes());
+  EXPECT_NEAR(stacked[1].pose.translation().z() - stacked[0].pose.translation().z(), 0.05 - 0.025 + 0.0125, 1e-12);
   EXPECT_EQ(parseScene(sceneFileText(mixed), "m").regions.at("corner").max, Eigen::Vector2d(0.7, 0.35));
 }
 
@@ -289,7 +294,11 @@ TEST(Scene, BadValuesAreErrorsNamingTheField) {
   EXPECT_EQ(problem(R"({"seed": -3, "parts": []})").substr(0, prefix.size() + 6), prefix + "seed: ");
   EXPECT_EQ(problem(R"({"parts": [{"class": 7}]})"), prefix + "parts[0].class: must be a string, not 7");
   EXPECT_EQ(problem(R"({"parts": [{"colour": "red", "class": "node"}]})"),
-            prefix + "parts[0].colour: unknown field (known: class, color, count, at, region)");
+            prefix + "parts[0].colour: unknown field (known: class, color, count, at, height, region)");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, 0], "height": -0.1}]})"),
+            prefix + "parts[0].height: must be within 0 .. 0.5 m above the table, got -0.1");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "region": "left", "height": 0.05}]})"),
+            prefix + "parts[0].height: only a part placed with \"at\" has a height");
   EXPECT_EQ(problem(R"({"regoins": {}, "parts": []})"),
             prefix + "regoins: unknown field (known: description, seed, min_gap, camera_offset, regions, parts)");
   EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5]}]})"),
