@@ -10,9 +10,10 @@
 
 #include "core/paths.h"
 #include "perception/canonical_orientation.h"
+#include "perception/features.h"
 #include "perception/median_filter.h"
-#include "perception/persistence.h"
 #include "perception/perception_component.h"
+#include "perception/persistence.h"
 #include "perception/pipeline.h"
 #include "perception/segmentation.h"
 #include "perception/workspace.h"
@@ -125,6 +126,21 @@ void BM_Stage3_NormalsFeaturesSvm(benchmark::State& state) {
 }
 BENCHMARK(BM_Stage3_NormalsFeaturesSvm)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+/// The classifier alone: the SVM's decision for every voxel of the benchmark's frame.
+void BM_Stage3c_SvmPredict(benchmark::State& state) {
+  Fixture& f = Fixture::get();
+  const camera::RgbdFrame median = medianFrame(f.frames);
+  WorkspaceCloud workspace = cropWorkspace(median, f.pipeline->options().workspace);
+  estimateNormals(median, workspace.cloud);
+  const VoxelFeatures voxels = computeFeatures(workspace.cloud, f.pipeline->options().segmentation.features);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(f.pipeline->classifier().predict(voxels.features));
+  }
+  state.counters["voxels"] = static_cast<double>(voxels.features.rows());
+  state.counters["support_vectors"] = static_cast<double>(f.pipeline->classifier().supportVectorCount());
+}
+BENCHMARK(BM_Stage3c_SvmPredict)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_Stages2to4_DetectFiltered(benchmark::State& state) {
   Fixture& f = Fixture::get();
   const camera::RgbdFrame median = medianFrame(f.frames);
@@ -176,11 +192,7 @@ BENCHMARK(BM_PersistenceUpdate)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Complexity(benchmark::oNLogN);
-BENCHMARK(BM_PersistenceUpdate)
-    ->Arg(10000)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MeasureProcessCPUTime();
+BENCHMARK(BM_PersistenceUpdate)->Arg(10000)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
 
 /// The reference: each detection against every previous object of its class, one match each.
 void BM_PersistenceBruteForce(benchmark::State& state) {

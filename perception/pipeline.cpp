@@ -12,6 +12,15 @@
 namespace costar::perception {
 
 namespace {
+/// Leftover points of a class's cluster handed to a neighbouring cluster of another class: at
+/// least this many, within this distance (m) of it. The task number that seeds its search is
+/// offset by kHandOverTask.
+constexpr std::size_t kHandOverPoints = 150;
+constexpr double kHandOverTouch = 0.01;
+constexpr std::uint32_t kHandOverTask = 1000;
+}  // namespace
+
+namespace {
 
 double since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -224,6 +233,51 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
       helper.join();
     }
   }
+  // A cluster's points that its class's detections leave unexplained, lying against a cluster
+  // of another class where nothing was found, may be that class's: a grey link lying across a
+  // node, seen side-on, is mostly labelled node, and its own few points fit no link. That class
+  // looks again at its cluster with those points added.
+  {
+    const double touch = kHandOverTouch * kHandOverTouch;
+    const std::size_t task_count = tasks.size();
+    for (std::size_t a = 0; a < task_count; ++a) {
+      const std::vector<int> leftover = workers_->estimators[0][tasks[a].model]->unexplainedPoints(
+          class_points[tasks[a].model], tasks[a].cluster, tasks[a].found);
+      if (leftover.size() < kHandOverPoints) {
+        continue;
+      }
+      const Cloud& from = class_points[tasks[a].model];
+      for (std::size_t b = 0; b < task_count; ++b) {
+        Task& other = tasks[b];
+        if (other.model == tasks[a].model || !other.found.empty()) {
+          continue;
+        }
+        const Cloud& own = class_points[other.model];
+        const bool touching = std::any_of(leftover.begin(), leftover.end(), [&](int i) {
+          const Eigen::Vector3f& p = from.points[static_cast<std::size_t>(i)];
+          return std::any_of(other.cluster.begin(), other.cluster.end(), [&](int j) {
+            return (own.points[static_cast<std::size_t>(j)] - p).squaredNorm() <= touch;
+          });
+        });
+        if (!touching) {
+          continue;
+        }
+        Cloud joined;
+        std::vector<int> cluster;
+        for (const int j : other.cluster) {
+          cluster.push_back(static_cast<int>(joined.size()));
+          joined.append(own, static_cast<std::size_t>(j));
+        }
+        for (const int i : leftover) {
+          cluster.push_back(static_cast<int>(joined.size()));
+          joined.append(from, static_cast<std::size_t>(i));
+        }
+        StdoutSilence silence;  // ObjRecRANSAC prints its progress
+        other.found = workers_->estimators[0][other.model]->estimateCluster(joined, cluster, reference,
+                                                                            other.index + kHandOverTask, &other.timing);
+      }
+    }
+  }
   std::vector<Detection> found;
   for (std::size_t m = 0; m < models_.size(); ++m) {
     std::vector<Detection> of_class;
@@ -232,8 +286,9 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
         of_class.insert(of_class.end(), task.found.begin(), task.found.end());
       }
     }
-    // Touching parts of a class: each refined on its own points.
+    // Touching parts of a class: each refined on its own points; then levelled where it rests.
     workers_->estimators[0][m]->refineTouching(class_points[m], of_class, reference);
+    workers_->estimators[0][m]->levelResting(of_class, reference);
     found.insert(found.end(), of_class.begin(), of_class.end());
   }
   for (const Task& task : tasks) {

@@ -581,6 +581,16 @@ namespace {
 constexpr double kRaisedSupport = 0.015;
 }  // namespace
 
+bool ClassPoseEstimator::raised(const world::Pose& pose) const {
+  if (!support_plane_) {
+    return false;
+  }
+  const Eigen::Isometry3f transform = pose.cast<float>();
+  return std::all_of(model_.interior.begin(), model_.interior.end(), [&](const Eigen::Vector3f& interior) {
+    return support_plane_->height(transform * interior) > kRaisedSupport;
+  });
+}
+
 namespace {
 
 /// restingSeeds (`middle`) and restingSeedsAtEnds (`ends`) from one pass over the points.
@@ -736,6 +746,40 @@ constexpr double kSlideBeforeRejecting = 0.3;
 
 }  // namespace
 
+void ClassPoseEstimator::levelResting(std::vector<Detection>& detections, const camera::RgbdFrame& frame) const {
+  if (!support_plane_) {
+    return;
+  }
+  constexpr double kLevelFrom = 1.0 * M_PI / 180.0;
+  constexpr double kLevelUpTo = 20.0 * M_PI / 180.0;
+  constexpr double kAgreementSlack = 0.005;
+  const Eigen::Vector3d up = support_plane_->normal.normalized();
+  for (Detection& detection : detections) {
+    const Eigen::Matrix3d rotation = detection.pose_in_camera.linear();
+    int axis = 0;
+    for (int k = 1; k < 3; ++k) {
+      if (std::abs(rotation.col(k).dot(up)) > std::abs(rotation.col(axis).dot(up))) {
+        axis = k;
+      }
+    }
+    const Eigen::Vector3d face =
+        rotation.col(axis).dot(up) > 0.0 ? rotation.col(axis) : Eigen::Vector3d(-rotation.col(axis));
+    const double tilt = std::acos(std::clamp(face.dot(up), -1.0, 1.0));
+    if (tilt < kLevelFrom || tilt > kLevelUpTo) {
+      continue;
+    }
+    world::Pose levelled = detection.pose_in_camera;
+    levelled.linear() = Eigen::Quaterniond::FromTwoVectors(face, up).toRotationMatrix() * rotation;
+    const DepthAgreement agreement = compareWithDepth(model_, levelled, frame, options_.depth_tolerance);
+    if (agreement.agreement() >= detection.confidence - kAgreementSlack &&
+        agreement.visibleFraction() >= options_.min_visible_fraction && aboveSupport(levelled)) {
+      detection.pose_in_camera = levelled;
+      detection.confidence = agreement.agreement();
+      detection.visible_fraction = agreement.visibleFraction();
+    }
+  }
+}
+
 std::optional<world::Pose> ClassPoseEstimator::slideAlongLongAxes(const world::Pose& pose,
                                                                   const camera::RgbdFrame& frame,
                                                                   const std::vector<std::uint8_t>* claimed) const {
@@ -842,10 +886,11 @@ std::optional<Detection> ClassPoseEstimator::verify(const Cloud& cloud, const wo
     quick = compareWithDepth(model_, coarse.pose, frame, options_.depth_tolerance, 5);
     ok = passes(quick);
   }
-  // An elongated part whose points are partly another class's (a link lying across a node, its
-  // end over the node labelled node) is pulled along its length by them: slid back to where the
-  // depth image has it, it may pass.
-  if (!ok && isElongated(model_.object_class.bounds().sizes()) &&
+  // An elongated part lying on another part, whose points are partly that part's class's (a
+  // link across a node, its end over the node labelled node), is pulled along its length by
+  // them: slid back to where the depth image has it, it may pass. (On the table, sliding a start
+  // that fails can put it where a partly hidden part is not: not done there.)
+  if (!ok && isElongated(model_.object_class.bounds().sizes()) && raised(coarse.pose) &&
       quick.agreement() >= options_.min_confidence - kSlideBeforeRejecting &&
       quick.visibleFraction() >= options_.min_visible_fraction * 0.8) {
     if (const std::optional<world::Pose> slid = slideAlongLongAxes(coarse.pose, frame)) {

@@ -181,14 +181,23 @@ class ClassPoseEstimator {
   /// neighbours' surface counted against it. Confidence and visible fraction are updated.
   void refineTouching(const Cloud& points, std::vector<Detection>& detections, const camera::RgbdFrame& frame) const;
 
+  /// Parts lie flat, on the table or on each other: a detection with a face within 20° of the
+  /// support plane's normal (and more than 1° off it) is turned about its centre to rest on that
+  /// face when the depth image agrees with the levelled pose as well (to 0.005). The depth check
+  /// (6 mm tolerance) cannot tell a square link rolled 17° about its length from a flat one, and
+  /// SmartRelease puts nothing on a part whose top is tilted. Needs setSupportPlane().
+  void levelResting(std::vector<Detection>& detections, const camera::RgbdFrame& frame) const;
+
+  /// Points of `cluster` (indices into `points`) farther than the depth tolerance from every
+  /// detection's surface.
+  std::vector<int> unexplainedPoints(const Cloud& points, const std::vector<int>& cluster,
+                                     const std::vector<Detection>& detections) const;
+
   /// All clusters in turn, refineTouching(), then mergeDetections(): the instances of the
   /// class in `points`.
   std::vector<Detection> estimate(const Cloud& points, const camera::RgbdFrame& frame, Timing* timing = nullptr);
 
  private:
-  /// Points of `cluster` farther than the depth tolerance from every detection's surface.
-  std::vector<int> unexplainedPoints(const Cloud& points, const std::vector<int>& cluster,
-                                     const std::vector<Detection>& detections) const;
   static double meanSupport(const std::vector<Detection>& detections);
   /// Start poses from the principal axes of `indices` of `points` (see estimateCluster).
   std::vector<world::Pose> principalAxisSeeds(const Cloud& points, const std::vector<int>& indices) const;
@@ -219,6 +228,9 @@ class ClassPoseEstimator {
 
   /// True when the object under `pose` lies (almost) entirely above the support plane.
   bool aboveSupport(const world::Pose& pose) const;
+  /// True when all of the object under `pose` is more than 1.5 cm above the support plane: it
+  /// rests on another part.
+  bool raised(const world::Pose& pose) const;
 
   struct Impl;
   const ObjectModel& model_;

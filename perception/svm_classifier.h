@@ -73,11 +73,34 @@ class SvmClassifier {
   int supportVectorCount() const { return static_cast<int>(support_vectors_.rows()); }
   const SvmTrainingReport& report() const { return report_; }
 
+  /// How the RBF kernel is evaluated: kBest uses AVX2 and FMA where the CPU has them (one
+  /// fused pass: dot products, exponentials and the weighted sums, 8 support vectors at a time),
+  /// else the portable path (Eigen's matrix products; the same decisions to float rounding).
+  enum class Instructions { kBest, kPortable };
+
   /// The label of each row of `features` (raw, unstandardized).
   /// @throws std::invalid_argument when the number of columns is not featureCount().
-  std::vector<int> predict(const Eigen::MatrixXf& features) const;
+  std::vector<int> predict(const Eigen::MatrixXf& features, Instructions instructions = Instructions::kBest) const;
+
+  /// libsvm's decision values: one row per row of `features`, one column per class pair
+  /// (libsvm's pair order), rho subtracted; positive votes for the pair's first class.
+  /// @throws std::invalid_argument as predict().
+  Eigen::MatrixXf decisionValues(const Eigen::MatrixXf& features,
+                                 Instructions instructions = Instructions::kBest) const;
+
+  /// Whether kBest runs the AVX2 path on this CPU.
+  static bool vectorKernelAvailable();
 
  private:
+  /// The support vectors feature-major and padded to a multiple of 8 (the padding's
+  /// coefficients are 0), their squared norms and the coefficients pair-major: the layout of
+  /// the AVX2 path. Made by train() and load().
+  void prepareKernel();
+  int padded_count_ = 0;
+  std::vector<float> support_by_feature_;    // feature x padded support vectors
+  std::vector<float> support_norms_;         // padded support vectors
+  std::vector<float> coefficients_by_pair_;  // pair x padded support vectors
+
   std::vector<int> labels_;  // libsvm's class order
   std::map<int, std::string> names_;
   Eigen::VectorXf mean_;

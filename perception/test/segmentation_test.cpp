@@ -118,6 +118,51 @@ TEST(Svm, DensePredictionEqualsLibsvmsOwn) {
   EXPECT_GE(same, 498);  // single versus double precision may flip a point on a boundary
 }
 
+// The AVX2 path (kBest on a CPU with AVX2 and FMA) computes the same decisions as the portable
+// one to float rounding, for row and support-vector counts that are not multiples of its blocks
+// (4 rows, 8 support vectors) and every class pair.
+TEST(Svm, TheVectorPathGivesThePortableDecisions) {
+  if (!SvmClassifier::vectorKernelAvailable()) {
+    GTEST_SKIP() << "this CPU has no AVX2 and FMA: kBest is the portable path";
+  }
+  std::mt19937 random(11);
+  std::normal_distribution<float> noise(0.0f, 1.0f);
+  constexpr int kDims = 39;  // as the pipeline's features
+  Eigen::MatrixXf features(3 * 70, kDims);
+  std::vector<int> labels;
+  for (int label = 0; label < 3; ++label) {
+    for (int i = 0; i < 70; ++i) {
+      for (int d = 0; d < kDims; ++d) {
+        features(label * 70 + i, d) = noise(random) + (d % 3 == label ? 1.5f : 0.0f);
+      }
+      labels.push_back(label);
+    }
+  }
+  SvmTrainingOptions options;
+  options.folds = 0;
+  const SvmClassifier classifier = SvmClassifier::train(features, labels, kNames, options);
+  ASSERT_NE(classifier.supportVectorCount() % 8, 0) << "pick data whose support vectors leave a partial block";
+  for (const int rows : {1, 3, 4, 203}) {
+    Eigen::MatrixXf queries(rows, kDims);
+    for (int r = 0; r < rows; ++r) {
+      for (int d = 0; d < kDims; ++d) {
+        queries(r, d) = 1.3f * noise(random) + (d % 3 == r % 3 ? 1.0f : 0.0f);
+      }
+    }
+    const Eigen::MatrixXf best = classifier.decisionValues(queries, SvmClassifier::Instructions::kBest);
+    const Eigen::MatrixXf portable = classifier.decisionValues(queries, SvmClassifier::Instructions::kPortable);
+    ASSERT_EQ(best.rows(), rows);
+    ASSERT_EQ(best.cols(), 3);
+    for (int r = 0; r < rows; ++r) {
+      for (int p = 0; p < 3; ++p) {
+        EXPECT_NEAR(best(r, p), portable(r, p), 2e-5f * (1.0f + std::abs(portable(r, p)))) << r << ", " << p;
+      }
+    }
+    EXPECT_EQ(classifier.predict(queries, SvmClassifier::Instructions::kBest),
+              classifier.predict(queries, SvmClassifier::Instructions::kPortable));
+  }
+}
+
 TEST(Svm, SavesAndLoads) {
   Eigen::MatrixXf features;
   std::vector<int> labels;

@@ -259,12 +259,20 @@ INSTANTIATE_TEST_SUITE_P(Assembly, FixedAssemblyTrial,
                              // The third look missed the grey link put across the base node (its points partly
                              // labelled node pulled every start 1.5 cm along its length, and the depth check refused
                              // them): "put it on the link: no feasible place for node_1: 1 candidate, none feasible
-                             // (1 predicate false)". Now a link start the depth check nearly accepts is slid along its
-                             // length first (ClassPoseEstimator::verify). The soak's 14705 and 14915 were the same.
+                             // (1 predicate false)". Now a start of a link lying on another part that the depth check
+                             // nearly accepts is slid along its length first (ClassPoseEstimator::verify). The soak's
+                             // 14705 and 14915 were the same.
                              FixedTrial{"LinkAcrossTheBaseNodeSeenAtTheNextLook", "ur5-sim", 14121},
                              // The iiwa's joint 5 ended the link grasp 2e-7 rad beyond its limit, and every place on
                              // the base node was refused: "joint 5 of the start is 2.96706 rad, above its maximum".
-                             FixedTrial{"ThreeFingerIiwaMovesOnFromAJointLimit", "iiwa-3f-sim", 1835}),
+                             FixedTrial{"ThreeFingerIiwaMovesOnFromAJointLimit", "iiwa-3f-sim", 1835},
+                             // The link put across the base node side-on to the camera was found rolled 17 deg about
+                             // its length (the depth check passed it), so its top was "tilted" and nothing could be
+                             // put on it; now a detection nearly resting flat is levelled (levelResting).
+                             FixedTrial{"LinkAcrossTheBaseNodeFoundRolledIsLevelled", "iiwa-3f-sim", 2109},
+                             // Most of that link labelled node: its own 366 points fit no link, and the node's
+                             // detection left ~600 unexplained; now those are handed to the link cluster beside them.
+                             FixedTrial{"LinkAcrossTheBaseNodeMostlyLabelledNodeIsFound", "iiwa-3f-sim", 2138}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 /// Speed work on the camera and the physics must not change what happens in a trial. Seeds 1
@@ -283,7 +291,9 @@ INSTANTIATE_TEST_SUITE_P(Assembly, FixedAssemblyTrial,
 // to open only as far as the part needs (issue 12: 66 mm for a node, 41 mm for a link, instead
 // of 85 mm before each grasp and at each release): shorter finger strokes, 32.78 s and 33.05 s;
 // then with the calibration marker on the gripper and the calibration component in the cell
-// (issue 14): 32.86 s and 33.00 s.
+// (issue 14): 32.86 s and 33.00 s; then when detections nearly resting flat began to be levelled
+// (levelResting: the parts' tilts of a fraction of a degree are gone, and the grasps follow):
+// 32.84 s and 33.03 s (the SVM's AVX2 path and the leftover hand-over, alone, change nothing here).
 TEST(Trials, TheSameSeedsGiveTheSameAssemblyTrials) {
   TrialOptions options;
   options.plan = dataRoot() / "examples/ur5/assemble_structure.xml";
@@ -294,7 +304,7 @@ TEST(Trials, TheSameSeedsGiveTheSameAssemblyTrials) {
   options.jobs = 2;
   const Summary summary = runTrials(options);
   ASSERT_EQ(summary.trials.size(), 2u);
-  const double recorded[] = {32.86, 33.00};
+  const double recorded[] = {32.84, 33.03};
   for (std::size_t i = 0; i < 2; ++i) {
     const TrialResult& trial = summary.trials[i];
     EXPECT_TRUE(trial.success) << "seed " << trial.seed << ": " << trial.failure_path << ": " << trial.reason;
