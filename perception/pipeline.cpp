@@ -18,6 +18,10 @@ namespace {
 constexpr std::size_t kHandOverPoints = 150;
 constexpr double kHandOverTouch = 0.01;
 constexpr std::uint32_t kHandOverTask = 1000;
+/// Leftover points with no such cluster beside them: at least this many, their lowest (5th
+/// percentile) this far above the table (m), are searched as a cluster of each other class.
+constexpr std::size_t kHandOverAlonePoints = 400;
+constexpr double kHandOverRaised = 0.015;
 }  // namespace
 
 namespace {
@@ -240,6 +244,7 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
   {
     const double touch = kHandOverTouch * kHandOverTouch;
     const std::size_t task_count = tasks.size();
+    std::vector<Task> added;
     for (std::size_t a = 0; a < task_count; ++a) {
       const std::vector<int> leftover = workers_->estimators[0][tasks[a].model]->unexplainedPoints(
           class_points[tasks[a].model], tasks[a].cluster, tasks[a].found);
@@ -247,6 +252,7 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
         continue;
       }
       const Cloud& from = class_points[tasks[a].model];
+      bool handed = false;
       for (std::size_t b = 0; b < task_count; ++b) {
         Task& other = tasks[b];
         if (other.model == tasks[a].model || !other.found.empty()) {
@@ -275,7 +281,44 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
         StdoutSilence silence;  // ObjRecRANSAC prints its progress
         other.found = workers_->estimators[0][other.model]->estimateCluster(joined, cluster, reference,
                                                                             other.index + kHandOverTask, &other.timing);
+        handed = true;
       }
+      // No such cluster beside them: a whole part lying on another may have been labelled the
+      // other's class. Many leftover points, all well above the table, are searched as a cluster
+      // of each other class.
+      if (handed || leftover.size() < kHandOverAlonePoints) {
+        continue;
+      }
+      std::vector<double> heights;
+      heights.reserve(leftover.size());
+      for (const int i : leftover) {
+        heights.push_back(workspace.plane.height(from.points[static_cast<std::size_t>(i)]));
+      }
+      const auto low = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 20);
+      std::nth_element(heights.begin(), low, heights.end());
+      if (*low < kHandOverRaised) {
+        continue;
+      }
+      Cloud alone;
+      std::vector<int> cluster;
+      for (const int i : leftover) {
+        cluster.push_back(static_cast<int>(alone.size()));
+        alone.append(from, static_cast<std::size_t>(i));
+      }
+      for (std::size_t m = 0; m < models_.size(); ++m) {
+        if (m == tasks[a].model) {
+          continue;
+        }
+        Task task{m, tasks[a].index + 2 * kHandOverTask, {}, {}, {}};
+        StdoutSilence silence;  // ObjRecRANSAC prints its progress
+        task.found = workers_->estimators[0][m]->estimateCluster(alone, cluster, reference, task.index, &task.timing);
+        if (!task.found.empty()) {
+          added.push_back(std::move(task));
+        }
+      }
+    }
+    for (Task& task : added) {
+      tasks.push_back(std::move(task));
     }
   }
   std::vector<Detection> found;
