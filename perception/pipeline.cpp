@@ -12,19 +12,25 @@
 namespace costar::perception {
 
 namespace {
+
 /// Leftover points of a class's cluster handed to a neighbouring cluster of another class: at
 /// least this many, within this distance (m) of it. The task number that seeds its search is
 /// offset by kHandOverTask.
 constexpr std::size_t kHandOverPoints = 150;
 constexpr double kHandOverTouch = 0.01;
 constexpr std::uint32_t kHandOverTask = 1000;
-/// Leftover points with no such cluster beside them: at least this many, their lowest (5th
-/// percentile) this far above the table (m), are searched as a cluster of each other class.
+/// Leftover points with no such cluster beside them: at least this many, their lowest resting
+/// on another part (lowHeight() above kRaisedSupport), are searched as a cluster of each other
+/// class.
 constexpr std::size_t kHandOverAlonePoints = 400;
-constexpr double kHandOverRaised = 0.015;
-}  // namespace
 
-namespace {
+/// Appends `indices` of `from` to `into` and their new indices to `cluster`.
+void gather(const Cloud& from, const std::vector<int>& indices, Cloud& into, std::vector<int>& cluster) {
+  for (const int i : indices) {
+    cluster.push_back(static_cast<int>(into.size()));
+    into.append(from, static_cast<std::size_t>(i));
+  }
+}
 
 double since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -270,14 +276,8 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
         }
         Cloud joined;
         std::vector<int> cluster;
-        for (const int j : other.cluster) {
-          cluster.push_back(static_cast<int>(joined.size()));
-          joined.append(own, static_cast<std::size_t>(j));
-        }
-        for (const int i : leftover) {
-          cluster.push_back(static_cast<int>(joined.size()));
-          joined.append(from, static_cast<std::size_t>(i));
-        }
+        gather(own, other.cluster, joined, cluster);
+        gather(from, leftover, joined, cluster);
         StdoutSilence silence;  // ObjRecRANSAC prints its progress
         other.found = workers_->estimators[0][other.model]->estimateCluster(joined, cluster, reference,
                                                                             other.index + kHandOverTask, &other.timing);
@@ -286,25 +286,13 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
       // No such cluster beside them: a whole part lying on another may have been labelled the
       // other's class. Many leftover points, all well above the table, are searched as a cluster
       // of each other class.
-      if (handed || leftover.size() < kHandOverAlonePoints) {
-        continue;
-      }
-      std::vector<double> heights;
-      heights.reserve(leftover.size());
-      for (const int i : leftover) {
-        heights.push_back(workspace.plane.height(from.points[static_cast<std::size_t>(i)]));
-      }
-      const auto low = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 20);
-      std::nth_element(heights.begin(), low, heights.end());
-      if (*low < kHandOverRaised) {
+      if (handed || leftover.size() < kHandOverAlonePoints ||
+          lowHeight(from, leftover, workspace.plane) < kRaisedSupport) {
         continue;
       }
       Cloud alone;
       std::vector<int> cluster;
-      for (const int i : leftover) {
-        cluster.push_back(static_cast<int>(alone.size()));
-        alone.append(from, static_cast<std::size_t>(i));
-      }
+      gather(from, leftover, alone, cluster);
       for (std::size_t m = 0; m < models_.size(); ++m) {
         if (m == tasks[a].model) {
           continue;

@@ -576,10 +576,19 @@ std::vector<world::Pose> ClassPoseEstimator::principalAxisSeeds(const Cloud& clo
   return seeds;
 }
 
-namespace {
-/// m: points whose lowest lie this far above the table may rest on another part.
-constexpr double kRaisedSupport = 0.015;
-}  // namespace
+double lowHeight(const Cloud& points, const std::vector<int>& indices, const TablePlane& support) {
+  if (indices.empty()) {
+    return 0.0;
+  }
+  std::vector<double> heights;
+  heights.reserve(indices.size());
+  for (const int i : indices) {
+    heights.push_back(support.height(points.points[static_cast<std::size_t>(i)]));
+  }
+  const auto low = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 20);
+  std::nth_element(heights.begin(), low, heights.end());
+  return *low;
+}
 
 bool ClassPoseEstimator::raised(const world::Pose& pose) const {
   if (!support_plane_) {
@@ -661,15 +670,8 @@ RestingStarts restingStarts(const Cloud& cloud, const std::vector<int>& indices,
   // What it rests on: the table, and, when even its lowest points are well above the table (a
   // link on a node), a level under those points as well (their 5th percentile height).
   std::vector<double> levels{0.0};
-  std::vector<double> heights;
-  heights.reserve(indices.size());
-  for (const int i : indices) {
-    heights.push_back(support.height(cloud.points[static_cast<std::size_t>(i)]));
-  }
-  const auto low = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 20);
-  std::nth_element(heights.begin(), low, heights.end());
-  if (*low > kRaisedSupport) {
-    levels.push_back(*low);
+  if (const double low = lowHeight(cloud, indices, support); low > kRaisedSupport) {
+    levels.push_back(low);
   }
   constexpr double kStep = 15.0 * M_PI / 180.0;
   const auto addStarts = [&](const Eigen::Vector3d& on_plane, std::vector<world::Pose>& seeds) {

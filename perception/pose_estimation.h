@@ -117,6 +117,13 @@ DepthAgreement compareWithDepth(const ObjectModel& model, const world::Pose& pos
 double overlapFraction(const ObjectModel& a, const world::Pose& pose_a, const ObjectModel& b, const world::Pose& pose_b,
                        double margin = 0.001);
 
+/// m: points whose lowest lie this far above the table may rest on another part.
+inline constexpr double kRaisedSupport = 0.015;
+
+/// How high the lowest of `indices` of `points` lie above `support`: their 5th percentile
+/// height (m); 0 for no points.
+double lowHeight(const Cloud& points, const std::vector<int>& indices, const TablePlane& support);
+
 /// Start poses (in the optical frame, the camera at the origin) of an object of
 /// `object_class` resting upright on `support` under `indices` of `points`: its z along the
 /// plane's normal, its bottom on the plane under the points (pushed back from the camera by a

@@ -301,9 +301,9 @@ Eigen::MatrixXf SvmClassifier::decisionValues(const Eigen::MatrixXf& features, I
   // Standardized, row-major: each row's features contiguous for the vector path.
   using RowMajor = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   const RowMajor x = (features.rowwise() - mean_.transpose()).array().rowwise() / scale_.transpose().array();
-  const Eigen::VectorXf x_norms = x.rowwise().squaredNorm();
   Eigen::MatrixXf decisions(n, pairs);
   if (instructions == Instructions::kBest && vectorKernelAvailable() && padded_count_ > 0 && pairs <= kMaxVectorPairs) {
+    const Eigen::VectorXf x_norms = x.rowwise().squaredNorm();
     RowMajor sums(n, pairs);
     rbfDecisionsAvx2(x.data(), x_norms.data(), static_cast<int>(n), static_cast<int>(x.cols()),
                      support_by_feature_.data(), support_norms_.data(), coefficients_by_pair_.data(), padded_count_,
