@@ -9,9 +9,11 @@
 #   3. pictures: the scene (out/assembly_scene.png) and what DetectObjects finds in it
 #      (out/assembly_detections.png).
 # Extra arguments go to the single run (e.g. --seed 7).
+# It builds only the two executables (and the models and cell descriptions they read); the tests
+# and benchmarks are built by scripts/test.sh.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh
+bash scripts/setup.sh costar costar-robot
 BUILD_DIR="${COSTAR_BUILD_DIR:-build}"
 COSTAR="$BUILD_DIR/cli/costar"
 TRIALS="${COSTAR_TRIALS:-10}"

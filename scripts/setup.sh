@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs every Debian package costar needs (idempotent) and builds it with ccache.
-#   bash scripts/setup.sh            # install + configure + build into build/
+#   bash scripts/setup.sh                      # install + configure + build everything into build/
+#   bash scripts/setup.sh costar costar-robot  # ... build only these targets (and what they need)
 #   COSTAR_BUILD_DIR=out bash scripts/setup.sh
 # Safe to run again: installs only what is missing, rebuilds only what changed.
 set -euo pipefail
@@ -53,6 +54,11 @@ echo "setup: configuring $BUILD_DIR (Release, ccache)"
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache \
   -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
-echo "setup: building with $JOBS job(s)"
-cmake --build "$BUILD_DIR" -j "$JOBS"
+if [[ $# -gt 0 ]]; then
+  echo "setup: building $* with $JOBS job(s)"
+  cmake --build "$BUILD_DIR" -j "$JOBS" --target "$@"
+else
+  echo "setup: building everything with $JOBS job(s)"
+  cmake --build "$BUILD_DIR" -j "$JOBS"
+fi
 echo "setup: done; the costar executable is $BUILD_DIR/cli/costar"
