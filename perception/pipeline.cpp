@@ -231,7 +231,6 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
     }
   };
   {
-    StdoutSilence silence;  // ObjRecRANSAC prints its progress
     const std::size_t threads =
         std::min<std::size_t>(workers_->estimators.size(), std::max<std::size_t>(1, tasks.size()));
     std::vector<std::thread> helpers;
@@ -278,7 +277,6 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
         std::vector<int> cluster;
         gather(own, other.cluster, joined, cluster);
         gather(from, leftover, joined, cluster);
-        StdoutSilence silence;  // ObjRecRANSAC prints its progress
         other.found = workers_->estimators[0][other.model]->estimateCluster(joined, cluster, reference,
                                                                             other.index + kHandOverTask, &other.timing);
         handed = true;
@@ -298,7 +296,6 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
           continue;
         }
         Task task{m, tasks[a].index + 2 * kHandOverTask, {}, {}, {}};
-        StdoutSilence silence;  // ObjRecRANSAC prints its progress
         task.found = workers_->estimators[0][m]->estimateCluster(alone, cluster, reference, task.index, &task.timing);
         if (!task.found.empty()) {
           added.push_back(std::move(task));

@@ -4,6 +4,10 @@
 // refined by point-to-plane ICP onto the class model and scored against the organized depth
 // image; hypotheses below a confidence threshold are dropped.
 //
+// One job a file: seeded_obj_rec_ransac (the hypotheses), icp (refinement), depth_check
+// (scoring), pose_seeds (starts besides ObjRecRANSAC's), class_pose_estimator (this class: the
+// search per cluster), touching_parts (parts of a class against each other), merge_detections.
+//
 // All poses here are object frame -> camera OPTICAL frame (x right, y down, z forward): that
 // is the frame ObjRecRANSAC needs its scene in (it projects the scene along z).
 
@@ -15,7 +19,10 @@
 
 #include "camera/rgbd.h"
 #include "perception/cloud.h"
+#include "perception/depth_check.h"
+#include "perception/icp.h"
 #include "perception/object_model.h"
+#include "perception/pose_seeds.h"
 #include "perception/workspace.h"
 #include "world/pose.h"
 
@@ -76,72 +83,6 @@ struct Detection {
   std::optional<Eigen::Vector3f> color;
 };
 
-/// Result of refining a pose.
-struct IcpResult {
-  world::Pose pose = world::Pose::Identity();
-  int inliers = 0;
-  double rms = 0.0;
-  int iterations = 0;
-};
-
-/// Point-to-plane ICP of `scene` (points in the camera frame) onto the model's surface,
-/// starting from `initial` (object -> camera). Correspondences come from the model's grid of
-/// nearest surface samples; the gate shrinks from `initial_distance` to `final_distance` (m)
-/// and residuals are Huber-weighted. `point_to_point_weight` > 0 adds that much of a
-/// point-to-point term (pulls an object that slid along a face back over its points).
-IcpResult refinePose(const ObjectModel& model, const std::vector<Eigen::Vector3f>& scene, const world::Pose& initial,
-                     int iterations, double initial_distance, double final_distance,
-                     double point_to_point_weight = 0.0);
-
-/// Render-and-compare: of the model surface samples that face the camera under `pose`
-/// (object -> optical frame) and project into `frame`, how many the organized depth confirms
-/// (within `tolerance`), contradicts (the camera sees farther), or cannot judge (something is
-/// in front: occluded, or no reading).
-struct DepthAgreement {
-  int facing = 0;
-  int confirmed = 0;
-  int contradicted = 0;
-  double agreement() const {
-    return confirmed + contradicted == 0 ? 0.0 : double(confirmed) / (confirmed + contradicted);
-  }
-  double visibleFraction() const { return facing == 0 ? 0.0 : double(confirmed) / facing; }
-};
-/// `stride` > 1 checks every stride-th sample only (a quick score). A sample confirmed on a
-/// `claimed` pixel (one per pixel of `frame`, non-zero: another detection's surface) counts
-/// as contradicted instead: the two objects would overlap.
-DepthAgreement compareWithDepth(const ObjectModel& model, const world::Pose& pose, const camera::RgbdFrame& frame,
-                                double tolerance, int stride = 1, const std::vector<std::uint8_t>* claimed = nullptr);
-
-/// Fraction of `a`'s interior samples (under pose_a) that lie inside `b`'s boxes (under pose_b)
-/// shrunk by `margin` (m): how much of a's volume b claims too.
-double overlapFraction(const ObjectModel& a, const world::Pose& pose_a, const ObjectModel& b, const world::Pose& pose_b,
-                       double margin = 0.001);
-
-/// m: points whose lowest lie this far above the table may rest on another part.
-inline constexpr double kRaisedSupport = 0.015;
-
-/// How high the lowest of `indices` of `points` lie above `support`: their 5th percentile
-/// height (m); 0 for no points.
-double lowHeight(const Cloud& points, const std::vector<int>& indices, const TablePlane& support);
-
-/// Start poses (in the optical frame, the camera at the origin) of an object of
-/// `object_class` resting upright on `support` under `indices` of `points`: its z along the
-/// plane's normal, its bottom on the plane under the points (pushed back from the camera by a
-/// quarter of its width: the seen faces are its top and the side facing the camera), turned
-/// about the normal in 15° steps from the points' main horizontal axis (12 poses: 0..165°).
-/// When the points' lowest (their 5th percentile) lie more than 1.5 cm above the plane, 12 more
-/// with its bottom at that height: resting on another part (a link on a node).
-/// Empty for fewer than 10 points.
-std::vector<world::Pose> restingSeeds(const Cloud& points, const std::vector<int>& indices, const TablePlane& support,
-                                      const world::ObjectClass& object_class);
-
-/// The same poses at both ends of the points instead of under their middle, when the points
-/// spread along their main horizontal axis over more than one and a half times the object's
-/// length (touching parts of a class, whose middle lies between them): half an object in from
-/// the points' extremes (2nd and 98th percentiles); 24 poses (48 raised), else none.
-std::vector<world::Pose> restingSeedsAtEnds(const Cloud& points, const std::vector<int>& indices,
-                                            const TablePlane& support, const world::ObjectClass& object_class);
-
 /// ObjRecRANSAC loaded with one class's model. Building it hashes the model's point pairs
 /// (milliseconds). One instance must not be used by two threads at once; distinct instances
 /// may run in parallel.
@@ -177,8 +118,8 @@ class ClassPoseEstimator {
   /// Finds the instances of the class in one cluster of `points` (optical frame, with normals
   /// towards the camera and pixel indices), refining each with the class's points nearby and
   /// checking it against the organized `frame` it came from. `task` seeds the sampling
-  /// (deterministic for the same input and task). ObjRecRANSAC writes to stdout: callers
-  /// silence it (StdoutSilence). Adds its time to `timing` when given.
+  /// (deterministic for the same input and task); nothing is printed. Adds its time to
+  /// `timing` when given.
   std::vector<Detection> estimateCluster(const Cloud& points, const std::vector<int>& cluster,
                                          const camera::RgbdFrame& frame, std::uint32_t task, Timing* timing = nullptr);
 
@@ -206,8 +147,9 @@ class ClassPoseEstimator {
 
  private:
   static double meanSupport(const std::vector<Detection>& detections);
-  /// Start poses from the principal axes of `indices` of `points` (see estimateCluster).
-  std::vector<world::Pose> principalAxisSeeds(const Cloud& points, const std::vector<int>& indices) const;
+  /// An axis of a model's box at least 1.5 times its shortest is long: point-to-plane ICP
+  /// cannot tell where along it the object lies (slideAlongLongAxes).
+  static bool isLongAxis(const Eigen::Vector3d& size, int axis);
 
   /// For an elongated model: the shift along its long axes (up to 24 mm) that the depth image
   /// agrees with best, if better than `pose`; nullopt otherwise. With `claimed` pixels (see
@@ -250,17 +192,7 @@ class ClassPoseEstimator {
 /// dropped when more than a fifth of its volume lies in a better one. `models` must hold every
 /// detection's class.
 std::vector<Detection> mergeDetections(std::vector<Detection> detections, const std::vector<ObjectModel>& models);
-
-/// While alive, the process's stdout (file descriptor 1) goes to /dev/null: PCL's ObjRecRANSAC
-/// prints its progress unconditionally (the installed library is built verbose). Nested and
-/// concurrent scopes share one redirection. Anything another thread prints to stdout
-/// meanwhile is lost too, so keep the scope short.
-class StdoutSilence {
- public:
-  StdoutSilence();
-  ~StdoutSilence();
-  StdoutSilence(const StdoutSilence&) = delete;
-  StdoutSilence& operator=(const StdoutSilence&) = delete;
-};
+/// The same for detections of one class, of `model`.
+std::vector<Detection> mergeDetections(std::vector<Detection> detections, const ObjectModel& model);
 
 }  // namespace costar::perception
