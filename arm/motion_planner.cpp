@@ -99,8 +99,8 @@ std::vector<JointVector> MotionPlanner::solutions(const world::Pose& tcp_in_worl
   return std::vector<JointVector>(found.begin(), found.end());
 }
 
-std::optional<planning::Contact> MotionPlanner::collision(const JointVector& q, const AllowedContacts& allowed) const {
-  return collisions_.check(q.eigen(), allowed);
+std::optional<planning::Contact> MotionPlanner::collision(const JointVector& q, const QueryScene& scene) const {
+  return collisions_.check(q.eigen(), scene);
 }
 
 MotionPlan MotionPlanner::timed(std::vector<JointVector> path, double speed) const {
@@ -124,7 +124,7 @@ MotionPlan MotionPlanner::timed(std::vector<JointVector> path, double speed) con
 }
 
 MotionPlan MotionPlanner::planToJoints(const JointVector& from, const JointVector& goal, double speed,
-                                       const AllowedContacts& allowed) const {
+                                       const QueryScene& scene) const {
   const JointLimits& limits = kinematics_->limits();
   if (goal.size() != limits.size() || from.size() != limits.size()) {
     return MotionPlan::failed(goal, "the goal has " + std::to_string(goal.size()) + " joints and the start " +
@@ -136,7 +136,7 @@ MotionPlan MotionPlanner::planToJoints(const JointVector& from, const JointVecto
       return MotionPlan::failed(goal, "joint " + std::to_string(j + 1) + " would leave its limits");
     }
   }
-  const planning::PlanResult path = planning::planPath(collisions_, start.eigen(), goal.eigen(), planner_, allowed);
+  const planning::PlanResult path = planning::planPath(collisions_, start.eigen(), goal.eigen(), planner_, scene);
   if (!path.ok()) {
     return MotionPlan::failed(goal, path.failure);
   }
@@ -148,7 +148,7 @@ MotionPlan MotionPlanner::planToJoints(const JointVector& from, const JointVecto
 }
 
 MotionPlan MotionPlanner::planToPose(const JointVector& from, const world::Pose& tcp_in_world, double speed,
-                                     const AllowedContacts& allowed) const {
+                                     const QueryScene& scene) const {
   const std::vector<JointVector> candidates = solutions(tcp_in_world, from);
   if (candidates.empty()) {
     return MotionPlan::failed(from,
@@ -156,13 +156,13 @@ MotionPlan MotionPlanner::planToPose(const JointVector& from, const world::Pose&
   }
   std::string first_problem;
   for (const JointVector& goal : candidates) {
-    if (const auto contact = collision(goal, allowed)) {
+    if (const auto contact = collision(goal, scene)) {
       if (first_problem.empty()) {
         first_problem = "at the goal, " + contact->str();
       }
       continue;
     }
-    MotionPlan plan = planToJoints(from, goal, speed, allowed);
+    MotionPlan plan = planToJoints(from, goal, speed, scene);
     if (plan.ok()) {
       return plan;
     }
@@ -175,7 +175,7 @@ MotionPlan MotionPlanner::planToPose(const JointVector& from, const world::Pose&
 }
 
 MotionPlan MotionPlanner::planLine(const JointVector& from, const world::Pose& target, double speed,
-                                   const AllowedContacts& allowed) const {
+                                   const QueryScene& scene) const {
   const JointVector current = from.size() == kinematics_->limits().size()
                                   ? atLimitsWithin(from, kinematics_->limits(), kStartBeyondLimitTolerance)
                                   : from;
@@ -203,8 +203,9 @@ MotionPlan MotionPlanner::planLine(const JointVector& from, const world::Pose& t
     }
     path.push_back(options.front());
   }
+  planning::CollisionWorld::Query query = collisions_.query(scene);
   for (std::size_t i = 1; i < path.size(); ++i) {
-    if (const auto contact = collisions_.checkSegment(path[i - 1].eigen(), path[i].eigen(), allowed)) {
+    if (const auto contact = query.checkSegment(path[i - 1].eigen(), path[i].eigen())) {
       return MotionPlan::failed(current, "the straight line is blocked: " + contact->str());
     }
   }

@@ -43,13 +43,13 @@ class MotionPlanner final : public MotionService {
   world::Pose endpoint() const override { return toolAt(joints()); }
   world::Pose toolAt(const JointVector& q) const override;
   std::vector<JointVector> solutions(const world::Pose& tcp_in_world, const JointVector& seed) const override;
-  std::optional<planning::Contact> collision(const JointVector& q, const AllowedContacts& allowed) const override;
+  std::optional<planning::Contact> collision(const JointVector& q, const QueryScene& scene) const override;
   MotionPlan planToJoints(const JointVector& from, const JointVector& goal, double speed,
-                          const AllowedContacts& allowed = {}) const override;
+                          const QueryScene& scene = {}) const override;
   MotionPlan planLine(const JointVector& from, const world::Pose& tcp_in_world, double speed,
-                      const AllowedContacts& allowed = {}) const override;
+                      const QueryScene& scene = {}) const override;
   MotionPlan planToPose(const JointVector& from, const world::Pose& tcp_in_world, double speed,
-                        const AllowedContacts& allowed = {}) const override;
+                        const QueryScene& scene = {}) const override;
 
   /// A path of joint waypoints timed at `speed`: a point-to-point motion for two, a blended
   /// path through more. Fails (with the reason) for fewer than two or a path the limits refuse.

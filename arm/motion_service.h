@@ -1,8 +1,11 @@
 #pragma once
-// What other components ask about an arm's motion (SmartMove, ...): where the arm is, the
-// inverse kinematics within the joint limits, collision queries and motion plans. Every query
-// is given the contacts it allows (the fingers may touch the part being grasped); nothing is
-// toggled in a shared collision world around a query.
+// What other components ask about an arm's motion (SmartMove, Calibrate, ...): where the arm
+// is, the inverse kinematics within the joint limits, collision queries and motion plans. Every
+// query carries its scene (planning::QueryScene): the contacts it allows (the fingers may touch
+// the part being grasped), the gripper's fingers as the motion will have them, obstacles only
+// it has (a keep-out box) or leaves out (the part held); nothing is toggled in a shared
+// collision world around a query. Every query is const and takes all it needs as arguments,
+// so a service in another process could answer it, and the cell's own answers several at once.
 //
 // The workcell builds the service (arm/motion_planner.h: the arm's kinematics and the cell's
 // collision world) and hands it to the components that need it. They move the arm through its
@@ -44,6 +47,7 @@ struct MotionPlan {
 };
 
 using planning::AllowedContacts;
+using planning::QueryScene;
 
 /// The arm's operation that follows a planned path (for other components; no node type).
 inline constexpr std::string_view kFollowJointPath = "FollowJointPath";
@@ -71,29 +75,29 @@ class MotionService {
   /// Every IK solution for a TCP pose in the world within the joint limits, each expressed
   /// nearest to `seed`, nearest first (not checked for collisions: see collision()).
   virtual std::vector<JointVector> solutions(const world::Pose& tcp_in_world, const JointVector& seed) const = 0;
-  /// What the arm would touch at `q` that neither the cell nor `allowed` allows, or nullopt.
-  virtual std::optional<planning::Contact> collision(const JointVector& q, const AllowedContacts& allowed) const = 0;
+  /// What the arm would touch at `q` in the cell as `scene` changes it, or nullopt.
+  virtual std::optional<planning::Contact> collision(const JointVector& q, const QueryScene& scene) const = 0;
 
   /// A collision-free joint-space motion from `from` to `goal` (straight when it is free, else
   /// planned around), timed at `speed` (a fraction of the joint speed and acceleration limits).
   /// A `from` (here and in planLine) a hair beyond a joint limit, as an arm sent to the limit
   /// reads, starts on the limit; further beyond it the plan fails naming the joint.
   virtual MotionPlan planToJoints(const JointVector& from, const JointVector& goal, double speed,
-                                  const AllowedContacts& allowed = {}) const = 0;
+                                  const QueryScene& scene = {}) const = 0;
   /// A straight Cartesian line of the TCP from the pose at `from` to `tcp_in_world`.
   virtual MotionPlan planLine(const JointVector& from, const world::Pose& tcp_in_world, double speed,
-                              const AllowedContacts& allowed = {}) const = 0;
+                              const QueryScene& scene = {}) const = 0;
   /// A collision-free motion from `from` to the TCP pose: the first IK solution (nearest
   /// `from`) that is free and reachable.
   virtual MotionPlan planToPose(const JointVector& from, const world::Pose& tcp_in_world, double speed,
-                                const AllowedContacts& allowed = {}) const = 0;
+                                const QueryScene& scene = {}) const = 0;
 
   /// The first of `candidates` free of collisions, or nullopt with the first contact found in
   /// `reason` (left as it is when there is no candidate).
-  std::optional<JointVector> firstFree(const std::vector<JointVector>& candidates, const AllowedContacts& allowed,
+  std::optional<JointVector> firstFree(const std::vector<JointVector>& candidates, const QueryScene& scene,
                                        std::string& reason) const {
     for (const JointVector& q : candidates) {
-      const auto contact = collision(q, allowed);
+      const auto contact = collision(q, scene);
       if (!contact) {
         return q;
       }

@@ -49,12 +49,12 @@ class CalibrationRun final : public component::RunningOperation {
         method_(method),
         speed_(speed),
         started_(component.clock_.now()),
-        start_joints_(component.arm_.joints()) {
+        start_joints_(component.motion_.joints()) {
     if (const auto& area = component.config_.keep_out) {
-      // The parts' area is an obstacle for every plan from here until the run ends.
-      c_.collisions_.setBox(kKeepOutObstacle, world::Pose(Eigen::Translation3d(area->center())), area->sizes());
+      // The parts' area is an obstacle of every plan of this run.
+      scene_.obstacles.push_back({kKeepOutObstacle, world::Pose(Eigen::Translation3d(area->center())), area->sizes()});
       keeping_out_ = true;
-      if (const auto contact = c_.collisions_.check(start_joints_.eigen());
+      if (const auto contact = c_.motion_.collision(start_joints_, scene_);
           contact && contact->other == kKeepOutObstacle) {
         release();
         done_ = OperationResult::failure(
@@ -130,14 +130,16 @@ class CalibrationRun final : public component::RunningOperation {
  private:
   std::string operation() const { return marker_stage_ ? "CalibrateMarker" : "Calibrate"; }
 
-  /// The run is over: the keep-out leaves the collision world, another calibration may start.
+  /// The run is over: another calibration may start.
   void release() {
-    if (keeping_out_) {
-      c_.collisions_.remove(kKeepOutObstacle);
-      keeping_out_ = false;
-    }
     std::lock_guard lock(c_.mutex_);
     c_.running_ = false;
+  }
+
+  /// Runs a plan with the arm's FollowJointPath (called `what` in messages).
+  std::unique_ptr<component::RunningOperation> follow(const arm::MotionPlan& plan, const std::string& what) {
+    return std::make_unique<component::DelegatedOperation>(c_.arm_, std::string(arm::kFollowJointPath),
+                                                           arm::followParams(plan, what));
   }
 
   /// The next candidate the camera would see (by the current estimate) and the arm can reach
@@ -147,7 +149,7 @@ class CalibrationRun final : public component::RunningOperation {
   void startNextMotion() {
     const CalibrationConfig& config = c_.config_;
     const camera::Intrinsics& intrinsics = c_.camera_.intrinsics();
-    const world::Pose tcp_in_flange = c_.arm_.config().tcp_in_flange;
+    const world::Pose& tcp_in_flange = config.tcp_in_flange;
     while (next_ < candidates_.size()) {
       const world::Pose candidate = candidates_[next_++];
       bool counted = false;
@@ -165,14 +167,14 @@ class CalibrationRun final : public component::RunningOperation {
           counted = true;
         }
         const world::Pose tcp = marker * marker_in_flange_.inverse() * tcp_in_flange;
-        arm::MotionPlan plan = c_.arm_.planToPose(tcp, speed_);
+        const arm::MotionPlan plan = c_.motion_.planToPose(c_.motion_.joints(), tcp, speed_, scene_);
         if (!plan.ok()) {
           continue;
         }
         if (lift > 0.0) {
           ++lifted_;
         }
-        motion_ = c_.arm_.execute(std::move(plan), operation() + " view " + std::to_string(tried_));
+        motion_ = follow(plan, operation() + " view " + std::to_string(tried_));
         return;
       }
       if (counted) {
@@ -184,7 +186,7 @@ class CalibrationRun final : public component::RunningOperation {
   /// Takes a frame at rest and finds the marker in it.
   void takeView() {
     const camera::RgbdFrame frame = c_.camera_.capture();
-    const world::Pose flange = c_.arm_.endpoint() * c_.arm_.config().tcp_in_flange.inverse();
+    const world::Pose flange = c_.motion_.endpoint() * c_.config_.tcp_in_flange.inverse();
     for (const auto& detection :
          perception::detectArucoMarkers(frame.rgb, frame.intrinsics, c_.config_.solve.marker_size)) {
       if (detection.id != c_.config_.marker_id || detection.corners.size() != 4) {
@@ -291,11 +293,11 @@ class CalibrationRun final : public component::RunningOperation {
   /// Back to where the arm started.
   OperationResult goBack() {
     returning_ = true;
-    arm::MotionPlan plan = c_.arm_.planToJoints(start_joints_, speed_);
+    const arm::MotionPlan plan = c_.motion_.planToJoints(c_.motion_.joints(), start_joints_, speed_, scene_);
     if (!plan.ok()) {
       return finish();  // already there, or no way back: the result stands either way
     }
-    motion_ = c_.arm_.execute(std::move(plan), operation() + ": back to the start");
+    motion_ = follow(plan, operation() + ": back to the start");
     return OperationResult::running();
   }
 
@@ -329,17 +331,19 @@ class CalibrationRun final : public component::RunningOperation {
   std::unique_ptr<component::RunningOperation> motion_;
   std::optional<TimePoint> settle_until_;
   bool returning_ = false;
+  /// What every motion query of the run sees besides the cell: the keep-out, if any.
+  arm::QueryScene scene_;
   bool keeping_out_ = false;
   OperationResult result_;
   std::optional<OperationResult> done_;
 };
 
-CalibrationComponent::CalibrationComponent(arm::ArmComponent& arm, planning::CollisionWorld& collisions,
+CalibrationComponent::CalibrationComponent(const arm::MotionService& motion, component::Component& arm,
                                            camera::RgbdCamera& camera, const Clock& clock,
                                            const world::Pose& drawn_camera_pose, CellCalibration initial,
                                            CalibrationConfig config)
-    : arm_(arm),
-      collisions_(collisions),
+    : motion_(motion),
+      arm_(arm),
       camera_(camera),
       clock_(clock),
       drawn_camera_pose_(drawn_camera_pose),

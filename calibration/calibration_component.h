@@ -14,12 +14,14 @@
 // Both move the arm back to where it started, save the result with the cell, and keep the
 // previous calibration when anything is wrong (marker not seen, too few or too similar views,
 // a degenerate solution, residuals too large), failing with the reason.
-// While either runs, the table's part area (CalibrationConfig::keep_out, from the workcell's
-// description) is an obstacle in the arm's collision world: the camera is not calibrated yet,
-// so no part seen can be trusted, and the arm, gripper and marker stay out of everywhere a
-// part may lie. Every view pose and every motion between views (and back) is planned and
-// checked against it by the arm's own planning; a view that would enter it is tried higher
-// (CalibrationConfig::lift_step), or left out.
+// The table's part area (CalibrationConfig::keep_out, from the workcell's description) is an
+// obstacle of every motion a calibration plans: the camera is not calibrated yet, so no part
+// seen can be trusted, and the arm, gripper and marker stay out of everywhere a part may lie.
+// Every view pose and every motion between views (and back) is planned and checked against it
+// by the cell's motion service (arm/motion_service.h), the keep-out in the query's scene (no
+// other query sees it); a view that would enter it is tried higher
+// (CalibrationConfig::lift_step), or left out. The arm moves by its FollowJointPath operation,
+// as SmartMove moves it, so the calibration needs neither the arm's class nor its process.
 // Symbols: `camera` (the RGB-D camera's optical frame in the world, as calibrated).
 // Predicate: camera_calibrated (the camera's pose comes from a Calibrate, not the drawings).
 
@@ -29,13 +31,12 @@
 #include <optional>
 #include <string>
 
-#include "arm/arm_component.h"
+#include "arm/motion_service.h"
 #include "calibration/calibration_file.h"
 #include "calibration/hand_eye.h"
 #include "camera/rgbd.h"
 #include "component/operation_table.h"
 #include "core/clock.h"
-#include "planning/collision_world.h"
 
 namespace costar::calibration {
 
@@ -46,6 +47,8 @@ struct CalibrationConfig {
   /// Where the marker roughly is on the flange (the drawings): aims the views before the
   /// marker is calibrated; never used as a result.
   world::Pose marker_in_flange_guess = world::Pose::Identity();
+  /// The tool centre point (the motion service's poses) in the flange's frame.
+  world::Pose tcp_in_flange = world::Pose::Identity();
   /// Where the marker's centre may be put, in the world (in front of the camera, above the
   /// table and the parts).
   Eigen::Vector3d region_min{0.35, -0.25, 0.18};
@@ -84,17 +87,16 @@ struct CalibrationConfig {
   double lift_step = 0.03;
 };
 
-/// The name of the keep-out obstacle in the collision world while a calibration runs.
+/// The name of the keep-out obstacle in the scene of a calibration's motion queries.
 inline constexpr const char* kKeepOutObstacle = "calibration_keep_out";
 
 class CalibrationComponent final : public component::TableComponent {
  public:
   /// `initial` is the calibration the cell starts with (saved earlier); without a camera pose
-  /// in it, `drawn_camera_pose` (where the cell's drawings put the camera) is used.
-  /// `collisions` is the arm's collision world (the one its planning checks against): the
-  /// keep-out is added to it while a calibration runs, and removed after. The arm, collision
-  /// world, camera and clock must outlive the component.
-  CalibrationComponent(arm::ArmComponent& arm, planning::CollisionWorld& collisions, camera::RgbdCamera& camera,
+  /// in it, `drawn_camera_pose` (where the cell's drawings put the camera) is used. `motion`:
+  /// the cell's motion service for the arm; `arm`: the component whose FollowJointPath moves it.
+  /// The motion service, arm, camera and clock must outlive the component.
+  CalibrationComponent(const arm::MotionService& motion, component::Component& arm, camera::RgbdCamera& camera,
                        const Clock& clock, const world::Pose& drawn_camera_pose, CellCalibration initial,
                        CalibrationConfig config);
 
@@ -113,8 +115,8 @@ class CalibrationComponent final : public component::TableComponent {
   /// Saves and applies an accepted calibration; returns a problem saving it, or "".
   std::string accept(const CellCalibration& next);
 
-  arm::ArmComponent& arm_;
-  planning::CollisionWorld& collisions_;
+  const arm::MotionService& motion_;
+  component::Component& arm_;
   camera::RgbdCamera& camera_;
   const Clock& clock_;
   world::Pose drawn_camera_pose_;

@@ -39,7 +39,7 @@ struct OperationSpec {
   /// Plan validation (the editor's Check, costar run) calls it with every port's value.
   std::function<std::string(const ParamMap& params)> check;
 
-  const ParamSpec* param(std::string_view name) const;
+  const ParamSpec* param(std::string_view param_name) const;
 };
 
 struct SymbolDecl {
@@ -70,7 +70,7 @@ struct ComponentDescription {
   std::vector<SymbolDecl> symbols;
   std::vector<PredicateDecl> predicates;
 
-  const OperationSpec* operation(std::string_view name) const;
+  const OperationSpec* operation(std::string_view operation_name) const;
 };
 
 enum class OperationState { kRunning, kSuccess, kFailure };
@@ -134,6 +134,21 @@ class FinishedOperation final : public RunningOperation {
 
  private:
   OperationResult result_;
+};
+
+/// An operation of another component, started now, followed as one's own (SmartMove moves the
+/// arm with its FollowJointPath, Calibrate likewise): poll and cancel go to that component.
+/// @throws std::exception from the constructor when the operation cannot start.
+class DelegatedOperation final : public RunningOperation {
+ public:
+  DelegatedOperation(Component& component, const std::string& operation, const ParamMap& params)
+      : component_(component), id_(component.start(operation, params)) {}
+  OperationResult poll() override { return component_.poll(id_); }
+  void cancel() override { component_.cancel(id_); }
+
+ private:
+  Component& component_;
+  OperationId id_;
 };
 
 /// Base for components living in the executor's process: keeps the id bookkeeping, so a

@@ -2,9 +2,17 @@
 // Collision checking of a robot arm (RobotModel) against itself and named obstacles (the
 // table, known parts), with FCL. Used to check every motion along its whole path before it
 // runs, and by the planner.
+//
+// The world holds what every query sees (the cell as it is: the table, the known parts, the
+// fingers as the gripper reads them), changed only between queries by whoever keeps the cell's
+// model. What one query sees besides (contacts it allows, a gripper's fingers at the opening a
+// grasp is planned with, a keep-out box, the part held left out) is its QueryScene, an argument:
+// nothing is toggled in the world around a query. Queries are const and keep their own placed
+// copies of the robot's shapes, so several may run at once while the world does not change.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <atomic>
 #include <memory>
 #include <optional>
 #include <set>
@@ -42,6 +50,33 @@ class AllowedContacts {
   std::vector<std::pair<std::string, std::string>> pairs_;
 };
 
+/// A box obstacle (full side lengths) at a pose in the world.
+struct BoxObstacle {
+  std::string name;
+  world::Pose pose = world::Pose::Identity();
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();
+};
+
+/// What one query sees besides the world's own obstacles, link shapes and allowances.
+struct QueryScene {
+  QueryScene() = default;
+  /// A scene that only allows contacts (implicit: most queries need nothing else).
+  QueryScene(AllowedContacts contacts) : allowed(std::move(contacts)) {}  // NOLINT(google-explicit-constructor)
+
+  /// Contacts the query may make.
+  AllowedContacts allowed;
+  /// Links whose shapes are others in this query (in the link's frame, padded like the others):
+  /// a gripper's fingers at the opening a grasp is planned with. Self-collision pairs stay
+  /// those chosen when the world was made.
+  std::vector<std::pair<std::string, std::vector<CollisionShape>>> link_shapes;
+  /// Obstacles only this query has (a keep-out box); one named like an obstacle of the world
+  /// stands in its place.
+  std::vector<BoxObstacle> obstacles;
+  /// Obstacles of the world this query leaves out (the part held); names the world does not
+  /// have are ignored.
+  std::vector<std::string> removed;
+};
+
 struct CollisionOptions {
   /// Robot shapes are inflated by this much (m) so that tracking errors keep a margin.
   double padding = 0.01;
@@ -72,7 +107,8 @@ class CollisionWorld {
   void setWorkspace(const Eigen::AlignedBox3d& box) { workspace_ = box; }
 
   /// Replaces the collision shapes of a robot link (in its frame, padded like the others): for
-  /// parts that move, such as a gripper's fingers at their opening. Self-collision pairs stay
+  /// parts that move, such as a gripper's fingers as the cell reads them (a query that plans
+  /// them elsewhere says so in its QueryScene). Self-collision pairs stay
   /// those chosen at construction. @throws std::invalid_argument for a link without shapes.
   void setLinkShapes(const std::string& link, const std::vector<CollisionShape>& shapes);
   /// The link's shapes now (as read from the robot model, or as last set).
@@ -85,24 +121,48 @@ class CollisionWorld {
   void disallow(const std::string& robot_link, const std::string& obstacle);
   void disallowAll();
 
-  /// The first contact of the robot at `q` that neither the world nor `allowed` allows, or
-  /// nullopt when it is free.
-  std::optional<Contact> check(const Eigen::VectorXd& q, const AllowedContacts& allowed = {}) const;
-  /// Checks the straight joint-space segment from `from` to `to` at `options.resolution`.
+  /// Collision checks of many configurations in one scene (a plan's): the world as `scene`
+  /// changes it, prepared once. It holds its own placed copies of the robot's shapes: queries
+  /// may run on several threads at once while the world does not change. The world must
+  /// outlive it. @throws std::invalid_argument for a link of scene.link_shapes without shapes.
+  class Query {
+   public:
+    ~Query();
+    Query(Query&&) noexcept;
+    Query(const Query&) = delete;
+    Query& operator=(const Query&) = delete;
+    Query& operator=(Query&&) = delete;
+
+    /// The first contact of the robot at `q` that neither the world nor the scene allows, or
+    /// nullopt when it is free.
+    std::optional<Contact> check(const Eigen::VectorXd& q);
+    /// Checks the straight joint-space segment from `from` to `to` at `options.resolution`.
+    std::optional<Contact> checkSegment(const Eigen::VectorXd& from, const Eigen::VectorXd& to);
+
+   private:
+    friend class CollisionWorld;
+    struct State;
+    explicit Query(std::unique_ptr<State> state);
+    std::unique_ptr<State> state_;
+  };
+  Query query(const QueryScene& scene = {}) const;
+
+  /// One configuration, or one segment, in `scene` (a Query made for it).
+  std::optional<Contact> check(const Eigen::VectorXd& q, const QueryScene& scene = {}) const;
   std::optional<Contact> checkSegment(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
-                                      const AllowedContacts& allowed = {}) const;
+                                      const QueryScene& scene = {}) const;
 
   const RobotModel& robot() const { return robot_; }
   const CollisionOptions& options() const { return options_; }
   /// Number of configurations checked so far (for benchmarks).
-  std::uint64_t checks() const { return checks_; }
+  std::uint64_t checks() const { return checks_.load(std::memory_order_relaxed); }
 
  private:
   struct Impl;
   const RobotModel& robot_;
   CollisionOptions options_;
   std::unique_ptr<Impl> impl_;
-  mutable std::uint64_t checks_ = 0;
+  mutable std::atomic<std::uint64_t> checks_ = 0;
   std::optional<Eigen::AlignedBox3d> workspace_;
 };
 

@@ -38,21 +38,22 @@ class SeededSimplifier final : public og::PathSimplifier {
 }  // namespace
 
 PlanResult planPath(const CollisionWorld& world, const Eigen::VectorXd& start, const Eigen::VectorXd& goal,
-                    const PlannerOptions& options, const AllowedContacts& allowed) {
+                    const PlannerOptions& options, const QueryScene& scene) {
+  CollisionWorld::Query query = world.query(scene);
   const auto wall_start = std::chrono::steady_clock::now();
   PlanResult result;
   const auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   };
-  if (const auto contact = world.check(start, allowed)) {
+  if (const auto contact = query.check(start)) {
     result.failure = "the arm is in collision where it starts: " + contact->str();
     return result;
   }
-  if (const auto contact = world.check(goal, allowed)) {
+  if (const auto contact = query.check(goal)) {
     result.failure = "the goal is in collision: " + contact->str();
     return result;
   }
-  if (!world.checkSegment(start, goal, allowed)) {
+  if (!query.checkSegment(start, goal)) {
     result.path = {start, goal};
     result.planning_seconds = elapsed();
     return result;
@@ -74,12 +75,12 @@ PlanResult planPath(const CollisionWorld& world, const Eigen::VectorXd& start, c
   space->setBounds(bounds);
   og::SimpleSetup setup(space);
   Eigen::VectorXd q(dof);
-  setup.setStateValidityChecker([&world, &q, dof, &allowed](const ob::State* state) {
+  setup.setStateValidityChecker([&query, &q, dof](const ob::State* state) {
     const auto* values = state->as<ob::RealVectorStateSpace::StateType>()->values;
     for (unsigned j = 0; j < dof; ++j) {
       q[j] = values[j];
     }
-    return !world.check(q, allowed).has_value();
+    return !query.check(q).has_value();
   });
   // Check motions at the collision world's joint resolution.
   setup.getSpaceInformation()->setStateValidityCheckingResolution(world.options().resolution /
@@ -95,7 +96,7 @@ PlanResult planPath(const CollisionWorld& world, const Eigen::VectorXd& start, c
   const ob::PlannerStatus status = setup.solve(options.time_limit_s);
   if (status != ob::PlannerStatus::EXACT_SOLUTION) {
     result.failure = "no collision-free path found within " + std::to_string(options.time_limit_s) +
-                     " s (the straight motion would hit: " + world.checkSegment(start, goal, allowed)->str() + ")";
+                     " s (the straight motion would hit: " + query.checkSegment(start, goal)->str() + ")";
     result.planning_seconds = elapsed();
     return result;
   }
@@ -113,7 +114,7 @@ PlanResult planPath(const CollisionWorld& world, const Eigen::VectorXd& start, c
   }
   // OMPL checks motions discretely; confirm every segment at our resolution.
   for (std::size_t i = 1; i < result.path.size(); ++i) {
-    if (const auto contact = world.checkSegment(result.path[i - 1], result.path[i], allowed)) {
+    if (const auto contact = query.checkSegment(result.path[i - 1], result.path[i])) {
       result.path.clear();
       result.failure = "the planned path failed its final check: " + contact->str();
       break;

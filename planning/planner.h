@@ -30,8 +30,9 @@ struct PlanResult {
 
 /// A collision-free path from `start` to `goal`: the straight segment when it is free, else a
 /// planned one. Fails with a reason when the start or the goal is in collision (naming the
-/// contact) or no path is found in time. `allowed`: contacts this plan may make (CollisionWorld::check).
+/// contact) or no path is found in time. `scene`: what this plan sees besides the world
+/// (contacts it may make, shapes, obstacles: CollisionWorld::query).
 PlanResult planPath(const CollisionWorld& world, const Eigen::VectorXd& start, const Eigen::VectorXd& goal,
-                    const PlannerOptions& options = {}, const AllowedContacts& allowed = {});
+                    const PlannerOptions& options = {}, const QueryScene& scene = {});
 
 }  // namespace costar::planning

@@ -57,8 +57,6 @@ struct RobotModel::Impl {
   std::vector<LinkGeometry> links;
   std::vector<int> link_segment;  // KDL segment index whose tip is the link (-1: the base)
   std::vector<int> link_parent;   // index in links of the parent link with geometry, or -1
-  mutable KDL::JntArray scratch;
-  mutable KDL::Frame scratch_frame;
 };
 
 RobotModel::RobotModel(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -213,7 +211,6 @@ RobotModel RobotModel::fromUrdfText(const std::string& urdf_text, const std::fil
   }
   impl->fk = std::make_unique<KDL::ChainFkSolverPos_recursive>(impl->chain);
   impl->ik = std::make_unique<KDL::ChainIkSolverPos_LMA>(impl->chain, 1e-6, 500);
-  impl->scratch.resize(joints);
   return RobotModel(std::move(impl));
 }
 
@@ -225,21 +222,26 @@ const Eigen::VectorXd& RobotModel::velocityLimits() const { return impl_->veloci
 const std::vector<LinkGeometry>& RobotModel::links() const { return impl_->links; }
 
 world::Pose RobotModel::forward(const Eigen::VectorXd& q) const {
-  impl_->scratch.data = q;
-  impl_->fk->JntToCart(impl_->scratch, impl_->scratch_frame);
-  return toPose(impl_->scratch_frame);
+  // Local joint and frame values (the solver keeps no state): several threads may ask at once.
+  KDL::JntArray joints;
+  joints.data = q;
+  KDL::Frame frame;
+  impl_->fk->JntToCart(joints, frame);
+  return toPose(frame);
 }
 
 void RobotModel::linkPoses(const Eigen::VectorXd& q, std::vector<world::Pose>& poses) const {
-  impl_->scratch.data = q;
+  KDL::JntArray joints;
+  joints.data = q;
+  KDL::Frame frame;
   poses.resize(impl_->links.size());
   for (std::size_t i = 0; i < impl_->links.size(); ++i) {
     const int segment = impl_->link_segment[i];
     if (segment < 0) {
       poses[i] = world::Pose::Identity();
     } else {
-      impl_->fk->JntToCart(impl_->scratch, impl_->scratch_frame, segment + 1);
-      poses[i] = toPose(impl_->scratch_frame);
+      impl_->fk->JntToCart(joints, frame, segment + 1);
+      poses[i] = toPose(frame);
     }
   }
 }

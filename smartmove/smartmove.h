@@ -28,11 +28,19 @@
 // operation lists every candidate with its cost or the reason it was rejected.
 //
 // Motion: SmartMove asks the cell's motion service (arm/motion_service.h) for where the arm is,
-// IK solutions, collisions and plans, passing the contacts each query allows (the fingers and
-// the part they grasp, the part held and its support); it moves the arm with the arm's
-// FollowJointPath operation and the gripper with the gripper's operations, as a plan would, so
-// it needs neither component's class. Cancelling a SmartMove cancels the arm's motion.
+// IK solutions, collisions and plans, each query with its scene (planning::QueryScene): the
+// contacts it allows (the fingers and the part they grasp, the part held and its support), the
+// fingers as the motion will have them (the gripper's geometry, gripper/gripper_geometry.h),
+// the part held left out. It changes nothing in the cell's collision world around a query; it
+// keeps the known parts there (syncObstacles). It moves the arm with the arm's FollowJointPath
+// operation and the gripper with the gripper's operations, as a plan would, so it needs neither
+// component's class. Cancelling a SmartMove cancels the arm's motion.
 // Predicate: holding(o) — the gripper holds part o (grasped by SmartGrasp, and still squeezing).
+//
+// One job a file: smartmove.cpp (this component: its operations, what it knows, the scenes of
+// its queries), script (the step engine), candidate_search (the choice among parts, symmetries
+// and shifted grasps), smart_grasp (SmartMove and SmartGrasp), smart_release, smart_push,
+// teach_grasp.
 
 #include <functional>
 #include <map>
@@ -43,7 +51,7 @@
 
 #include "arm/motion_service.h"
 #include "component/operation_table.h"
-#include "gripper/finger_geometry.h"
+#include "gripper/gripper_geometry.h"
 #include "planning/collision_world.h"
 #include "predicator/predicator.h"
 #include "smartmove/grasps.h"
@@ -80,37 +88,21 @@ struct SmartMoveConfig {
   /// Robot links that may touch the part being grasped (the gripper): the robot
   /// description's links.gripper (arm/robot_description.h).
   std::vector<std::string> gripper_links;
-  /// The gripper's fingers where they are at an opening. When given, they replace the shapes of
-  /// `finger_link` in the collision world (syncFingers), grasps are planned with the fingers
-  /// opened only as far as the part needs plus `grasp_margin`, and the gripper opens that far
-  /// (its Open takes an `opening`) before a grasp and to release. When not, the robot model's
-  /// finger shapes stay and the gripper opens fully.
-  std::optional<gripper::FingerGeometry> fingers;
+  /// The gripper's fingers (one implementation per kind of gripper): grasps are planned with
+  /// the fingers as the grasp will have them (a parallel gripper opened only as far as the part
+  /// needs plus `grasp_margin`, and opened that far before a grasp and to release; an adaptive
+  /// gripper in the grasp's mode, closed part way where the open fingers do not fit among
+  /// neighbours). Not modelled: the robot model's finger shapes stay and the gripper opens fully.
+  std::shared_ptr<const gripper::GripperGeometry> gripper = gripper::rigidGripperGeometry();
+  /// The robot link whose shapes are the fingers.
   std::string finger_link = "fingers";
-  /// A gripper with modes (the 3-finger gripper). A grasp that needs a mode is planned with that
-  /// mode's fingers, before SmartGrasp has turned the gripper to it; when none of its candidates
-  /// is free with the fingers open, with them closed part way round the part (a fingertip mode:
-  /// the gripper's Open takes a `position`).
-  struct ModeFingers {
-    /// The fingers' shapes in mode (SetMode's name) stopped at position (0 open .. 1 closed),
-    /// in the finger link's frame; empty for a mode it does not model.
-    std::function<std::vector<planning::CollisionShape>(const std::string& mode, double position)> shapes;
-    /// The most closed position in mode that leaves half_width (m) clear either side of the
-    /// tool's axis between the fingertips; 0 when the fingers cannot close part way.
-    std::function<double(const std::string& mode, double half_width)> position_for;
-    /// How far (m) the fingers in mode reach along the tool's x, either side of its axis: a
-    /// grasp shifted along a part keeps them that far inside its end. Empty, or 0 for a mode it
-    /// does not model: no shifted grasps.
-    std::function<double(const std::string& mode)> reach_across;
-  };
-  std::optional<ModeFingers> mode_fingers;
   /// m added to the part's width between the fingers: covers perception error (a few mm, a few
   /// degrees of yaw) and the fingers' tracking.
   double grasp_margin = 0.016;
   /// When no centred grasp is feasible, grasps shifted across the fingers (along the tool's x)
   /// are tried, nearest the centre first: in steps of grasp_shift_step up to grasp_shift_max,
   /// keeping the pads grasp_shift_keep inside the part's end (a link gripped off its middle, a
-  /// node off its centre line). With `fingers`, or `mode_fingers` that give `reach_across`.
+  /// node off its centre line). Where the gripper's geometry says how far the fingers reach.
   double grasp_shift_step = 0.01;
   double grasp_shift_max = 0.04;
   double grasp_shift_keep = 0.003;
@@ -128,6 +120,9 @@ using predicator::parsePredicateList;
 /// Obstacle name of a known part in the collision world.
 std::string partObstacle(const std::string& object);
 
+/// The fingers' boxes as collision shapes of the finger link.
+std::vector<planning::CollisionShape> fingerShapes(const std::vector<gripper::OrientedBox>& boxes);
+
 /// Checks one predicate pattern of a plan before it runs (known predicate, right number of
 /// arguments, known reference frames): empty when fine, else the problem.
 using PatternCheck = predicator::PatternCheck;
@@ -137,8 +132,8 @@ class SmartMoveComponent final : public component::TableComponent {
   /// Everything passed by reference must outlive the component. `motion`: the cell's motion
   /// service for the arm; `arm` and `gripper`: the components SmartMove moves through their
   /// operations (the arm's FollowJointPath; the gripper's Open and Close). `collisions`: the
-  /// cell's collision world, where SmartMove keeps the known parts (syncObstacles) and the
-  /// fingers' shapes (syncFingers); the motion service plans in it.
+  /// cell's collision world, where SmartMove keeps the known parts (syncObstacles); the motion
+  /// service plans in it. @throws std::invalid_argument when config.gripper is null.
   SmartMoveComponent(const arm::MotionService& motion, component::Component& arm, component::Component& gripper,
                      world::WorldState& world, planning::CollisionWorld& collisions,
                      std::vector<world::ObjectClass> classes, GraspLibrary& grasps, SmartMoveConfig config = {});
@@ -150,15 +145,10 @@ class SmartMoveComponent final : public component::TableComponent {
   /// workcell does it before every tick).
   void syncObstacles();
 
-  /// Puts the fingers' collision shapes where they are at `opening` (m), as the gripper reads
-  /// it (not a number: unknown, the whole stroke); nothing without SmartMoveConfig::fingers. Call before planning (the
-  /// workcell does it before every tick).
-  void syncFingers(double opening);
-
   /// The opening a grasp with the tool centre point at `tcp` needs for a part of `object_class`
   /// at `object`: the part's width between the fingers (its extent along the tool's y) plus
   /// grasp_margin, at most the gripper's stroke; nullopt when the part is wider than the stroke;
-  /// 0 (open fully) when the fingers are not modelled.
+  /// 0 (open fully) for a gripper without a width (GripperGeometry::graspOpening).
   std::optional<double> graspOpening(const world::Pose& tcp, const world::Pose& object,
                                      const world::ObjectClass& object_class) const;
 
@@ -185,67 +175,78 @@ class SmartMoveComponent final : public component::TableComponent {
                         const world::Pose& grasp, double approach, double speed, const std::string& mode = {});
 
  private:
-  // The operations' handlers (one table, declared in the constructor).
+  // The operations' handlers (one table, declared in the constructor), each in its own file.
   std::unique_ptr<component::RunningOperation> beginMoveOrGrasp(bool grasping, const component::ParamMap& params);
   std::unique_ptr<component::RunningOperation> beginRelease(const component::ParamMap& params);
   std::unique_ptr<component::RunningOperation> beginTeachGrasp(const component::ParamMap& params);
-  std::unique_ptr<component::RunningOperation> beginPushOperation(const component::ParamMap& params);
+  std::unique_ptr<component::RunningOperation> beginPush(const component::ParamMap& params);
   const world::ObjectClass* objectClass(const std::string& name) const;
-  /// SmartPush (see the top of this file).
-  std::unique_ptr<component::RunningOperation> beginPush(const std::string& object_class,
-                                                         const std::vector<predicator::Pattern>& patterns,
-                                                         double distance, double speed);
-  /// Why a spot on the table does not satisfy `pattern` (empty if it does).
-  std::string spotFailsPattern(const Eigen::Vector3d& spot, const predicator::Pattern& pattern) const;
+
+  // What every motion query is given.
+  /// The scene of a motion query: the gripper's links may touch `objects` (parts, or a
+  /// support), the fingers stand as `stance` says (as the cell has them where the gripper's
+  /// geometry does not model it), the part held is left out.
+  arm::QueryScene scene(const std::vector<std::string>& objects = {}, const gripper::FingerStance& stance = {}) const;
   ArmModel armModel() const;
-  /// Contacts a query may make: the gripper's links with these objects (parts, or a support).
-  arm::AllowedContacts touching(const std::vector<std::string>& objects) const;
   /// Runs a plan with the arm's FollowJointPath (called `what` in messages), or an operation
   /// that fails with the plan's reason.
   std::unique_ptr<component::RunningOperation> follow(const arm::MotionPlan& plan, const std::string& what);
-  /// How far (m) the fingers reach along the tool's x either side of its axis when they hold a
-  /// part (in gripper mode `mode` for an adaptive gripper); nullopt when it is not modelled (no
-  /// shifted grasps then).
-  std::optional<double> fingerReachAcross(const std::string& mode) const;
-  /// Shifts (m along the tool's x) of a grasp at `tcp` that keep fingers reaching `reach` either
-  /// side of the tool's axis on the part.
+  /// Starts a joint-space motion to the IK solution for `pose` nearest `seed` that is free with
+  /// the fingers standing as `stance` (the arm's operation named `what`), or an operation that
+  /// fails with `none` and the reason.
+  std::unique_ptr<component::RunningOperation> moveToFreeConfiguration(const world::Pose& pose,
+                                                                       const arm::JointVector& seed, double speed,
+                                                                       const std::string& what, const std::string& none,
+                                                                       const gripper::FingerStance& stance = {});
+  /// The gripper's Open to stand as `stance` says (fully open where it says nothing the
+  /// gripper has), and Close with the grip force `force` (N): steps of a script.
+  std::unique_ptr<component::RunningOperation> openGripper(const gripper::FingerStance& stance);
+  std::unique_ptr<component::RunningOperation> closeGripper(double force);
+
+  // The candidate search (candidate_search.cpp).
+  /// How far (m along the tool's x) a grasp at `tcp` may shift and keep fingers reaching
+  /// `reach` either side of the tool's axis on the part.
   std::vector<double> graspShifts(const world::Pose& tcp, const world::Pose& object,
                                   const world::ObjectClass& object_class, double reach) const;
+  /// A start at `start` (the IK solution nearest `goal_joints` free in `scene`) and a straight
+  /// line from there to `goal`: empty when both are found (in `from` and `line`), else why not,
+  /// `names.start` or `names.line` first (`reason` keeps the first contact seen so far).
+  struct StraightNames {
+    const char* start;
+    const char* line;
+  };
+  std::string straightOnto(const world::Pose& start, const world::Pose& goal, const arm::JointVector& goal_joints,
+                           const arm::QueryScene& scene, std::string& reason, const StraightNames& names,
+                           arm::JointVector& from, arm::MotionPlan& line) const;
+  /// The objects `matches` rejected, added to `selection` as rejected candidates, and its
+  /// failure summarized (no part known at all: "detect the parts first").
+  static void addRejected(Selection& selection, const Matches& matches);
   /// `centred` (none feasible) with the shifted grasps of its candidates tried after it.
   Selection withShiftedGrasps(Selection centred, const world::ObjectClass& object_class, double reach,
                               const FeasibilityCheck& feasible);
-  /// Puts the fingers' shapes of gripper mode `mode` at `position` in the collision world
-  /// (nothing when the mode's fingers are not given): before planning a motion in that mode.
-  void fingersInMode(const std::string& mode, double position = 0.0);
   /// Half the part's width between the fingers of a grasp with the tool centre point at `tcp`
   /// (its extent along the tool's y, either side of the TCP).
   static double partHalfWidth(const world::Pose& tcp, const world::Pose& object,
                               const world::ObjectClass& object_class);
-  /// Shapes of the fingers at `opening`, in the finger link's frame.
-  std::vector<planning::CollisionShape> fingerShapes(double opening) const;
-  /// The Open operation's parameters: at `opening` when the fingers are modelled, else fully.
-  component::ParamMap openParams(double opening) const;
-  /// SmartGrasp centre="true": after the close, open fully, rise `rise` m, turn by `turn` about
-  /// the tool axis, go down and close, which centres the part along the pads too; `opening` (m)
-  /// is the turned grasp's, to release it.
+
+  // SmartGrasp centre="true" (smart_grasp.cpp): after the close, open fully, rise `rise` m,
+  // turn by `turn` about the tool axis, go down and close, which centres the part along the
+  // pads too; `opening` (m) is the turned grasp's, to release it.
   struct Centring {
     world::Pose turn = world::Pose::Identity();
     double rise = 0.0;
     double opening = 0.0;
   };
-  /// How to square up the part of the `chosen` grasp, or nullopt and why not (the grasp is off
-  /// the part's centre, the part does not fit the fingers turned, a neighbour is in the way).
+  /// How to square up the part of the `chosen` grasp, or nullopt and why not (the gripper has
+  /// no width, the grasp is off the part's centre, the part does not fit the fingers turned, a
+  /// neighbour is in the way).
   std::optional<Centring> planCentring(const Candidate& chosen, const world::Pose& object_pose,
                                        const world::ObjectClass& object_class, std::string& why);
-  /// Starts a joint-space motion to the collision-free IK solution for `pose` nearest `seed`
-  /// (the arm's operation named `what`), or an operation that fails with `none` and the reason.
-  std::unique_ptr<component::RunningOperation> moveToFreeConfiguration(const world::Pose& pose,
-                                                                       const arm::JointVector& seed, double speed,
-                                                                       const std::string& what,
-                                                                       const std::string& none);
 
-  friend class SmartStep;
-  class PlannedFingers;
+  // SmartRelease on the table (smart_release.cpp).
+  /// Why a spot on the table does not satisfy `pattern` (empty if it does).
+  std::string spotFailsPattern(const Eigen::Vector3d& spot, const predicator::Pattern& pattern) const;
+
   const arm::MotionService& motion_;
   component::Component& arm_;
   component::Component& gripper_;
@@ -254,12 +255,13 @@ class SmartMoveComponent final : public component::TableComponent {
   std::vector<world::ObjectClass> classes_;
   GraspLibrary& grasps_;
   SmartMoveConfig config_;
+  const gripper::GripperGeometry& fingers_;  // config_.gripper's
 
   std::optional<std::string> held_;
   std::string held_class_;
   world::Pose held_grasp_ = world::Pose::Identity();  // the TCP in the held part's frame
   double held_opening_ = 0.0;                         // the opening of its grasp, m (0: fully)
-  std::string held_mode_;                             // the gripper mode it was grasped in (mode_fingers)
+  std::string held_mode_;                             // the gripper mode it was grasped in
   double held_finger_position_ = 0.0;                 // where its fingers release to in that mode (0: open)
   /// The part SmartRelease put down last: its class, where it was put (the part's frame in the
   /// world), and where the parts of its class were believed to be then (the part itself where it
@@ -270,7 +272,6 @@ class SmartMoveComponent final : public component::TableComponent {
     std::vector<Eigen::Vector3d> known;
   };
   std::optional<PutDown> put_;
-  double synced_opening_ = -1.0;  // the fingers' shapes are at this opening
   std::vector<std::string> obstacles_;
   std::shared_ptr<PatternCheck> pattern_check_ = std::make_shared<PatternCheck>();
 };

@@ -6,7 +6,6 @@ namespace costar::testing {
 
 using component::FinishedOperation;
 using component::OperationResult;
-using component::OperationSpec;
 using component::ParamSpec;
 using component::RunningOperation;
 using component::ValueType;
@@ -14,23 +13,22 @@ using component::ValueType;
 // --- TestLogger ------------------------------------------------------------------------
 
 TestLogger::TestLogger() {
-  description_.name = "test_logger";
-  description_.type = "TestLogger";
-  description_.operations = {{"TestLog",
-                              "TEST ONLY: records a message.",
-                              {{"message", ValueType::kString, "text to record", {}}},
-                              component::OperationKind::kKnowledge}};
+  component::OperationTable operations;
+  operations.add({"TestLog",
+                  "TEST ONLY: records a message.",
+                  {{"message", ValueType::kString, "text to record", {}}},
+                  component::OperationKind::kKnowledge},
+                 [this](const component::ParamMap& params) {
+                   std::lock_guard lock(mutex_);
+                   messages_.push_back(params.at("message").asString());
+                   return std::make_unique<FinishedOperation>(OperationResult::success());
+                 });
+  declare({.name = "test_logger", .type = "TestLogger"}, std::move(operations));
 }
 
 std::vector<std::string> TestLogger::messages() const {
   std::lock_guard lock(mutex_);
   return messages_;
-}
-
-std::unique_ptr<RunningOperation> TestLogger::begin(const std::string&, const component::ParamMap& params) {
-  std::lock_guard lock(mutex_);
-  messages_.push_back(params.at("message").asString());
-  return std::make_unique<FinishedOperation>(OperationResult::success());
 }
 
 // --- TestActions -----------------------------------------------------------------------
@@ -66,37 +64,43 @@ class ThrowingOperation final : public RunningOperation {
 }  // namespace
 
 TestActions::TestActions() {
-  description_.name = "test_actions";
-  description_.type = "TestActions";
   ParamSpec result{
       "result", ValueType::kString, "what the action returns", std::string("success"), {"success", "failure"}};
   ParamSpec polls{"polls", ValueType::kInt, "polls spent RUNNING before the result", 0LL};
   polls.min = 0;
   ParamSpec reason{"reason", ValueType::kString, "failure reason", std::string("scripted failure")};
-  description_.operations = {
-      {"TestAction", "TEST ONLY: runs for some polls, then succeeds or fails.", {result, polls, reason}},
-      {"TestThrow", "TEST ONLY: the component throws (a fault).", {}}};
-}
-
-std::unique_ptr<RunningOperation> TestActions::begin(const std::string& operation, const component::ParamMap& params) {
-  ++starts;
-  if (operation == "TestThrow") {
+  component::OperationTable operations;
+  operations.add({"TestAction", "TEST ONLY: runs for some polls, then succeeds or fails.", {result, polls, reason}},
+                 [this](const component::ParamMap& params) {
+                   ++starts;
+                   return std::make_unique<ScriptedOperation>(*this, params.at("polls").asInt(),
+                                                              params.at("result").asString() == "success",
+                                                              params.at("reason").asString());
+                 });
+  operations.add({"TestThrow", "TEST ONLY: the component throws (a fault).", {}}, [this](const component::ParamMap&) {
+    ++starts;
     return std::make_unique<ThrowingOperation>();
-  }
-  return std::make_unique<ScriptedOperation>(
-      *this, params.at("polls").asInt(), params.at("result").asString() == "success", params.at("reason").asString());
+  });
+  declare({.name = "test_actions", .type = "TestActions"}, std::move(operations));
 }
 
 // --- TestCounter -----------------------------------------------------------------------
 
 TestCounter::TestCounter() {
-  description_.name = "test_counter";
-  description_.type = "TestCounter";
-  description_.operations = {{"TestCount",
-                              "TEST ONLY: adds one to a named counter.",
-                              {{"counter", ValueType::kString, "counter name", {}}},
-                              component::OperationKind::kKnowledge}};
-  description_.predicates = {{"test_count", 2, "test_count(counter, n): the counter's value is n"}};
+  component::OperationTable operations;
+  operations.add({"TestCount",
+                  "TEST ONLY: adds one to a named counter.",
+                  {{"counter", ValueType::kString, "counter name", {}}},
+                  component::OperationKind::kKnowledge},
+                 [this](const component::ParamMap& params) {
+                   std::lock_guard lock(mutex_);
+                   ++counters_[params.at("counter").asString()];
+                   return std::make_unique<FinishedOperation>(OperationResult::success());
+                 });
+  declare({.name = "test_counter",
+           .type = "TestCounter",
+           .predicates = {{"test_count", 2, "test_count(counter, n): the counter's value is n"}}},
+          std::move(operations));
 }
 
 world::Report TestCounter::report() const {
@@ -112,12 +116,6 @@ int TestCounter::value(const std::string& counter) const {
   std::lock_guard lock(mutex_);
   const auto it = counters_.find(counter);
   return it == counters_.end() ? 0 : it->second;
-}
-
-std::unique_ptr<RunningOperation> TestCounter::begin(const std::string&, const component::ParamMap& params) {
-  std::lock_guard lock(mutex_);
-  ++counters_[params.at("counter").asString()];
-  return std::make_unique<FinishedOperation>(OperationResult::success());
 }
 
 // --- TestArm ---------------------------------------------------------------------------
@@ -144,22 +142,38 @@ class TimedOperation final : public RunningOperation {
 }  // namespace
 
 TestArm::TestArm() {
-  description_.name = "test_arm";
-  description_.type = "TestArm";
-  description_.implements = {"Arm"};
   ParamSpec waypoint{"waypoint", ValueType::kString, "waypoint to move to", {}};
   waypoint.choices_from = "waypoint";
-  description_.operations = {{"Move", "TEST ONLY: moves the endpoint to a waypoint (3 polls).", {waypoint}},
-                             {"Teach",
-                              "TEST ONLY: saves the endpoint as a named waypoint.",
-                              {{"waypoint", ValueType::kString, "name for the new waypoint", {}}},
-                              component::OperationKind::kKnowledge},
-                             {"SetEndpoint",
-                              "TEST ONLY: jogs the endpoint to a pose.",
-                              {{"pose", ValueType::kPose, "x;y;z;roll;pitch;yaw (m, deg)", {}}}}};
-  description_.symbols = {{"endpoint", world::SymbolKind::kFrame, "the arm's tool frame"}};
-  description_.predicates = {{"at_waypoint", 1, "at_waypoint(w): the endpoint is at waypoint w"}};
+  component::OperationTable operations;
+  operations.add({"Move", "TEST ONLY: moves the endpoint to a waypoint (3 polls).", {waypoint}},
+                 [this](const component::ParamMap& params) { return move(params.at("waypoint").asString()); });
+  operations.add({"Teach",
+                  "TEST ONLY: saves the endpoint as a named waypoint.",
+                  {{"waypoint", ValueType::kString, "name for the new waypoint", {}}},
+                  component::OperationKind::kKnowledge},
+                 [this](const component::ParamMap& params) {
+                   std::lock_guard lock(mutex_);
+                   waypoints_[params.at("waypoint").asString()] = endpoint_;
+                   at_waypoint_ = params.at("waypoint").asString();
+                   return std::make_unique<FinishedOperation>(OperationResult::success());
+                 });
+  operations.add({"SetEndpoint",
+                  "TEST ONLY: jogs the endpoint to a pose.",
+                  {{"pose", ValueType::kPose, "x;y;z;roll;pitch;yaw (m, deg)", {}}}},
+                 [this](const component::ParamMap& params) {
+                   std::lock_guard lock(mutex_);
+                   endpoint_ = params.at("pose").asPose();
+                   at_waypoint_.clear();
+                   return std::make_unique<FinishedOperation>(OperationResult::success());
+                 });
+  component::ComponentDescription description;
+  description.name = "test_arm";
+  description.type = "TestArm";
+  description.implements = {"Arm"};
+  description.symbols = {{"endpoint", world::SymbolKind::kFrame, "the arm's tool frame"}};
+  description.predicates = {{"at_waypoint", 1, "at_waypoint(w): the endpoint is at waypoint w"}};
   waypoints_["home"] = world::Pose(Eigen::Translation3d(0.3, 0.0, 0.5));
+  declare(std::move(description), std::move(operations));
 }
 
 world::Report TestArm::report() const {
@@ -175,19 +189,8 @@ world::Report TestArm::report() const {
   return report;
 }
 
-std::unique_ptr<RunningOperation> TestArm::begin(const std::string& operation, const component::ParamMap& params) {
+std::unique_ptr<RunningOperation> TestArm::move(const std::string& name) {
   std::lock_guard lock(mutex_);
-  if (operation == "Teach") {
-    waypoints_[params.at("waypoint").asString()] = endpoint_;
-    at_waypoint_ = params.at("waypoint").asString();
-    return std::make_unique<FinishedOperation>(OperationResult::success());
-  }
-  if (operation == "SetEndpoint") {
-    endpoint_ = params.at("pose").asPose();
-    at_waypoint_.clear();
-    return std::make_unique<FinishedOperation>(OperationResult::success());
-  }
-  const std::string name = params.at("waypoint").asString();
   const auto it = waypoints_.find(name);
   if (it == waypoints_.end()) {
     return std::make_unique<FinishedOperation>(OperationResult::failure("unknown waypoint '" + name + "'"));
@@ -199,6 +202,24 @@ std::unique_ptr<RunningOperation> TestArm::begin(const std::string& operation, c
     endpoint_ = target;
     at_waypoint_ = name;
   });
+}
+
+// --- OraclePerception ------------------------------------------------------------------
+
+OraclePerception::OraclePerception(std::function<std::vector<TruePart>()> truth) : truth_(std::move(truth)) {
+  declare({.name = "test_oracle_perception",
+           .type = "TestOraclePerception",
+           .predicates = {{"is_a", 2, "TEST ONLY: is_a(part, class) from ground truth"}}},
+          {});
+}
+
+world::Report OraclePerception::report() const {
+  world::Report report;
+  for (const TruePart& part : truth_()) {
+    report.symbols.push_back({part.name, "", {}, world::FrameValue{"world", part.pose}});
+    report.predicates.push_back({"is_a", {part.name, part.object_class}, true, ""});
+  }
+  return report;
 }
 
 }  // namespace costar::testing

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "gripper/adaptive_gripper.h"
@@ -41,7 +42,19 @@ GripperModel parallelTwoFinger() {
   model.tcp_link = "tcp";
   model.tcp_in_flange.translation() = Eigen::Vector3d(0.0, 0.0, 0.14);
   model.links = {"fingers"};
-  model.fingers = gripper::twoFingerGripper();
+  model.finger_link = "fingers";
+  const gripper::FingerGeometry fingers = gripper::twoFingerGripper();
+  model.geometry = gripper::parallelGripperGeometry(fingers);
+  model.read_stance = [stroke = fingers.max_opening](const GripperDrivers& drivers) {
+    double opening = std::numeric_limits<double>::quiet_NaN();
+    try {
+      opening = drivers.parallel->read().opening;
+    } catch (const std::exception&) {
+      // unknown: see below
+    }
+    // An opening not known (a reading that fails, or is not a number) counts as the whole stroke.
+    return std::optional<gripper::FingerStance>({.opening = std::isfinite(opening) ? opening : stroke});
+  };
   model.marker_in_flange_guess = world::poseFromXyzRpy(0.035, 0, 0.075, -M_PI / 2, 0, -M_PI / 2);
   model.grasps = smartmove::kParallelGripper;
   model.make_component = &makeParallelGripper;
@@ -51,19 +64,43 @@ GripperModel parallelTwoFinger() {
 /// "robotiq3f": the 3-finger adaptive gripper (robots/grippers/robotiq3f.json, docs/GRIPPERS.md),
 /// its pieces generated at build time (robots/generate_gripper.py): the tool centre point from
 /// the description (0.19 m along the flange's z axis); the calibration marker where the
-/// generator puts it, on the palm's +x face. No finger geometry for SmartMove: the planner's
-/// fingers hold the open fingers at any mode, and the gripper opens fully.
+/// generator puts it, on the palm's +x face. Its fingers are modelled in each mode, open or (in a
+/// fingertip mode) closed part way; it opens fully, or to a position in a fingertip mode.
 GripperModel robotiq3f() {
   const std::filesystem::path generated = COSTAR_GRIPPER_MODEL_DIR;
+  const gripper::AdaptiveGripperDescription description =
+      gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile("robotiq3f"));
   GripperModel model;
   model.key = "robotiq3f";
   model.mjcf = generated / "robotiq3f_mount.xml";
   model.urdf = generated / "robotiq3f.urdf";
   model.tcp_link = "tcp";
-  model.tcp_in_flange.translation() =
-      gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile("robotiq3f")).tcp;
+  model.tcp_in_flange.translation() = description.tcp;
   model.links = {"robotiq3f_fingers"};
   model.finger_link = "robotiq3f_fingers";
+  model.geometry = gripper::adaptiveGripperGeometry(description);
+  // The fingers as the mode places them: open, or in a fingertip mode closed part way as far as
+  // its most open closing finger reads (rounded down to 1 %, toward open).
+  model.read_stance = [description](const GripperDrivers& drivers) -> std::optional<gripper::FingerStance> {
+    gripper::AdaptiveGripperReading reading;
+    try {
+      reading = drivers.adaptive->read();
+    } catch (const std::exception&) {
+      return std::nullopt;  // the component reports the failure
+    }
+    const gripper::AdaptiveModeDescription& mode = description.mode(reading.mode);
+    double position = 0.0;
+    if (mode.fingertip) {
+      position = 1.0;
+      for (std::size_t i = 0; i < reading.fingers.size(); ++i) {
+        if (mode.closing[i]) {
+          position = std::min(position, reading.fingers[i].position);
+        }
+      }
+      position = std::clamp(std::floor(position * 100.0) / 100.0, 0.0, 0.9);
+    }
+    return gripper::FingerStance{.mode = std::string(gripper::toString(reading.mode)), .position = position};
+  };
   model.marker_in_flange_guess = world::poseFromXyzRpy(0.0653, 0, 0.045, -M_PI / 2, 0, -M_PI / 2);
   model.adaptive = "robotiq3f";
   model.grasps = smartmove::kAdaptiveGripper;

@@ -5,6 +5,7 @@
 // robots/grippers/NAME.json for an adaptive gripper) and a row.
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -13,8 +14,8 @@
 #include "component/component.h"
 #include "core/clock.h"
 #include "gripper/adaptive_gripper_driver.h"
-#include "gripper/finger_geometry.h"
 #include "gripper/gripper_driver.h"
+#include "gripper/gripper_geometry.h"
 #include "world/pose.h"
 
 namespace costar::workcell {
@@ -37,11 +38,15 @@ struct GripperModel {
   world::Pose tcp_in_flange = world::Pose::Identity();
   /// The gripper's links that may touch a part being grasped (SmartMove allows it).
   std::vector<std::string> links;
-  /// An adaptive gripper's fingers' link: the cell puts the open fingers of the current mode
-  /// there (gripper::openFingerBoxes) whenever the mode changes.
+  /// The URDF link whose collision shapes are the fingers: the cell keeps them there as the
+  /// gripper reads them (read_stance, geometry); SmartMove's queries put them where a motion
+  /// will have them.
   std::string finger_link;
-  /// The fingers' shapes by opening (SmartMove plans grasps with them), if the gripper has some.
-  std::optional<gripper::FingerGeometry> fingers;
+  /// The fingers' geometry (gripper/gripper_geometry.h: one implementation per kind of gripper).
+  std::shared_ptr<const gripper::GripperGeometry> geometry;
+  /// How the fingers stand as the cell's driver reads them; nullopt when the reading fails and
+  /// they are left as they were.
+  std::function<std::optional<gripper::FingerStance>(const GripperDrivers& drivers)> read_stance;
   /// Where the drawings put the hand-eye calibration marker in the flange frame.
   world::Pose marker_in_flange_guess = world::Pose::Identity();
   /// A 3-finger adaptive gripper's description (robots/grippers/NAME.json): the simulation

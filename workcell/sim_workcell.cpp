@@ -9,8 +9,6 @@
 #include "component/operation_table.h"
 #include "core/paths.h"
 #include "faults/injector.h"
-#include "gripper/adaptive_gripper_description.h"
-#include "gripper/finger_geometry.h"
 #include "perception/perception_component.h"
 #include "perception/pipeline.h"
 #include "planning/collision_world.h"
@@ -20,6 +18,7 @@
 #include "sim/drivers.h"
 #include "sim/simulation.h"
 #include "smartmove/smartmove.h"
+#include "testing/test_components.h"
 #include "workcell/grippers.h"
 #include "workcell/sim_cell_description.h"
 
@@ -50,30 +49,6 @@ class FixedFrames final : public component::TableComponent {
 
  private:
   std::vector<std::pair<std::string, world::Pose>> frames_;
-};
-
-/// TEST ONLY: the simulator's true part poses as object symbols, standing in for perception
-/// when SmartMove is tested apart from it.
-class TestOraclePerception final : public component::TableComponent {
- public:
-  explicit TestOraclePerception(sim::Simulation& simulation) : simulation_(simulation) {
-    component::ComponentDescription description;
-    description.name = "test_oracle_perception";
-    description.type = "TestOraclePerception";
-    description.predicates = {{"is_a", 2, "TEST ONLY: is_a(part, class) from ground truth"}};
-    declare(std::move(description), {});  // no operations
-  }
-  world::Report report() const override {
-    world::Report report;
-    for (const sim::PartState& part : simulation_.parts()) {
-      report.symbols.push_back({part.name, "", {}, world::FrameValue{"world", part.pose}});
-      report.predicates.push_back({"is_a", {part.name, part.object_class}, true, ""});
-    }
-    return report;
-  }
-
- private:
-  sim::Simulation& simulation_;
 };
 
 /// The perception pipeline (models and SVM loaded from the data files, about half a second),
@@ -148,10 +123,9 @@ class SimWorkcell final : public Workcell {
       gripper::AdaptiveGripperDriver* adaptive = simulation_->adaptiveGripper();
       gripper_drivers.adaptive = faults_ && adaptive != nullptr ? &faults_->wrap(*adaptive) : adaptive;
     }
-    cell_gripper_driver_ = gripper_drivers.parallel;
-    if (!gripper_model_.adaptive.empty()) {
-      adaptive_ = gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile(gripper_model_.adaptive));
-    }
+    // The fingers as the cell reads them: the 2-finger's through the fault injector, the
+    // adaptive gripper's from the simulation.
+    finger_drivers_ = {gripper_drivers.parallel, simulation_->adaptiveGripper()};
     camera::RgbdCamera& camera = faults_ ? faults_->wrap(camera_) : camera_;
     const auto add = [this](std::shared_ptr<component::Component> component) {
       components().add(faults_ ? faults_->wrap(std::move(component)) : std::move(component));
@@ -183,13 +157,20 @@ class SimWorkcell final : public Workcell {
     }
     add(arm);
     components().add(gripper);
-    // HandEyeCalibration: the camera's pose comes from it (the drawings until calibrated).
-    calibration_ = makeCalibration(options, *arm, camera);
+    // HandEyeCalibration: the camera's pose comes from it (the drawings until calibrated); it
+    // moves the arm as SmartMove does.
+    calibration_ = makeCalibration(options, *arm, arm_config.tcp_in_flange, camera);
     add(calibration_);
     add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
         {"table_center", tableCenter()}, {"robot_base", cell_.robot_base}}));
     if (options.test_oracle_perception) {
-      add(std::make_shared<TestOraclePerception>(*simulation_));
+      add(std::make_shared<testing::OraclePerception>([simulation = simulation_.get()] {
+        std::vector<testing::TruePart> parts;
+        for (const sim::PartState& part : simulation->parts()) {
+          parts.push_back({part.name, part.object_class, part.pose});
+        }
+        return parts;
+      }));
     } else {
       // DetectObjects: the camera's frames only, never the simulator's true poses.
       perception::PerceptionConfig perception_config;
@@ -200,23 +181,8 @@ class SimWorkcell final : public Workcell {
     }
     smartmove::SmartMoveConfig smartmove_config;
     smartmove_config.gripper_links = gripperLinks(robot_description_, gripper_model_);
-    smartmove_config.fingers = gripper_model_.fingers;
-    if (adaptive_) {
-      smartmove_config.finger_link = gripper_model_.finger_link;
-      smartmove_config.mode_fingers = smartmove::SmartMoveConfig::ModeFingers{
-          [this](const std::string& name, double position) {
-            const auto mode = gripper::modeFromString(name);
-            return mode ? adaptiveFingerShapes(*mode, position) : std::vector<planning::CollisionShape>{};
-          },
-          [this](const std::string& name, double half_width) {
-            const auto mode = gripper::modeFromString(name);
-            return mode ? gripper::fingertipPositionFor(*adaptive_, *mode, half_width) : 0.0;
-          },
-          [this](const std::string& name) {
-            const auto mode = gripper::modeFromString(name);
-            return mode ? gripper::fingerReachAcross(*adaptive_, *mode) : 0.0;
-          }};
-    }
+    smartmove_config.gripper = gripper_model_.geometry;
+    smartmove_config.finger_link = gripper_model_.finger_link;
     smartmove_ =
         std::make_shared<smartmove::SmartMoveComponent>(*motion_, *arm, *gripper, components().world(), collisions_,
                                                         simulation_->objectClasses(), grasps_, smartmove_config);
@@ -241,64 +207,26 @@ class SimWorkcell final : public Workcell {
     syncFingers();
   }
 
-  /// The fingers' collision shapes at the opening the gripper reads (as the cell sees it, faults
-  /// included); a reading that fails counts as unknown: SmartMove takes the whole stroke.
+  /// The fingers' collision shapes as the gripper reads them (as the cell sees it, faults
+  /// included), set when they moved: the cell's model of where they are, which every motion
+  /// query starts from (SmartMove's say where a motion will have them).
   void syncFingers() {
-    if (adaptive_) {
-      syncAdaptiveFingers();
+    const std::optional<gripper::FingerStance> stance = gripper_model_.read_stance(finger_drivers_);
+    if (!stance || (synced_stance_ && sameStance(*synced_stance_, *stance))) {
       return;
     }
-    double opening = std::numeric_limits<double>::quiet_NaN();
-    try {
-      opening = cell_gripper_driver_->read().opening;
-    } catch (const std::exception&) {
-      // unknown: see syncFingers
+    if (const auto boxes = gripper_model_.geometry->fingerBoxes(*stance)) {
+      collisions_.setLinkShapes(gripper_model_.finger_link, smartmove::fingerShapes(*boxes));
     }
-    smartmove_->syncFingers(opening);
+    synced_stance_ = stance;
   }
 
-  /// The adaptive gripper's fingers in the collision world, as its mode places them: open, or in
-  /// a fingertip mode closed part way as far as its most open closing finger reads (rounded
-  /// down to 1 %, toward open). A reading that fails leaves them as they were (the component
-  /// reports the failure).
-  void syncAdaptiveFingers() {
-    gripper::AdaptiveGripperReading reading;
-    try {
-      reading = simulation_->adaptiveGripper()->read();
-    } catch (const std::exception&) {
-      return;
-    }
-    const auto& mode = adaptive_->mode(reading.mode);
-    double position = 0.0;
-    if (mode.fingertip) {
-      position = 1.0;
-      for (std::size_t i = 0; i < reading.fingers.size(); ++i) {
-        if (mode.closing[i]) {
-          position = std::min(position, reading.fingers[i].position);
-        }
-      }
-      position = std::clamp(std::floor(position * 100.0) / 100.0, 0.0, 0.9);
-    }
-    if (synced_mode_ == reading.mode && synced_position_ == position) {
-      return;
-    }
-    collisions_.setLinkShapes(gripper_model_.finger_link, adaptiveFingerShapes(reading.mode, position));
-    synced_mode_ = reading.mode;
-    synced_position_ = position;
-  }
-
-  /// The adaptive gripper's fingers in `mode` at `position` (0: open), as collision shapes of
-  /// the finger link.
-  std::vector<planning::CollisionShape> adaptiveFingerShapes(gripper::GripperMode mode, double position = 0.0) const {
-    std::vector<planning::CollisionShape> shapes;
-    for (const gripper::OrientedBox& box : gripper::fingerBoxesAt(*adaptive_, mode, position)) {
-      planning::CollisionShape shape;
-      shape.kind = planning::CollisionShape::Kind::kBox;
-      shape.size = box.size;
-      shape.origin = box.pose;
-      shapes.push_back(shape);
-    }
-    return shapes;
+  /// Stances the fingers' shapes need not be set again for: the same mode and position, an
+  /// opening within 0.1 mm.
+  static bool sameStance(const gripper::FingerStance& a, const gripper::FingerStance& b) {
+    const bool same_opening =
+        a.opening.has_value() == b.opening.has_value() && (!a.opening || std::abs(*a.opening - *b.opening) <= 1e-4);
+    return same_opening && a.mode == b.mode && a.position == b.position;
   }
 
   /// A plan's predicate pattern names a declared predicate with the right number of arguments,
@@ -343,7 +271,8 @@ class SimWorkcell final : public Workcell {
   /// The calibration component with the cell's saved calibration (the marker's shipped one
   /// when none was saved).
   std::shared_ptr<calibration::CalibrationComponent> makeCalibration(const WorkcellOptions& options,
-                                                                     arm::ArmComponent& arm,
+                                                                     component::Component& arm,
+                                                                     const world::Pose& tcp_in_flange,
                                                                      camera::RgbdCamera& camera) {
     const std::filesystem::path file =
         !options.calibration.empty()
@@ -363,11 +292,12 @@ class SimWorkcell final : public Workcell {
     config.seed = options.seed.value_or(scene_.seed);
     // The drawings of the gripper.
     config.marker_in_flange_guess = gripper_model_.marker_in_flange_guess;
+    config.tcp_in_flange = tcp_in_flange;
     config.solve.marker_size = sim::Simulation::kGripperMarkerSize;
     config.marker_id = sim::Simulation::kGripperMarkerId;
     config.keep_out = cell_.part_area;
     return std::make_shared<calibration::CalibrationComponent>(
-        arm, collisions_, camera, clock(), simulation_->rgbdNominalPose(), std::move(initial), config);
+        *motion_, arm, camera, clock(), simulation_->rgbdNominalPose(), std::move(initial), config);
   }
   static Eigen::VectorXd toEigen(const sim::ArmJoints& q) { return q.eigen(); }
 
@@ -378,10 +308,8 @@ class SimWorkcell final : public Workcell {
   std::unique_ptr<sim::Simulation> simulation_;
   sim::SimArmDriver arm_driver_;
   sim::SimGripperDriver gripper_driver_;
-  std::optional<gripper::AdaptiveGripperDescription> adaptive_;  // the adaptive gripper's, if it is one
-  std::optional<gripper::GripperMode> synced_mode_;              // its fingers' mode in the collision world
-  double synced_position_ = -1.0;                                // and their position there (0: open)
-  gripper::GripperDriver* cell_gripper_driver_ = nullptr;        // the 2-finger's, as the cell uses it (faults)
+  GripperDrivers finger_drivers_;                       // what the cell reads the fingers from
+  std::optional<gripper::FingerStance> synced_stance_;  // the fingers' stance in the collision world
   sim::SimRgbdCamera camera_;
   planning::RobotModel robot_;
   planning::CollisionWorld collisions_;

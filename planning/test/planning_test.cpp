@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <thread>
+
 #include <random>
 
 #include "core/paths.h"
@@ -80,6 +82,16 @@ TEST(RobotModel, NumericInverseKinematicsReachesReachablePoses) {
 
 class Collisions : public ::testing::Test {
  protected:
+  /// Two 26 x 8 x 40 mm finger pads whose inner faces are `opening` apart, 14 cm along the tool.
+  static std::vector<CollisionShape> pads(double opening) {
+    std::vector<CollisionShape> shapes(2);
+    for (int side = 0; side < 2; ++side) {
+      shapes[side].size = {0.026, 0.008, 0.04};
+      shapes[side].origin = world::Pose(Eigen::Translation3d(0, (side == 0 ? 1 : -1) * (opening / 2 + 0.004), 0.14));
+    }
+    return shapes;
+  }
+
   Collisions() : robot(ur5()), world(robot, kBaseInWorld, {}, {kHome}) {
     // The table: top at z = 0.
     world.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
@@ -150,14 +162,6 @@ TEST_F(Collisions, ALinksShapesCanBeReplacedAndPutBack) {
   const std::vector<CollisionShape> travel = world.linkShapes("fingers");
   ASSERT_EQ(travel.size(), 1u);
   // Two 8 mm pads 40 mm apart (their inner faces) miss it; 80 mm apart they reach it.
-  const auto pads = [](double opening) {
-    std::vector<CollisionShape> shapes(2);
-    for (int side = 0; side < 2; ++side) {
-      shapes[side].size = {0.026, 0.008, 0.04};
-      shapes[side].origin = world::Pose(Eigen::Translation3d(0, (side == 0 ? 1 : -1) * (opening / 2 + 0.004), 0.14));
-    }
-    return shapes;
-  };
   world.setLinkShapes("fingers", pads(0.04));
   EXPECT_FALSE(world.check(kHome).has_value());
   world.setLinkShapes("fingers", pads(0.08));
@@ -168,6 +172,73 @@ TEST_F(Collisions, ALinksShapesCanBeReplacedAndPutBack) {
   EXPECT_TRUE(world.check(kHome).has_value());
   EXPECT_THROW(world.setLinkShapes("tcp", {}), std::invalid_argument);  // a link without shapes
   EXPECT_THROW(world.linkShapes("gripper"), std::invalid_argument);
+}
+
+TEST_F(Collisions, AQueryCarriesItsSceneAndLeavesTheWorldAsItWas) {
+  // The fingers at an opening, a keep-out box and a part left out, each for one query only.
+  const world::Pose tcp = kBaseInWorld * robot.forward(kHome);
+  world.setBox("block", tcp * Eigen::Translation3d(0, 0.05, 0), {0.02, 0.02, 0.02});
+  QueryScene narrow;
+  narrow.link_shapes = {{"fingers", pads(0.04)}};
+  EXPECT_FALSE(world.check(kHome, narrow).has_value());
+  EXPECT_EQ(world.check(kHome)->str(), "fingers would touch block");  // the world's fingers as they were
+  EXPECT_EQ(world.linkShapes("fingers").size(), 1u);
+
+  QueryScene without_block;
+  without_block.removed = {"block"};
+  EXPECT_FALSE(world.check(kHome, without_block).has_value());
+  EXPECT_EQ(world.obstacleNames(), (std::vector<std::string>{"block", "table"}));
+
+  // An obstacle of its own is reported by its name, in name order with the world's.
+  QueryScene keep_out;
+  keep_out.removed = {"block"};
+  keep_out.obstacles = {{"a_keep_out", tcp, {0.1, 0.1, 0.1}}};
+  const auto contact = world.check(kHome, keep_out);
+  ASSERT_TRUE(contact.has_value());
+  EXPECT_EQ(contact->other, "a_keep_out");
+  EXPECT_EQ(world.obstacleNames(), (std::vector<std::string>{"block", "table"}));
+
+  // A prepared query answers the same as one made per configuration, and plans see the scene.
+  CollisionWorld::Query prepared = world.query(narrow);
+  EXPECT_FALSE(prepared.check(kHome).has_value());
+  EXPECT_FALSE(prepared.checkSegment(kHome, kHome).has_value());
+  EXPECT_FALSE(planPath(world, kHome, kHome).ok());
+  EXPECT_TRUE(planPath(world, kHome, kHome, {}, narrow).ok());
+  QueryScene unknown_link;
+  unknown_link.link_shapes = {{"gripper", pads(0.04)}};
+  EXPECT_THROW(world.query(unknown_link), std::invalid_argument);
+}
+
+TEST_F(Collisions, QueriesOnSeveralThreadsAgreeWithOneThread) {
+  // Queries place their own copies of the robot's shapes: two threads checking different
+  // configurations at once get what one thread gets.
+  const world::Pose tcp = kBaseInWorld * robot.forward(kHome);
+  world.setBox("part_1", tcp, {0.05, 0.05, 0.05});
+  std::vector<Eigen::VectorXd> configurations;
+  for (int k = 0; k < 40; ++k) {
+    Eigen::VectorXd q = kHome;
+    q[0] += 0.05 * k;
+    q[1] -= 0.02 * k;
+    configurations.push_back(q);
+  }
+  std::vector<std::string> alone(configurations.size());
+  for (std::size_t k = 0; k < configurations.size(); ++k) {
+    const auto contact = world.check(configurations[k]);
+    alone[k] = contact ? contact->str() : "free";
+  }
+  std::vector<std::string> together(configurations.size());
+  const auto work = [&](std::size_t first) {
+    for (int round = 0; round < 20; ++round) {
+      for (std::size_t k = first; k < configurations.size(); k += 2) {
+        const auto contact = world.check(configurations[k]);
+        together[k] = contact ? contact->str() : "free";
+      }
+    }
+  };
+  std::thread other(work, 1);
+  work(0);
+  other.join();
+  EXPECT_EQ(together, alone);
 }
 
 /// The tool over the table at 25 cm, swung to the left or right by the shoulder pan.

@@ -25,7 +25,7 @@ using component::OperationState;
 /// Encoders that read where the (remote) arm was last sent.
 class Encoders final : public arm::ArmDriver {
  public:
-  explicit Encoders(arm::JointVector q) : q(q) {}
+  explicit Encoders(arm::JointVector at) : q(at) {}
   arm::ArmState read() const override { return {q, {}}; }
   void execute(std::shared_ptr<const arm::JointTrajectory>, TimePoint) override {}
   arm::JointVector q;
@@ -114,6 +114,7 @@ class RecordingMotion final : public arm::MotionService {
   struct Query {
     std::string kind;
     bool part_allowed = false;  // the gripper may touch node_0
+    std::vector<std::pair<std::string, std::vector<planning::CollisionShape>>> link_shapes;  // the scene's
   };
   RecordingMotion(const arm::MotionService& inner, std::string gripper_link)
       : inner_(inner), gripper_link_(std::move(gripper_link)) {}
@@ -124,31 +125,30 @@ class RecordingMotion final : public arm::MotionService {
   std::vector<arm::JointVector> solutions(const world::Pose& tcp, const arm::JointVector& seed) const override {
     return inner_.solutions(tcp, seed);
   }
-  std::optional<planning::Contact> collision(const arm::JointVector& q,
-                                             const arm::AllowedContacts& allowed) const override {
-    return inner_.collision(q, allowed);
+  std::optional<planning::Contact> collision(const arm::JointVector& q, const arm::QueryScene& scene) const override {
+    return inner_.collision(q, scene);
   }
   arm::MotionPlan planToJoints(const arm::JointVector& from, const arm::JointVector& goal, double speed,
-                               const arm::AllowedContacts& allowed) const override {
-    record("joints", allowed);
-    return inner_.planToJoints(from, goal, speed, allowed);
+                               const arm::QueryScene& scene) const override {
+    record("joints", scene);
+    return inner_.planToJoints(from, goal, speed, scene);
   }
   arm::MotionPlan planLine(const arm::JointVector& from, const world::Pose& tcp, double speed,
-                           const arm::AllowedContacts& allowed) const override {
-    record("line", allowed);
-    return inner_.planLine(from, tcp, speed, allowed);
+                           const arm::QueryScene& scene) const override {
+    record("line", scene);
+    return inner_.planLine(from, tcp, speed, scene);
   }
   arm::MotionPlan planToPose(const arm::JointVector& from, const world::Pose& tcp, double speed,
-                             const arm::AllowedContacts& allowed) const override {
-    record("pose", allowed);
-    return inner_.planToPose(from, tcp, speed, allowed);
+                             const arm::QueryScene& scene) const override {
+    record("pose", scene);
+    return inner_.planToPose(from, tcp, speed, scene);
   }
 
   mutable std::vector<Query> queries;
 
  private:
-  void record(const char* kind, const arm::AllowedContacts& allowed) const {
-    queries.push_back({kind, allowed.contains(gripper_link_, partObstacle("node_0"))});
+  void record(const char* kind, const arm::QueryScene& scene) const {
+    queries.push_back({kind, scene.allowed.contains(gripper_link_, partObstacle("node_0")), scene.link_shapes});
   }
   const arm::MotionService& inner_;
   std::string gripper_link_;
@@ -261,22 +261,41 @@ TEST_F(SmartMoveMotion, AGraspThatNeedsAModeIsPlannedWithThatModesFingersAndSets
   SmartMoveConfig config = smartmoveConfig();
   config.finger_link = "wrist_3_link";  // a link of the arm-only model with shapes
   // Pinch's fingers, here a slab 80 cm thick round the wrist: at every candidate it would be in
-  // the table.
-  planning::CollisionShape slab;
-  slab.size = Eigen::Vector3d(1.0, 1.0, 0.8);
-  // Closed part way, they would be clear (a 1 cm cube); here they cannot close part way.
-  planning::CollisionShape small;
-  small.size = Eigen::Vector3d(0.01, 0.01, 0.01);
+  // the table. Closed part way, they would be clear (a 1 cm cube); at first they cannot close
+  // part way.
   double part_way = 0.0;
   bool closing_hits = false;  // the fingers closed part way would be the slab instead
-  config.mode_fingers = SmartMoveConfig::ModeFingers{
-      [&](const std::string& mode, double position) {
-        if (mode != "pinch") {
-          return std::vector<planning::CollisionShape>{};
-        }
-        return std::vector<planning::CollisionShape>{(position > 0.0) != closing_hits ? small : slab};
-      },
-      [&](const std::string&, double) { return part_way; }};
+  /// Fingers modelled in Pinch only, that close part way to `part_way` in any mode.
+  class ModedFingers final : public gripper::GripperGeometry {
+   public:
+    ModedFingers(const double& part_way, const bool& closing_hits) : part_way_(part_way), closing_hits_(closing_hits) {}
+    std::optional<std::vector<gripper::OrientedBox>> fingerBoxes(const gripper::FingerStance& stance) const override {
+      if (stance.mode != "pinch") {
+        return std::nullopt;
+      }
+      gripper::OrientedBox box;
+      box.size = (stance.position > 0.0) != closing_hits_ ? Eigen::Vector3d(0.01, 0.01, 0.01)  // small, clear
+                                                          : Eigen::Vector3d(1.0, 1.0, 0.8);    // the slab
+      return std::vector<gripper::OrientedBox>{box};
+    }
+    std::optional<double> stroke() const override { return std::nullopt; }
+    std::optional<double> graspOpening(double, double) const override { return 0.0; }
+    bool plansMode(const std::string& mode) const override { return !mode.empty(); }
+    double fingertipPosition(const std::string&, double) const override { return part_way_; }
+    std::optional<double> reachAcross(const std::string&) const override { return std::nullopt; }
+    Eigen::Vector2d closedHalfExtent() const override { return {0.015, 0.015}; }
+    void openTo(const gripper::FingerStance& stance, component::ParamMap& params) const override {
+      if (stance.position > 0.0) {
+        params["position"] = stance.position;
+      }
+    }
+    std::vector<std::string> modes() const override { return {"pinch", "wide"}; }
+
+   private:
+    const double& part_way_;
+    const bool& closing_hits_;
+  };
+  config.gripper = std::make_shared<ModedFingers>(part_way, closing_hits);
   const std::size_t shapes_before = collisions.linkShapes(config.finger_link).size();
   SmartMoveComponent moded(motion, remote, gripper, world, collisions,
                            world::loadObjectClasses(dataRoot() / "data/objects"), library, config);
@@ -305,7 +324,17 @@ TEST_F(SmartMoveMotion, AGraspThatNeedsAModeIsPlannedWithThatModesFingersAndSets
   part_way = 0.3;
   gripper.modes.clear();
   gripper.openings.clear();
+  motion.queries.clear();
   const auto taken = moded.start("SmartGrasp", params("SmartGrasp", {{"object_class", "node"}, {"grasp", "pinched"}}));
+  // Every plan of the choice carried the fingers as the grasp has them in its own scene; the
+  // collision world's fingers are as they were.
+  ASSERT_FALSE(motion.queries.empty());
+  for (const auto& query : motion.queries) {
+    ASSERT_EQ(query.link_shapes.size(), 1u) << query.kind;
+    EXPECT_EQ(query.link_shapes[0].first, config.finger_link);
+    EXPECT_DOUBLE_EQ(query.link_shapes[0].second.at(0).size.x(), 0.01);
+  }
+  EXPECT_EQ(collisions.linkShapes(config.finger_link).size(), shapes_before);
   ASSERT_EQ(moded.poll(taken).state, OperationState::kRunning);
   EXPECT_EQ(gripper.modes, std::vector<std::string>{"pinch"});
   EXPECT_EQ(gripper.openings, (std::vector<double>{0.0, 0.3}));
@@ -333,8 +362,8 @@ TEST_F(SmartMoveMotion, APartSeenAgainFarFromWhereItWasPutIsMisplacedUntilItIsGr
       if (result.state != OperationState::kRunning) {
         return result;
       }
-      for (auto& motion : remote.motions) {
-        motion->finished = true;
+      for (auto& sent : remote.motions) {
+        sent->finished = true;
       }
     }
     return OperationResult::failure("did not end");
