@@ -119,40 +119,36 @@ PerceptionComponent::PerceptionComponent(camera::RgbdCamera& camera, const Clock
       config_(std::move(config)),
       pipeline_(std::move(pipeline)),
       persistence_(classesOf(*pipeline_), config_.persistence) {
-  description_.name = config_.name;
-  description_.type = "CostarPerception";
-  description_.inputs = {"rgbd_frames"};
-  description_.outputs = {"detections"};
+  component::ComponentDescription description;
+  description.name = config_.name;
+  description.type = "CostarPerception";
+  description.inputs = {"rgbd_frames"};
+  description.outputs = {"detections"};
   ParamSpec frames{"frames", ValueType::kInt,
                    "frames to capture at the camera's rate; their per-pixel median is processed",
                    static_cast<long long>(config_.frames)};
   frames.min = 1;
   frames.max = 60;
-  description_.operations = {
-      {"DetectObjects",
-       "Looks at the workspace with the RGB-D camera and updates the known objects: a frame symbol per object "
-       "(names kept across detections), is_a(object, class) and visible(object).",
-       {frames},
-       component::OperationKind::kKnowledge}};
+  component::OperationTable operations;
+  operations.add({"DetectObjects",
+                  "Looks at the workspace with the RGB-D camera and updates the known objects: a frame symbol per "
+                  "object (names kept across detections), is_a(object, class) and visible(object).",
+                  {frames},
+                  component::OperationKind::kKnowledge},
+                 [this](const component::ParamMap& params) {
+                   const auto it = params.find("frames");
+                   const int count = it != params.end() ? static_cast<int>(it->second.asInt()) : config_.frames;
+                   return std::make_unique<DetectObjectsOperation>(*this, std::clamp(count, 1, 60));
+                 });
   for (const auto& model : pipeline_->models()) {
-    description_.symbols.push_back({model.name(), world::SymbolKind::kObjectClass,
-                                    "object class " + model.name() + ": " + model.object_class.description});
+    description.symbols.push_back({model.name(), world::SymbolKind::kObjectClass,
+                                   "object class " + model.name() + ": " + model.object_class.description});
   }
-  description_.symbols.push_back({"<class>_<n>", world::SymbolKind::kFrame,
-                                  "a detected object's frame in the world (e.g. node_3), canonical orientation"});
-  description_.predicates = {{"is_a", 2, "is_a(object, class): the detected object is of that class"},
-                             {"visible", 1, "visible(object): the latest DetectObjects saw the object"}};
-}
-
-std::unique_ptr<component::RunningOperation> PerceptionComponent::begin(const std::string& operation,
-                                                                        const component::ParamMap& params) {
-  if (operation != "DetectObjects") {
-    return std::make_unique<component::FinishedOperation>(
-        OperationResult::failure(operation + ": not an operation of the perception component"));
-  }
-  const auto it = params.find("frames");
-  const int frames = it != params.end() ? static_cast<int>(it->second.asInt()) : config_.frames;
-  return std::make_unique<DetectObjectsOperation>(*this, std::clamp(frames, 1, 60));
+  description.symbols.push_back({"<class>_<n>", world::SymbolKind::kFrame,
+                                 "a detected object's frame in the world (e.g. node_3), canonical orientation"});
+  description.predicates = {{"is_a", 2, "is_a(object, class): the detected object is of that class"},
+                            {"visible", 1, "visible(object): the latest DetectObjects saw the object"}};
+  declare(std::move(description), std::move(operations));
 }
 
 OperationResult PerceptionComponent::process(const std::vector<camera::RgbdFrame>& frames) {

@@ -28,7 +28,7 @@
 #include <optional>
 
 #include "camera/rgbd.h"
-#include "component/component.h"
+#include "component/operation_table.h"
 #include "core/clock.h"
 #include "perception/persistence.h"
 #include "perception/pipeline.h"
@@ -63,7 +63,7 @@ struct PerceptionConfig {
 /// (one detection at a time). @throws std::runtime_error naming a missing or inconsistent file.
 std::shared_ptr<Pipeline> loadPipeline(const PerceptionConfig& config);
 
-class PerceptionComponent final : public component::LocalComponent {
+class PerceptionComponent final : public component::TableComponent {
  public:
   /// Loads the pipeline's data files. The camera and clock must outlive the component.
   /// @throws std::runtime_error naming a missing or inconsistent file.
@@ -73,7 +73,6 @@ class PerceptionComponent final : public component::LocalComponent {
   PerceptionComponent(camera::RgbdCamera& camera, const Clock& clock, std::shared_ptr<Pipeline> pipeline,
                       PerceptionConfig config = {});
 
-  const component::ComponentDescription& description() const override { return description_; }
   world::Report report() const override;
 
   /// The objects known after the latest detection (names, classes, world poses).
@@ -84,14 +83,11 @@ class PerceptionComponent final : public component::LocalComponent {
 
  private:
   friend class DetectObjectsOperation;
-  std::unique_ptr<component::RunningOperation> begin(const std::string& operation,
-                                                     const component::ParamMap& params) override;
   /// @throws std::runtime_error naming what is wrong when the camera's stream is not healthy.
   void checkCamera() const;
   /// Runs the pipeline on `frames` and updates the state; returns the operation's result.
   component::OperationResult process(const std::vector<camera::RgbdFrame>& frames);
 
-  component::ComponentDescription description_;
   camera::RgbdCamera& camera_;
   const Clock& clock_;
   PerceptionConfig config_;

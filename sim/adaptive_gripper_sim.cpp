@@ -134,6 +134,9 @@ SimAdaptiveGripper::SimAdaptiveGripper(mjModel_* model, mjData_* data, gripper::
 }
 
 void SimAdaptiveGripper::applyMode() {
+  // The fingertip locks are equality constraints switched on and off: MuJoCo 2.2.2 keeps that
+  // switch in mjModel only (mjData::eq_active comes with 3.0). The model is this simulation's
+  // own (each Simulation loads one), so nothing outside it changes.
   const bool fingertip = description_.mode(mode_).fingertip;
   for (const int lock : fingertip_locks_) {
     model_->eq_active[lock] = fingertip ? 1 : 0;
@@ -219,6 +222,8 @@ void SimAdaptiveGripper::commandFingers(const std::array<double, kFingerCount>& 
     // A new command starts from where the finger is (not from the previous setpoint).
     finger.setpoint = std::clamp(position(finger), 0.0, 1.0);
     finger.target = std::clamp(positions[i], 0.0, 1.0);
+    // The commanded force limit: MuJoCo 2.2.2 clamps an actuator's force by mjModel's range
+    // only (no mjData counterpart); the model is this simulation's own.
     model_->actuator_forcerange[2 * finger.actuator] = -torque;
     model_->actuator_forcerange[2 * finger.actuator + 1] = torque;
   }

@@ -539,6 +539,8 @@ void Simulation::commandFingers(double opening, double speed, double force) {
   impl_->finger_target = std::clamp(opening, 0.0, kMaxOpening) / 2.0;
   impl_->finger_speed = std::max(speed, 1e-3) / 2.0;
   const double limit = std::clamp(force, 1.0, 200.0);
+  // The grip force limit: MuJoCo 2.2.2 clamps an actuator's force by mjModel's range only (no
+  // mjData counterpart); the model is this simulation's own (each Simulation loads one).
   impl_->model->actuator_forcerange[2 * impl_->finger_actuator] = -limit;
   impl_->model->actuator_forcerange[2 * impl_->finger_actuator + 1] = limit;
 }
