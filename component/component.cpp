@@ -4,18 +4,18 @@
 
 namespace costar::component {
 
-const ParamSpec* OperationSpec::param(std::string_view name) const {
+const ParamSpec* OperationSpec::param(std::string_view param_name) const {
   for (const auto& spec : params) {
-    if (spec.name == name) {
+    if (spec.name == param_name) {
       return &spec;
     }
   }
   return nullptr;
 }
 
-const OperationSpec* ComponentDescription::operation(std::string_view name) const {
+const OperationSpec* ComponentDescription::operation(std::string_view operation_name) const {
   for (const auto& spec : operations) {
-    if (spec.name == name) {
+    if (spec.name == operation_name) {
       return &spec;
     }
   }

@@ -214,13 +214,13 @@ AdaptiveGripper::AdaptiveGripper(AdaptiveGripperDriver& driver, const Clock& clo
         std::array<double, kFingerCount> targets{};
         if (part_way > 0.0) {
           const AdaptiveGripperReading reading = checkedRead();
-          const AdaptiveModeDescription& mode = gripper_.mode(reading.mode);
-          if (!mode.fingertip) {
+          const AdaptiveModeDescription& current = gripper_.mode(reading.mode);
+          if (!current.fingertip) {
             throw std::invalid_argument("Open to " + percent(part_way) + " closed: only in a fingertip mode (pinch); " +
                                         "the gripper is in " + std::string(toString(reading.mode)) + " mode");
           }
           for (std::size_t i = 0; i < targets.size(); ++i) {
-            targets[i] = mode.closing[i] ? part_way : 0.0;
+            targets[i] = current.closing[i] ? part_way : 0.0;
           }
         }
         return std::make_unique<FingerMotion>(*this, driver_, clock_, targets, params.at("speed").asDouble(),

@@ -231,7 +231,7 @@ INSTANTIATE_TEST_SUITE_P(Ur5, PaperTask,
                          ::testing::Values(std::make_pair("pick_up_node", "lift"),
                                            std::make_pair("move_nodes_right_to_left", "right_to_left"),
                                            std::make_pair("assemble_structure", "assembly")),
-                         [](const auto& info) { return std::string(info.param.first); });
+                         [](const auto& test_info) { return std::string(test_info.param.first); });
 
 /// Assembly trials that failed on 6a7916a for a reason fixed since, each its own seed.
 struct FixedTrial {
@@ -276,7 +276,7 @@ INSTANTIATE_TEST_SUITE_P(Assembly, FixedAssemblyTrial,
                              // All of it labelled node (no link cluster at all): the ~1,000 points the base node's
                              // detection leaves, all 5 cm above the table, are searched as a link cluster.
                              FixedTrial{"LinkAcrossTheBaseNodeAllLabelledNodeIsFound", "iiwa-3f-sim", 2446}),
-                         [](const auto& info) { return std::string(info.param.name); });
+                         [](const auto& test_info) { return std::string(test_info.param.name); });
 
 /// Speed work on the camera and the physics must not change what happens in a trial. Seeds 1
 /// and 2 of the assembly, recorded with the build before the camera was made faster (commit
