@@ -98,7 +98,7 @@ void acquireDisplay(SharedDisplay& shared) {
 /// One user fewer. The display stays initialized when the last goes, for the next renderer and
 /// until the process ends: Mesa keeps about 23 kB of every eglInitialize that eglTerminate does
 /// not give back, which a trial loop (a renderer per trial, one at a time) paid once per trial
-/// (docs/BENCHMARKS.md, the soak). The caller holds the mutex.
+/// (docs/BENCHMARKS_HISTORY.md, the soak). The caller holds the mutex.
 void releaseDisplay(SharedDisplay& shared) { --shared.users; }
 
 }  // namespace

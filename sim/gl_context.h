@@ -40,7 +40,7 @@ class GlRenderer {
   /// only depth is rendered (flat, no shadows: faster, the same depth). Shadows are cast only
   /// in a colour picture without depth (a view for people): a camera frame (colour and depth)
   /// is lit without them, which takes 60 % of a colour frame's render CPU off and leaves
-  /// DetectObjects' results as they were (docs/BENCHMARKS.md, issue 13). Not for two threads
+  /// DetectObjects' results as they were (docs/BENCHMARKS_HISTORY.md, issue 13). Not for two threads
   /// at once on one renderer.
   void render(const mjModel* model, mjData* data, int camera_id, int width, int height, RgbImage* rgb,
               std::vector<float>* depth);

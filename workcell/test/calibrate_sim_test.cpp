@@ -3,7 +3,7 @@
 // from its drawn mounting without touching the parts on the table (it knows none of them yet:
 // the camera is not calibrated), and the camera is found within the 2 mm / 0.2 deg.
 // The seeds are set-ups where Calibrate's arm used to sweep through the parts (seed 500: a
-// part pushed 81 mm; iiwa seed 31: docs/BENCHMARKS.md, "Calibration").
+// part pushed 81 mm; iiwa seed 31: docs/BENCHMARKS_HISTORY.md, "Calibration").
 
 #include <gtest/gtest.h>
 
