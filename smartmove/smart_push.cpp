@@ -92,7 +92,8 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginPush(const component:
   const arm::QueryScene clear = scene({}, closed);
   nlohmann::json tried = nlohmann::json::array();
   for (const auto& [room_now, entry] : order) {
-    const auto& [object, pose] = entry;
+    const std::string& object = entry.first;
+    const world::Pose& pose = entry.second;
     std::vector<std::pair<Room, double>> directions;  // room after the push, angle
     for (int k = 0; k < kDirections; ++k) {
       const double angle = 2.0 * std::numbers::pi * k / kDirections;

@@ -183,12 +183,13 @@ std::optional<std::string> SmartMoveComponent::misplacedPart() const {
   // by where it is: the nearest of its class to where it was put, among those seen where none was.
   std::optional<std::pair<std::string, double>> nearest;
   for (const auto& [object, pose] : matching(put_->object_class, {}).objects) {
+    const Eigen::Vector3d seen = pose.translation();
     if (std::any_of(put_->known.begin(), put_->known.end(), [&](const Eigen::Vector3d& known) {
-          return (known - pose.translation()).norm() <= config_.misplaced_distance;
+          return (known - seen).norm() <= config_.misplaced_distance;
         })) {
       continue;
     }
-    const double distance = (pose.translation() - put_->pose.translation()).norm();
+    const double distance = (seen - put_->pose.translation()).norm();
     if (!nearest || distance < nearest->second) {
       nearest = {object, distance};
     }
