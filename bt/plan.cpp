@@ -5,7 +5,8 @@ namespace costar::bt {
 std::string toString(const SourceLocation& where) {
   std::string text = where.file.empty() ? "<plan>" : where.file;
   if (where.line > 0) {
-    text += ":" + std::to_string(where.line);
+    text += ':';
+    text += std::to_string(where.line);
   }
   return text;
 }
@@ -17,7 +18,10 @@ namespace {
 std::string joinDiagnostics(const std::vector<Diagnostic>& diagnostics) {
   std::string text;
   for (const auto& diagnostic : diagnostics) {
-    text += (text.empty() ? "" : "\n") + diagnostic.str();
+    if (!text.empty()) {
+      text += '\n';
+    }
+    text += diagnostic.str();
   }
   return text;
 }
@@ -77,9 +81,11 @@ std::string Plan::mainTreeId() const {
   if (file.trees.size() == 1) {
     return file.trees.front().id;
   }
-  throw PlanError({{{file.path, 0},
-                    file.trees.empty() ? "the file defines no BehaviorTree"
-                                       : "the file defines several BehaviorTrees but no main_tree_to_execute"}});
+  Diagnostic problem;
+  problem.where = {file.path, 0};
+  problem.message = file.trees.empty() ? "the file defines no BehaviorTree"
+                                       : "the file defines several BehaviorTrees but no main_tree_to_execute";
+  throw PlanError({std::move(problem)});
 }
 
 bool sameContent(const PlanNode& a, const PlanNode& b) {
