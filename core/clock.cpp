@@ -1,9 +1,23 @@
 #include "core/clock.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 namespace costar {
+
+Duration checkedDuration(double seconds, std::string_view what) {
+  // NaN fails every comparison: the condition is written so that it fails this one.
+  if (!(seconds >= 0.0 && seconds <= kMaxDurationSeconds)) {
+    char text[160];
+    std::snprintf(text, sizeof text, ": must be a number of seconds from 0 to %g, not %g", kMaxDurationSeconds,
+                  seconds);
+    throw std::invalid_argument(std::string(what) + text);
+  }
+  return fromSeconds(seconds);
+}
 
 RealClock::RealClock() : start_(std::chrono::steady_clock::now()) {}
 

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <mutex>
+#include <string_view>
 #include <vector>
 
 namespace costar {
@@ -20,6 +21,16 @@ using TimePoint = std::chrono::time_point<ClockEpoch, Duration>;
 inline double toSeconds(Duration d) { return std::chrono::duration<double>(d).count(); }
 inline double toSeconds(TimePoint t) { return toSeconds(t.time_since_epoch()); }
 inline Duration fromSeconds(double s) { return std::chrono::duration_cast<Duration>(std::chrono::duration<double>(s)); }
+
+/// The longest duration a person may give (an option, a fault's moment): 1e9 s, about 31 years.
+/// Durations hold about 292 years; the margin keeps a moment plus such a duration in range.
+inline constexpr double kMaxDurationSeconds = 1e9;
+
+/// A number of seconds a person gave (`what`: "--time-limit") as a Duration, checked: NaN,
+/// infinite, negative and above kMaxDurationSeconds are refused, as fromSeconds would overflow
+/// (1e10 s became -9.2e9 s) or make a NaN mean something.
+/// @throws std::invalid_argument "WHAT: must be a number of seconds from 0 to 1e+09, not X".
+Duration checkedDuration(double seconds, std::string_view what);
 
 /// A source of time. Implementations are thread-safe for now(); sleepUntil() is called by
 /// one thread (the executor's).

@@ -2,7 +2,9 @@
 
 #include <png.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -24,7 +26,7 @@ void writePng(const std::filesystem::path& path, const RgbImage& image) {
   }
   std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "wb"));
   if (!file) {
-    throw std::runtime_error("cannot create '" + path.string() + "'");
+    throw std::runtime_error("cannot write '" + path.string() + "': " + std::strerror(errno));
   }
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
@@ -32,9 +34,13 @@ void writePng(const std::filesystem::path& path, const RgbImage& image) {
     png_destroy_write_struct(&png, &info);
     throw std::runtime_error("libpng could not start writing '" + path.string() + "'");
   }
+  errno = 0;
   if (setjmp(png_jmpbuf(png))) {
+    // libpng stops at a failed fwrite ("Write Error"): errno says why.
+    const int error = errno;
     png_destroy_write_struct(&png, &info);
-    throw std::runtime_error("libpng failed writing '" + path.string() + "'");
+    throw std::runtime_error("cannot write '" + path.string() +
+                             "': " + (error != 0 ? std::strerror(error) : "libpng failed"));
   }
   png_init_io(png, file.get());
   png_set_IHDR(png, info, static_cast<png_uint_32>(image.width), static_cast<png_uint_32>(image.height), 8,
@@ -45,6 +51,12 @@ void writePng(const std::filesystem::path& path, const RgbImage& image) {
   }
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
+  // The stream's buffer holds the end of the image: a full disk shows only when it is written.
+  const bool flushed = std::fflush(file.get()) == 0 && std::ferror(file.get()) == 0;
+  const int error = errno;
+  if (std::fclose(file.release()) != 0 || !flushed) {
+    throw std::runtime_error("cannot write '" + path.string() + "': " + std::strerror(flushed ? errno : error));
+  }
 }
 
 RgbImage readPng(const std::filesystem::path& path) {

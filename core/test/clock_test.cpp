@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace costar {
@@ -45,6 +49,22 @@ TEST(RealClock, SleepsAtLeastUntilTheDeadline) {
   clock.sleepUntil(deadline);
   EXPECT_GE(clock.now(), deadline);
   EXPECT_FALSE(clock.simulated());
+}
+
+TEST(CheckedDuration, RefusesNanInfiniteNegativeAndOverflowingSecondsNamingTheOption) {
+  for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity(), -1.0, 1e10, 1e308}) {
+    try {
+      checkedDuration(bad, "--time-limit");
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.rfind("--time-limit: must be a number of seconds from 0 to 1e+09, not ", 0), 0u) << message;
+      EXPECT_LT(message.size(), 100u) << "numbers are printed short: " << message;
+    }
+  }
+  EXPECT_EQ(checkedDuration(2.5, "t"), 2500ms);
+  EXPECT_EQ(checkedDuration(1e9, "t"), std::chrono::seconds(1000000000));
+  EXPECT_EQ(checkedDuration(0.0, "t"), 0ns);
 }
 
 }  // namespace

@@ -35,5 +35,17 @@ TEST(Png, ErrorsNameTheFile) {
   EXPECT_THROW(readPng("/nonexistent.png"), std::runtime_error);
 }
 
+TEST(Png, APictureOnAFullDiskIsAnErrorNotAFileWritten) {
+  // /dev/full takes the open and fails every write: small images fail only at the close.
+  for (const int size : {2, 600}) {
+    try {
+      writePng("/dev/full", RgbImage(size, size));
+      ADD_FAILURE() << size << " px: no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), "cannot write '/dev/full': No space left on device") << size << " px";
+    }
+  }
+}
+
 }  // namespace
 }  // namespace costar
