@@ -3,16 +3,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <random>
-#include <sstream>
 #include <stdexcept>
 
 #include "arm/waypoints.h"
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
+#include "core/clock.h"
+#include "core/files.h"
+#include "core/json_file.h"
 #include "core/parallel.h"
 #include "core/paths.h"
 #include "faults/injector.h"
@@ -22,13 +23,6 @@
 namespace costar::faults {
 
 namespace {
-
-std::string readAll(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 double largestSpeed(const sim::Simulation& simulation) {
   double largest = 0.0;
@@ -112,8 +106,8 @@ FaultTrial runOne(const CampaignOptions& options, const CampaignTask& task, cons
     }
     trial.final_speed = simulation != nullptr ? largestSpeed(*simulation) : 0.0;
     if (!options.waypoints.empty()) {
-      trial.waypoints_intact = readAll(options.waypoints) == waypoints_before;
       try {
+        trial.waypoints_intact = readFile(options.waypoints) == waypoints_before;
         arm::WaypointStore(options.waypoints, /*persist=*/false).all();
       } catch (const std::exception&) {
         trial.waypoints_intact = false;
@@ -192,8 +186,39 @@ std::vector<std::string> testCellFaults() {
   return faults;
 }
 
+void checkOptions(const CampaignOptions& options) {
+  if (options.count < 1) {
+    throw std::invalid_argument("-n: the number of runs must be at least 1, not " + std::to_string(options.count));
+  }
+  if (options.jobs < 1) {
+    throw std::invalid_argument("--jobs: must be at least 1, not " + std::to_string(options.jobs));
+  }
+  if (options.tasks.empty()) {
+    throw std::invalid_argument("no plan to run");
+  }
+  checkedDuration(options.window_s, "--window");
+  checkedDuration(options.deadline_s, "deadline");
+  checkedDuration(options.settle_s, "settle time");
+  checkedDuration(options.time_limit_s, "time limit");
+  const auto positive = [](double value, const char* what) {
+    if (!(value > 0.0) || !std::isfinite(value)) {
+      char text[160];
+      std::snprintf(text, sizeof text, "%s: must be a finite number above 0, not %g", what, value);
+      throw std::invalid_argument(text);
+    }
+  };
+  positive(options.window_s, "--window");
+  positive(options.time_limit_s, "time limit");
+  positive(options.rest_speed, "rest speed");
+  if (options.frames_per_detection < 1) {
+    throw std::invalid_argument("frames per detection: must be at least 1, not " +
+                                std::to_string(options.frames_per_detection));
+  }
+}
+
 CampaignSummary runCampaign(const CampaignOptions& options,
                             const std::function<void(const FaultTrial&, int)>& progress) {
+  checkOptions(options);
   const std::vector<std::string> faults = !options.faults.empty()      ? options.faults
                                           : options.workcell == "test" ? testCellFaults()
                                                                        : allFaults();
@@ -212,7 +237,7 @@ CampaignSummary runCampaign(const CampaignOptions& options,
     if (!std::filesystem::exists(options.waypoints)) {
       throw std::runtime_error("waypoint file '" + options.waypoints.string() + "' does not exist");
     }
-    waypoints_before = readAll(options.waypoints);
+    waypoints_before = readFile(options.waypoints);
   }
   CampaignSummary summary;
   summary.options = options;
@@ -232,24 +257,130 @@ CampaignSummary runCampaign(const CampaignOptions& options,
   return summary;
 }
 
+nlohmann::json FaultTrial::toJson() const {
+  return {{"index", index},
+          {"seed", seed},
+          {"task", task},
+          {"fault", fault},
+          {"outcome", outcome},
+          {"failure_path", failure_path},
+          {"reason", reason},
+          {"due_s", due_s},
+          {"effect_s", effect_s},
+          {"end_s", end_s},
+          {"latency_s", latency_s},
+          {"rest_after_s", rest_after_s},
+          {"final_speed", final_speed},
+          {"waypoints_intact", waypoints_intact},
+          {"wall_s", wall_s}};
+}
+
+namespace {
+
+const nlohmann::json& member(const nlohmann::json& json, const char* key) {
+  const auto found = json.find(key);
+  if (found == json.end()) {
+    throw std::runtime_error(std::string("missing field '") + key + "'");
+  }
+  return *found;
+}
+
+[[noreturn]] void wrongType(const char* key, const std::string& what, const nlohmann::json& value) {
+  throw std::runtime_error(std::string("field '") + key + "' must be " + what + ", not " +
+                           value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).substr(0, 60));
+}
+
+double numberField(const nlohmann::json& json, const char* key) {
+  const nlohmann::json& value = member(json, key);
+  if (!value.is_number()) {
+    wrongType(key, "a number", value);
+  }
+  return value.get<double>();
+}
+
+std::string textField(const nlohmann::json& json, const char* key) {
+  const nlohmann::json& value = member(json, key);
+  if (!value.is_string()) {
+    wrongType(key, "a string", value);
+  }
+  return value.get<std::string>();
+}
+
+}  // namespace
+
+FaultTrial FaultTrial::fromJson(const nlohmann::json& json) {
+  if (!json.is_object()) {
+    throw std::runtime_error("must be a JSON object {\"index\": ..., ...}, not " + std::string(json.type_name()));
+  }
+  FaultTrial trial;
+  const nlohmann::json& index = member(json, "index");
+  if (!index.is_number_integer() || index.get<long long>() < 0 || index.get<long long>() > 1000000000) {
+    wrongType("index", "a whole number from 0", index);
+  }
+  trial.index = index.get<int>();
+  const nlohmann::json& seed = member(json, "seed");
+  if (!seed.is_number_unsigned()) {
+    wrongType("seed", "a whole number from 0", seed);
+  }
+  trial.seed = seed.get<std::uint64_t>();
+  trial.task = textField(json, "task");
+  trial.fault = textField(json, "fault");
+  trial.outcome = textField(json, "outcome");
+  trial.failure_path = textField(json, "failure_path");
+  trial.reason = textField(json, "reason");
+  trial.due_s = numberField(json, "due_s");
+  trial.effect_s = numberField(json, "effect_s");
+  trial.end_s = numberField(json, "end_s");
+  trial.latency_s = numberField(json, "latency_s");
+  trial.rest_after_s = numberField(json, "rest_after_s");
+  trial.final_speed = numberField(json, "final_speed");
+  const nlohmann::json& intact = member(json, "waypoints_intact");
+  if (!intact.is_boolean()) {
+    wrongType("waypoints_intact", "true or false", intact);
+  }
+  trial.waypoints_intact = intact.get<bool>();
+  trial.wall_s = numberField(json, "wall_s");
+  return trial;
+}
+
+CampaignSummary readJsonLines(const std::filesystem::path& file, std::vector<std::string>& notes) {
+  const std::string text = readFile(file);
+  CampaignSummary summary;
+  std::size_t start = 0;
+  for (int line = 1; start < text.size(); ++line) {
+    const std::size_t end = std::min(text.find('\n', start), text.size());
+    const std::string_view content(text.data() + start, end - start);
+    const bool last_cut_short = end == text.size();  // no newline after it
+    start = end + 1;
+    if (content.find_first_not_of(" \t\r") == std::string_view::npos) {
+      continue;
+    }
+    const std::string where = file.string() + ":" + std::to_string(line) + ": ";
+    nlohmann::json json;
+    try {
+      json = core::parseJson(content);
+    } catch (const nlohmann::json::parse_error& e) {
+      if (last_cut_short) {
+        notes.push_back(where + "the last line is cut short (the campaign was stopped while writing it): left out");
+        break;
+      }
+      throw std::runtime_error(where + "not a JSON object: " + e.what());
+    } catch (const std::exception& e) {
+      throw std::runtime_error(where + e.what());
+    }
+    try {
+      summary.trials.push_back(FaultTrial::fromJson(json));
+    } catch (const std::exception& e) {
+      throw std::runtime_error(where + e.what());
+    }
+  }
+  return summary;
+}
+
 nlohmann::json CampaignSummary::toJson() const {
   nlohmann::json list = nlohmann::json::array();
   for (const FaultTrial& t : trials) {
-    list.push_back({{"index", t.index},
-                    {"seed", t.seed},
-                    {"task", t.task},
-                    {"fault", t.fault},
-                    {"outcome", t.outcome},
-                    {"failure_path", t.failure_path},
-                    {"reason", t.reason},
-                    {"due_s", t.due_s},
-                    {"effect_s", t.effect_s},
-                    {"end_s", t.end_s},
-                    {"latency_s", t.latency_s},
-                    {"rest_after_s", t.rest_after_s},
-                    {"final_speed", t.final_speed},
-                    {"waypoints_intact", t.waypoints_intact},
-                    {"wall_s", t.wall_s}});
+    list.push_back(t.toJson());
   }
   return {{"count", trials.size()},
           {"seed", options.seed},

@@ -78,6 +78,11 @@ struct FaultTrial {
   bool waypoints_intact = true;
   double wall_s = 0;
   bool met() const { return outcome == "stopped"; }
+  /// One run as a JSON object (a line of --jsonl, an entry of --json's "trials").
+  nlohmann::json toJson() const;
+  /// Reads what toJson wrote. @throws std::runtime_error "missing field 'F'" or "field 'F' must
+  /// be ..., not V".
+  static FaultTrial fromJson(const nlohmann::json& json);
 };
 
 struct CampaignSummary {
@@ -88,7 +93,19 @@ struct CampaignSummary {
   std::string text() const;
 };
 
-/// @throws std::runtime_error before the first run for a missing plan or file.
+/// The runs of a --jsonl file (one FaultTrial::toJson() a line; empty lines are skipped). A last
+/// line cut short (the campaign was killed while writing it) is left out with a note in `notes`.
+/// @throws std::runtime_error "FILE:LINE: PROBLEM" for a line that is not a run, naming the field.
+CampaignSummary readJsonLines(const std::filesystem::path& file, std::vector<std::string>& notes);
+
+/// Checks the numbers: count and jobs at least 1; window, deadline, settle time and time limit
+/// numbers of seconds (core/clock.h checkedDuration), the window and time limit above 0; rest
+/// speed and frames per detection positive.
+/// @throws std::invalid_argument naming the option and the problem.
+void checkOptions(const CampaignOptions& options);
+
+/// @throws std::invalid_argument for an option out of range (checkOptions), std::runtime_error
+/// before the first run for a missing plan or file.
 CampaignSummary runCampaign(const CampaignOptions& options,
                             const std::function<void(const FaultTrial&, int done)>& progress = {});
 

@@ -1,14 +1,37 @@
 // fault_campaign: the paper's UR5 plans with injected faults, judged from outside
 // (faults/campaign.h). Run from the repository root:
 //   nice -n 10 build/faults/fault_campaign -n 1000 -j 2 --json faults.json
-// Exit code: 0 when every fault that took effect stopped the task in time, else 1.
+// Exit code: 0 when every fault that took effect stopped the task in time, 1 when one did not,
+// 2 for a bad option or file, or an output that could not be written.
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
+#include <optional>
 
+#include "cli/number_options.h"
+#include "core/clock.h"
+#include "core/files.h"
 #include "faults/campaign.h"
+
+namespace {
+
+int summarize(const std::string& file) {
+  try {
+    std::vector<std::string> notes;
+    const costar::faults::CampaignSummary summary = costar::faults::readJsonLines(file, notes);
+    for (const std::string& note : notes) {
+      std::fprintf(stderr, "note: %s\n", note.c_str());
+    }
+    std::printf("%zu runs from %s\n%s", summary.trials.size(), file.c_str(), summary.text().c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   costar::faults::CampaignOptions options;
@@ -19,6 +42,7 @@ int main(int argc, char** argv) {
   app.add_option("--seed", options.seed, "seed of the first run (run i: seed + i)")->capture_default_str();
   app.add_option("-j,--jobs", options.jobs, "runs at once")->check(CLI::Range(1, 64))->capture_default_str();
   app.add_option("--window", options.window_s, "timed faults: moment in [0, WINDOW) simulated s")
+      ->check(costar::cli::numberIn(0.0, costar::kMaxDurationSeconds, true, " s"))
       ->capture_default_str();
   app.add_option("-w,--workcell", options.workcell,
                  "a simulated workcell (ur5-sim, iiwa-sim, iiwa-3f-sim: `costar workcells`), or test (components only)")
@@ -31,35 +55,20 @@ int main(int argc, char** argv) {
   app.add_option("--json", json, "write every run as JSON");
   std::string jsonl;
   app.add_option("--jsonl", jsonl, "append each run as a JSON line as it ends (survives an interrupted campaign)");
-  std::string summarize;
-  app.add_option("--summarize", summarize, "print the table of a --jsonl file (an interrupted campaign) and exit")
+  std::string summarize_file;
+  app.add_option("--summarize", summarize_file, "print the table of a --jsonl file (an interrupted campaign) and exit")
       ->check(CLI::ExistingFile);
-  CLI11_PARSE(app, argc, argv);
-  if (!summarize.empty()) {
-    costar::faults::CampaignSummary summary;
-    std::ifstream in(summarize);
-    for (std::string line; std::getline(in, line);) {
-      const auto j = nlohmann::json::parse(line);
-      costar::faults::FaultTrial t;
-      t.index = j.at("index");
-      t.seed = j.at("seed");
-      t.task = j.at("task");
-      t.fault = j.at("fault");
-      t.outcome = j.at("outcome");
-      t.failure_path = j.at("failure_path");
-      t.reason = j.at("reason");
-      t.due_s = j.at("due_s");
-      t.effect_s = j.at("effect_s");
-      t.end_s = j.at("end_s");
-      t.latency_s = j.at("latency_s");
-      t.rest_after_s = j.at("rest_after_s");
-      t.final_speed = j.at("final_speed");
-      t.waypoints_intact = j.at("waypoints_intact");
-      t.wall_s = j.at("wall_s");
-      summary.trials.push_back(std::move(t));
-    }
-    std::printf("%zu runs from %s\n%s", summary.trials.size(), summarize.c_str(), summary.text().c_str());
-    return 0;
+  app.footer(
+      "Exit code: 0 every fault that took effect stopped the task in time, 1 one did not, 2 a bad option or file, or "
+      "an output that could not be written.");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);  // prints the problem (or the help)
+    return code == 0 ? 0 : 2;
+  }
+  if (!summarize_file.empty()) {
+    return summarize(summarize_file);
   }
   if (!plans.empty()) {
     options.tasks.clear();
@@ -71,16 +80,32 @@ int main(int argc, char** argv) {
   if (std::getenv("XDG_STATE_HOME") == nullptr) {
     ::setenv("XDG_STATE_HOME", "/tmp/costar-fault-campaign-state", 1);
   }
-  std::ofstream lines;
-  if (!jsonl.empty()) {
-    lines.open(jsonl, std::ios::app);
+  // The outputs are checked before the first run: no campaign is lost to a path that cannot be
+  // written at the end.
+  std::optional<costar::AppendingFile> lines;
+  try {
+    if (!json.empty()) {
+      costar::checkOutputFile(json, "--json");
+    }
+    if (!jsonl.empty()) {
+      lines.emplace(jsonl, costar::AppendingFile::Mode::kAppend);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
   }
+  bool lines_failed = false;
   try {
     const auto summary = costar::faults::runCampaign(options, [&](const auto& trial, int done) {
-      if (lines.is_open()) {
-        costar::faults::CampaignSummary one;
-        one.trials = {trial};
-        lines << one.toJson()["trials"][0].dump() << std::endl;
+      if (lines && !lines_failed) {
+        try {
+          lines->append(trial.toJson().dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+        } catch (const std::exception& e) {
+          // The campaign goes on (its --json may still be written); the error is said at once
+          // and in the exit code.
+          std::fprintf(stderr, "error: %s; --jsonl holds the runs before this one\n", e.what());
+          lines_failed = true;
+        }
       }
       std::printf("[%4d/%d] %-26s %-34s %-13s %6.3f s  %s%s%s\n", done, options.count, trial.task.c_str(),
                   trial.fault.c_str(), trial.outcome.c_str(), trial.latency_s, trial.failure_path.c_str(),
@@ -88,17 +113,33 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
     });
     std::printf("\n%s", summary.text().c_str());
-    if (!json.empty()) {
-      std::ofstream(json) << summary.toJson().dump(1) << "\n";
-    }
+    int code = 0;
     for (const auto& trial : summary.trials) {
       const bool excused =
           trial.outcome == "not-due" || trial.outcome == "no-effect" || trial.outcome == "recovered" || trial.met();
       if (!excused) {
-        return 1;
+        code = 1;
       }
     }
-    return 0;
+    if (lines && !lines_failed) {
+      try {
+        lines->close();
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "error: %s\n", e.what());
+        lines_failed = true;
+      }
+    }
+    if (!json.empty()) {
+      try {
+        costar::writeOutputFile(json,
+                                summary.toJson().dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+        std::printf("wrote %s\n", json.c_str());
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "error: %s\n", e.what());
+        code = 2;
+      }
+    }
+    return lines_failed ? 2 : code;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <utility>
 
+#include "core/clock.h"
+
 namespace costar::faults {
 
 namespace {
@@ -126,8 +128,8 @@ FaultSpec parseFault(std::string_view text) {
   const std::string_view when = text.substr(at + 1);
   if (when.starts_with("t=")) {
     const auto seconds = number(withoutSeconds(when.substr(2)));
-    if (!seconds || *seconds < 0) {
-      throw fail("t= needs a time in seconds >= 0, e.g. t=2.5s");
+    if (!seconds || *seconds < 0 || *seconds > kMaxDurationSeconds) {
+      throw fail("t= needs a time in seconds from 0 to 1e9, e.g. t=2.5s");
     }
     spec.when = {FaultWhen::Type::kTime, *seconds, 1};
   } else if (when.starts_with("op=")) {
@@ -140,8 +142,8 @@ FaultSpec parseFault(std::string_view text) {
     spec.when = {FaultWhen::Type::kRandom, 10.0, 1};
   } else if (when.starts_with("random=")) {
     const auto seconds = number(withoutSeconds(when.substr(7)));
-    if (!seconds || *seconds <= 0) {
-      throw fail("random= needs a window in seconds > 0, e.g. random=8s");
+    if (!seconds || *seconds <= 0 || *seconds > kMaxDurationSeconds) {
+      throw fail("random= needs a window in seconds above 0 and at most 1e9, e.g. random=8s");
     }
     spec.when = {FaultWhen::Type::kRandom, *seconds, 1};
   } else {

@@ -5,6 +5,11 @@
 #include "faults/campaign.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
 
 #include "core/paths.h"
 
@@ -123,6 +128,101 @@ TEST(FaultCampaign, TheThreeFingerGrippersDriverBreaksAndTheCellStops) {
     EXPECT_LE(trial.latency_s, 0.25);
     EXPECT_LT(trial.final_speed, 0.01);
   }
+}
+
+TEST(FaultCampaign, ANanOrInfiniteWindowIsRefusedBeforeAnyRun) {
+  for (const double window : {std::nan(""), std::numeric_limits<double>::infinity(), 0.0, -1.0, 1e10}) {
+    CampaignOptions options;
+    options.window_s = window;
+    int runs = 0;
+    try {
+      runCampaign(options, [&](const FaultTrial&, int) { ++runs; });
+      ADD_FAILURE() << "window " << window << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("--window: must be", 0), 0u) << e.what();
+    }
+    EXPECT_EQ(runs, 0);
+  }
+}
+
+/// A --jsonl file of `text` in the temporary folder.
+std::filesystem::path jsonLines(const std::string& name, const std::string& text) {
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".jsonl");
+  std::ofstream(file) << text;
+  return file;
+}
+
+std::string run(int index) {
+  FaultTrial trial;
+  trial.index = index;
+  trial.seed = 1 + index;
+  trial.task = "task1";
+  trial.fault = "nan:arm-driver@t=1s";
+  trial.outcome = "stopped";
+  return trial.toJson().dump() + "\n";
+}
+
+TEST(FaultCampaign, AJsonLinesFileReadsBackTheRunsItHolds) {
+  const auto file = jsonLines("campaign_ok", run(0) + "\n" + run(1));  // an empty line between
+  std::vector<std::string> notes;
+  const CampaignSummary summary = readJsonLines(file, notes);
+  ASSERT_EQ(summary.trials.size(), 2u);
+  EXPECT_EQ(summary.trials[1].index, 1);
+  EXPECT_EQ(summary.trials[1].fault, "nan:arm-driver@t=1s");
+  EXPECT_TRUE(notes.empty());
+  std::filesystem::remove(file);
+}
+
+TEST(FaultCampaign, ALineLackingAFieldIsAnErrorNamingTheFileTheLineAndTheField) {
+  nlohmann::json partial = nlohmann::json::parse(run(1));
+  partial.erase("outcome");
+  const auto file = jsonLines("campaign_missing", run(0) + partial.dump() + "\n" + run(2));
+  std::vector<std::string> notes;
+  try {
+    readJsonLines(file, notes);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), file.string() + ":2: missing field 'outcome'");
+  }
+  std::filesystem::remove(file);
+}
+
+TEST(FaultCampaign, AFieldOfTheWrongTypeOrADuplicateKeyIsAnErrorNamingTheLine) {
+  nlohmann::json wrong = nlohmann::json::parse(run(0));
+  wrong["latency_s"] = "fast";
+  const auto file = jsonLines("campaign_type", wrong.dump() + "\n");
+  std::vector<std::string> notes;
+  try {
+    readJsonLines(file, notes);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), file.string() + ":1: field 'latency_s' must be a number, not \"fast\"");
+  }
+  std::ofstream(file) << R"({"index": 0, "index": 1})"
+                      << "\n";
+  try {
+    readJsonLines(file, notes);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              file.string() + ":1: (top level): key 'index' appears twice (a key may appear once in an object)");
+  }
+  std::filesystem::remove(file);
+}
+
+TEST(FaultCampaign, ALastLineCutShortIsLeftOutWithANoteAndOneInTheMiddleIsAnError) {
+  const std::string line = run(1);
+  const auto cut = jsonLines("campaign_cut", run(0) + line.substr(0, 20));
+  std::vector<std::string> notes;
+  EXPECT_EQ(readJsonLines(cut, notes).trials.size(), 1u);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0],
+            cut.string() + ":2: the last line is cut short (the campaign was stopped while writing it): left out");
+  std::ofstream(cut) << line.substr(0, 20) << "\n" << run(0);
+  notes.clear();
+  EXPECT_THROW(readJsonLines(cut, notes), std::runtime_error);
+  std::filesystem::remove(cut);
 }
 
 }  // namespace

@@ -54,5 +54,16 @@ TEST(FaultSpec, RefusesBadSpecsNamingThePart) {
   expectError("throw:arm@soon", "unknown moment 'soon'");
 }
 
+// Issue 27: t=1e10s overflowed the clock's nanoseconds and took effect at once ("due at
+// -9223372036.855 s"); nan and inf are refused too.
+TEST(FaultSpec, AMomentBeyondTheClocksRangeIsRefused) {
+  for (const char* spec :
+       {"nan:arm-driver@t=1e10s", "nan:arm-driver@t=nan", "nan:arm-driver@t=inf", "nan:arm-driver@t=1e308"}) {
+    expectError(spec, "t= needs a time in seconds from 0 to 1e9");
+  }
+  expectError("die:arm@random=1e10s", "random= needs a window in seconds above 0 and at most 1e9");
+  EXPECT_EQ(parseFault("nan:arm-driver@t=1e9s").when.seconds, 1e9);
+}
+
 }  // namespace
 }  // namespace costar::faults
