@@ -1,11 +1,13 @@
 #include "cli/calibrate_command.h"
 
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
 
+#include "calibration/hand_eye.h"
+#include "cli/number_options.h"
+#include "core/files.h"
 #include "sim/simulation.h"
 #include "trials/calibration_eval.h"
 #include "workcell/sim_cell_description.h"
@@ -30,20 +32,6 @@ struct CalibrateOptions {
   bool truth = false;
 };
 
-/// "0.05,5" -> 0.05 m, 5 degrees. @throws CLI::ValidationError naming the option.
-std::pair<double, double> parseMove(const std::string& text) {
-  std::istringstream in(text);
-  double distance = 0;
-  double angle = 0;
-  char comma = 0;
-  if (!(in >> distance >> comma >> angle) || comma != ',' || !in.eof() || distance < 0 || distance > 0.5 || angle < 0 ||
-      angle > 45) {
-    throw CLI::ValidationError("--camera-move",
-                               "'" + text + "' should be DISTANCE_M,ANGLE_DEG (e.g. 0.05,5; at most 0.5 m and 45 deg)");
-  }
-  return {distance, angle};
-}
-
 workcell::WorkcellOptions cellOptions(const CalibrateOptions& options) {
   workcell::WorkcellOptions cell;
   cell.name = options.workcell;
@@ -52,16 +40,29 @@ workcell::WorkcellOptions cellOptions(const CalibrateOptions& options) {
     cell.seed = options.seed;
   }
   if (!options.camera_move.empty()) {
-    const auto [distance, angle] = parseMove(options.camera_move);
+    const auto [distance, angle] = parseCameraMove(options.camera_move);
     cell.camera_move = workcell::WorkcellOptions::CameraMove{distance, angle, {}};
   }
   cell.calibration = options.calibration;
   return cell;
 }
 
+/// The result as --json holds it. @throws std::runtime_error "cannot write 'FILE': ERROR".
+void writeResult(const std::string& file, const nlohmann::json& result) {
+  writeOutputFile(file, result.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  std::printf("wrote %s\n", file.c_str());
+}
+
 int calibrate(const CalibrateOptions& options, bool marker) {
   std::unique_ptr<workcell::Workcell> cell;
   try {
+    // The files written at the end are checked before the arm moves.
+    if (!options.json.empty()) {
+      checkOutputFile(options.json, "--json");
+    }
+    if (!options.calibration.empty()) {
+      checkOutputFile(options.calibration, "--calibration");
+    }
     cell = workcell::makeWorkcell(cellOptions(options));
   } catch (const CLI::ValidationError& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -103,18 +104,53 @@ int calibrate(const CalibrateOptions& options, bool marker) {
     out["error_against_truth"] = {{"mm", (found.translation() - truth.translation()).norm() * 1000},
                                   {"deg", world::rotationAngle(found, truth) * 180 / M_PI}};
   }
+  const auto shown = [](const nlohmann::json& json) {
+    return json.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+  };
+  int code = result.state == component::OperationState::kSuccess ? 0 : 1;
   if (result.state == component::OperationState::kSuccess) {
-    std::printf("SUCCESS: %s\n", out.dump(2).c_str());
+    std::printf("SUCCESS: %s\n", shown(out).c_str());
+    // The calibration is in use in this process, which ends here: unsaved, it is lost.
+    if (out.contains("warning")) {
+      std::cerr << "error: the calibration was not saved: " << out["warning"].get<std::string>() << "\n";
+      code = 2;
+    }
   } else {
-    std::printf("FAILURE: %s\n%s\n", result.reason.c_str(), out.is_null() ? "" : out.dump(2).c_str());
+    std::printf("FAILURE: %s\n%s\n", result.reason.c_str(), out.is_null() ? "" : shown(out).c_str());
   }
   if (!options.json.empty()) {
-    std::ofstream(options.json)
-        << nlohmann::json{{"state", component::toString(result.state)}, {"reason", result.reason}, {"data", out}}.dump(
-               2)
-        << "\n";
+    try {
+      writeResult(options.json,
+                  {{"state", component::toString(result.state)}, {"reason", result.reason}, {"data", out}});
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      code = 2;
+    }
   }
-  return result.state == component::OperationState::kSuccess ? 0 : 1;
+  return code;
+}
+
+/// --methods "daniilidis,tsai": each a hand-eye method. @throws std::invalid_argument naming
+/// the option, the method and the known ones.
+std::vector<std::string> parseMethods(const std::string& text) {
+  std::vector<std::string> methods;
+  if (text.empty()) {
+    return methods;
+  }
+  std::stringstream list(text);
+  for (std::string method; std::getline(list, method, ',');) {
+    try {
+      calibration::methodFromName(method);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("--methods: ") + e.what() +
+                                  " (a comma-separated list, e.g. daniilidis,tsai)");
+    }
+    methods.push_back(method);
+  }
+  if (text.back() == ',') {
+    throw std::invalid_argument("--methods: '" + typed(text) + "' ends with a comma (e.g. daniilidis,tsai)");
+  }
+  return methods;
 }
 
 struct EvalOptions {
@@ -139,18 +175,16 @@ int evaluate(EvalOptions options) {
     return 2;
   }
   try {
-    const auto [distance, angle] = parseMove(options.camera_move);
+    const auto [distance, angle] = parseCameraMove(options.camera_move);
     options.eval.camera_move_m = distance;
     options.eval.camera_turn_deg = angle;
-  } catch (const CLI::ValidationError& e) {
+    options.eval.methods = parseMethods(options.methods);
+    if (!options.json.empty()) {
+      checkOutputFile(options.json, "--json");
+    }
+  } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
-  }
-  std::stringstream list(options.methods);
-  for (std::string method; std::getline(list, method, ',');) {
-    if (!method.empty()) {
-      options.eval.methods.push_back(method);
-    }
   }
   options.eval.refine = !options.no_refine;
   std::printf("costar calibrate eval: %s, %d set-up(s), seeds %llu.., camera moved %.3f m and turned %.1f deg\n",
@@ -178,7 +212,12 @@ int evaluate(EvalOptions options) {
       });
   std::printf("\n%s", summary.text().c_str());
   if (!options.json.empty()) {
-    std::ofstream(options.json) << summary.toJson().dump(2) << "\n";
+    try {
+      writeResult(options.json, summary.toJson());
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 2;
+    }
   }
   return 0;
 }
@@ -198,7 +237,7 @@ void addCellOptions(CLI::App* command, CalibrateOptions& options) {
   command->add_option("--calibration", options.calibration,
                       "calibration file to read and write (default: the cell's, beside its waypoints)");
   command->add_option("--views", options.views, "views of the marker to take")->check(CLI::Range(1, 40));
-  command->add_option("--speed", options.speed, "fraction of the arm's top speed")->check(CLI::Range(0.05, 1.0));
+  command->add_option("--speed", options.speed, "fraction of the arm's top speed")->check(numberIn(0.05, 1.0));
   command->add_option("--json", options.json, "write the result as JSON");
   command->add_flag("--truth", options.truth, "simulation: also print the error against the true camera pose");
 }

@@ -1,8 +1,8 @@
 #include "cli/describe_command.h"
 
-#include <fstream>
 #include <iostream>
 
+#include "core/files.h"
 #include "sim/simulation.h"
 #include "workcell/described_workcell.h"
 
@@ -30,9 +30,7 @@ int describe(const DescribeOptions& options) {
       std::cout << text;
       return 0;
     }
-    const std::string partial = options.out + ".partial";
-    std::ofstream(partial) << text;
-    std::filesystem::rename(partial, options.out);
+    writeOutputFile(options.out, text);
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "cli/number_options.h"
 #include "core/files.h"
 #include "core/image.h"
 #include "core/paths.h"
@@ -103,6 +104,8 @@ struct TrainOptions {
 
 int train(const TrainOptions& options) {
   try {
+    const fs::path out = options.out.empty() ? perception::PipelineFiles::under().svm_file : fs::path(options.out);
+    checkOutputFile(out, "--out");  // before the training's minutes
     const perception::TrainingSet dataset = perception::loadTrainingSet(options.dataset);
     std::printf("train: %zu examples from %s\n", dataset.labels.size(), options.dataset.c_str());
     perception::SvmTrainingReport report;
@@ -111,7 +114,6 @@ int train(const TrainOptions& options) {
                                                                std::printf("train: %s ...\n", step.c_str());
                                                                std::fflush(stdout);
                                                              });
-    const fs::path out = options.out.empty() ? perception::PipelineFiles::under().svm_file : fs::path(options.out);
     classifier.save(out);
     std::printf("train: %d support vectors, C = %g, gamma = %s, %.1f s\n", report.support_vectors, options.svm.cost,
                 options.svm.gamma > 0 ? std::to_string(options.svm.gamma).c_str() : "1/features", report.seconds);
@@ -144,9 +146,7 @@ int evaluate(const EvalOptions& options) {
     const trials::PerceptionEvalOptions& eval = options.eval;
     // Refused now rather than after the evaluation's minutes.
     if (!options.json.empty()) {
-      if (const fs::path folder = fs::absolute(options.json).parent_path(); !fs::is_directory(folder)) {
-        throw std::runtime_error("cannot write --json " + options.json + ": no folder " + folder.string());
-      }
+      checkOutputFile(options.json, "--json");
     }
     std::printf(
         "eval: %d random cluttered scene(s), seed %llu, %d frames per DetectObjects, %d repeat(s), %d push(es)\n",
@@ -163,14 +163,16 @@ int evaluate(const EvalOptions& options) {
         });
     std::fputs(summary.text().c_str(), stdout);
     if (!options.json.empty()) {
-      writeFileAtomically(options.json, summary.toJson().dump(2) + "\n");
+      writeOutputFile(options.json,
+                      summary.toJson().dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
       std::printf("\nwrote %s\n", options.json.c_str());
     }
     if (!eval.pictures.empty()) {
-      std::printf("pictures in %s (green: within 5 mm / 5 deg, red: not, orange: false detection, yellow: missed);\n"
-                  "each scene's file beside its picture (scene_NNN.json, scene_NNN_push_K.json): "
-                  "`costar-robot perception detect FILE` runs it again\n",
-                  eval.pictures.string().c_str());
+      std::printf(
+          "pictures in %s (green: within 5 mm / 5 deg, red: not, orange: false detection, yellow: missed);\n"
+          "each scene's file beside its picture (scene_NNN.json, scene_NNN_push_K.json): "
+          "`costar-robot perception detect FILE` runs it again\n",
+          eval.pictures.string().c_str());
     }
     const double found = summary.scores.foundWithinTolerance();
     if (options.min_found >= 0 && found < options.min_found) {
@@ -196,6 +198,9 @@ struct DetectOptions {
 /// simulator's truth and draws it.
 int detectScene(const DetectOptions& options) {
   try {
+    if (!options.out.empty()) {
+      checkOutputFile(options.out, "--out");
+    }
     const trials::SceneDetection found = trials::detectInScene(options.scene, options.seed, options.frames);
     const trials::Match& match = found.match;
     std::printf("DetectObjects on %s: %zu object(s) in %.1f ms (%d frames; capture not included)\n",
@@ -298,8 +303,11 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
   train_command->add_option("--dataset", train_options->dataset, "folder written by `costar perception collect`")
       ->capture_default_str();
   train_command->add_option("-o,--out", train_options->out, "model file (default: data/perception/svm_model.json)");
-  train_command->add_option("--cost", train_options->svm.cost, "SVM soft-margin cost C")->capture_default_str();
+  train_command->add_option("--cost", train_options->svm.cost, "SVM soft-margin cost C")
+      ->check(numberIn(0.0, 1e9, true))
+      ->capture_default_str();
   train_command->add_option("--gamma", train_options->svm.gamma, "RBF gamma on standardized features (0: 1/features)")
+      ->check(numberIn(0.0, 1e9))
       ->capture_default_str();
   train_command->add_option("--folds", train_options->svm.folds, "cross-validation folds (0: none)")
       ->capture_default_str();
@@ -345,9 +353,11 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(1, 60));
   eval_command->add_option("--touching", eval_options->eval.touching, "chance that a part is placed against another")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
-  eval_command->add_option("--min-found", eval_options->min_found,
-                           "fail (exit 1) when fewer of the visible parts are found within 5 mm and 5 deg");
+      ->check(numberIn(0.0, 1.0));
+  eval_command
+      ->add_option("--min-found", eval_options->min_found,
+                   "fail (exit 1) when fewer of the visible parts are found within 5 mm and 5 deg (0..1)")
+      ->check(numberIn(0.0, 1.0));
   eval_command->callback([eval_options, &exit_code] { exit_code = evaluate(*eval_options); });
 
   auto detect_options = std::make_shared<DetectOptions>();

@@ -2,10 +2,9 @@
 
 #include <unistd.h>
 
-#include <atomic>
-#include <csignal>
+#include <cerrno>
 #include <cstdio>
-#include <fstream>
+#include <cstring>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -16,7 +15,10 @@
 #include "bt/plan_xml.h"
 #include "bt/trace.h"
 #include "cli/inject_option.h"
+#include "cli/number_options.h"
+#include "cli/stop_signals.h"
 #include "cli/workcell_access.h"
+#include "core/files.h"
 #include "workcell/workcell.h"
 
 namespace costar::cli {
@@ -26,15 +28,6 @@ namespace {
 constexpr int kExitSuccess = 0;
 constexpr int kExitFailure = 1;
 constexpr int kExitInvalid = 2;
-constexpr int kExitStopped = 130;
-
-std::atomic<bt::Executor*> g_running_executor{nullptr};
-
-void onInterrupt(int /*signal*/) {
-  if (bt::Executor* executor = g_running_executor.load()) {
-    executor->requestStop();  // an atomic store: safe in a signal handler
-  }
-}
 
 struct Colors {
   explicit Colors(bool on)
@@ -121,6 +114,19 @@ struct RunOptions {
 };
 
 int runPlan(RunOptions options) {
+  // From the start: a signal while the cell is built stops the run at its first tick, with its
+  // trace written, rather than killing the process.
+  const StopSignals signals;
+  bt::ExecutorOptions executor_options;
+  try {
+    executor_options.tick_period = checkedDuration(1.0 / options.rate_hz, "--rate: the tick period");
+    if (options.time_limit_s > 0) {
+      executor_options.time_limit = checkedDuration(options.time_limit_s, "--time-limit");
+    }
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitInvalid;
+  }
   if (!options.inject.empty()) {
     options.workcell.faults = makeFaultInjector(options.inject, options.workcell.seed.value_or(1));
   }
@@ -136,15 +142,15 @@ int runPlan(RunOptions options) {
     return kExitInvalid;
   }
 
-  std::ofstream trace_file;
-  std::optional<bt::JsonLinesTrace> trace;
+  // The trace is written as the run goes: each tick's transitions at the next tick.
+  std::optional<bt::JsonLinesFileTrace> trace;
   if (!options.trace.empty()) {
-    trace_file.open(options.trace, std::ios::trunc);
-    if (!trace_file) {
-      std::cerr << "error: cannot write trace file '" << options.trace << "'\n";
+    try {
+      trace.emplace(options.trace);
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
       return kExitInvalid;
     }
-    trace.emplace(trace_file);
     tree->addObserver(&*trace);
   }
   const Colors colors(::isatty(STDOUT_FILENO) != 0);
@@ -156,41 +162,55 @@ int runPlan(RunOptions options) {
                 tree->mainTreeId().c_str(), tree->nodes().size(), options.rate_hz, cell->description().c_str());
   }
 
-  bt::ExecutorOptions executor_options;
-  executor_options.tick_period = fromSeconds(1.0 / options.rate_hz);
-  if (options.time_limit_s > 0) {
-    executor_options.time_limit = fromSeconds(options.time_limit_s);
-  }
   bt::Executor executor(*tree, cell->clock(), executor_options);
-  executor.setBeforeTick([&cell] { cell->beforeTick(); });
-  g_running_executor.store(&executor);
-  auto* previous = std::signal(SIGINT, onInterrupt);
+  bool trace_error_said = false;
+  const auto flushTrace = [&trace, &trace_error_said] {
+    if (trace) {
+      trace->flush();
+      if (!trace->error().empty() && !trace_error_said) {
+        std::cerr << "error: " << trace->error() << "; the run goes on without its trace\n";
+        trace_error_said = true;
+      }
+    }
+  };
+  executor.setBeforeTick([&cell, &executor, &flushTrace] {
+    if (StopSignals::stopRequested().load()) {
+      executor.requestStop();  // halts the tree at the next tick: running operations are cancelled
+    }
+    flushTrace();
+    cell->beforeTick();
+  });
   const auto wall_start = std::chrono::steady_clock::now();
   const bt::RunResult result = executor.run();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  std::signal(SIGINT, previous);
-  g_running_executor.store(nullptr);
+  if (trace) {
+    trace->close();
+    flushTrace();  // says a failure of the last writes
+  }
+  const int signal = StopSignals::received();
 
   const char* clock_kind = cell->clock().simulated() ? "simulated" : "real";
   if (options.workcell.faults) {
     std::printf("%s", faultSummary(*options.workcell.faults).c_str());
   }
   const std::uint64_t node_ticks = tree->context().nodeTicks();
+  // A trace that could not be written makes the exit code 2 whatever the run's result.
+  const auto exitCode = [&trace](int code) { return trace && !trace->error().empty() ? kExitInvalid : code; };
   if (result.stopped) {
-    std::printf("%sSTOPPED%s by the user after %.3f s %s; running operations were cancelled\n", colors.red,
-                colors.reset, toSeconds(result.elapsed), clock_kind);
-    return kExitStopped;
+    std::printf("%sSTOPPED%s by %s after %.3f s %s; running operations were cancelled\n", colors.red, colors.reset,
+                StopSignals::name(signal).c_str(), toSeconds(result.elapsed), clock_kind);
+    return exitCode(StopSignals::exitCode(signal));
   }
   if (result.status == bt::Status::kSuccess) {
     std::printf("%sSUCCESS%s in %.3f s %s (%.3f s wall, %llu ticks, %llu node ticks)\n", colors.green, colors.reset,
                 toSeconds(result.elapsed), clock_kind, wall, static_cast<unsigned long long>(result.ticks),
                 static_cast<unsigned long long>(node_ticks));
-    return kExitSuccess;
+    return exitCode(kExitSuccess);
   }
   std::printf("%sFAILURE%s at %s: %s\n  after %.3f s %s (%.3f s wall, %llu ticks)\n", colors.red, colors.reset,
               result.failure_path.c_str(), result.failure_reason.c_str(), toSeconds(result.elapsed), clock_kind, wall,
               static_cast<unsigned long long>(result.ticks));
-  return kExitFailure;
+  return exitCode(kExitFailure);
 }
 
 int validatePlan(const std::string& path, const workcell::WorkcellOptions& workcell_options) {
@@ -249,11 +269,20 @@ int writeNodes(const workcell::WorkcellOptions& workcell_options, const std::str
   const std::string text = format == "json" ? nodesJson(cell->nodes()).dump(2) + "\n"
                                             : bt::treeNodesModelXml(cell->nodes(), {.include_btcpp_builtins = all});
   if (out.empty()) {
-    std::cout << text;
-  } else {
-    std::ofstream(out) << text;
-    std::cerr << "wrote " << out << "\n";
+    std::cout << text << std::flush;
+    if (!std::cout) {
+      std::cerr << "error: cannot write the standard output: " << std::strerror(errno) << "\n";
+      return kExitInvalid;
+    }
+    return kExitSuccess;
   }
+  try {
+    writeOutputFile(out, text);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitInvalid;
+  }
+  std::cerr << "wrote " << out << "\n";
   return kExitSuccess;
 }
 
@@ -264,18 +293,20 @@ void addPlanCommands(CLI::App& app, int& exit_code) {
   CLI::App* run = app.add_subcommand("run", "Run a task plan (BehaviorTree.CPP v4 XML) on a workcell");
   run->add_option("plan", options->plan, "plan file")->required()->check(CLI::ExistingFile);
   addWorkcellOptions(run, options->workcell);
-  run->add_option("--trace", options->trace, "write every status transition to FILE as JSON lines");
+  run->add_option("--trace", options->trace,
+                  "write every status transition to FILE as JSON lines, as the run goes (each tick's at the next)");
   run->add_option("--rate", options->rate_hz, "ticks per second of clock time")
-      ->check(CLI::Range(0.1, 10000.0))
+      ->check(numberIn(0.1, 10000.0, false, " Hz"))
       ->capture_default_str();
   run->add_option("--time-limit", options->time_limit_s, "fail the run after this many clock seconds (0: none)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(numberIn(0.0, kMaxDurationSeconds, false, " s"));
   run->add_flag("-q,--quiet", options->quiet, "print only the result");
   run->add_flag("--all-nodes", options->all_nodes, "status lines for internal nodes too");
   addInjectOption(run, options->inject);
   run->footer(
-      "Exit code: 0 SUCCESS, 1 FAILURE (the failing node's path and reason are printed), 2 invalid plan,\n"
-      "130 stopped with Ctrl-C (running operations are cancelled).");
+      "Exit code: 0 SUCCESS, 1 FAILURE (the failing node's path and reason are printed), 2 invalid plan or option,\n"
+      "or the --trace could not be written; 130 stopped by Ctrl-C (SIGINT), 143 by SIGTERM (running operations\n"
+      "are cancelled, the trace is complete).");
   run->callback([options, &exit_code] { exit_code = runPlan(*options); });
 
   auto validate_plan = std::make_shared<std::string>();
@@ -297,6 +328,7 @@ void addPlanCommands(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   nodes->add_flag("--all", *nodes_all, "also describe nodes that BehaviorTree.CPP has built in");
   nodes->add_option("-o,--out", *nodes_out, "write to FILE instead of standard output");
+  nodes->footer("Exit code: 0 written, 2 bad options or a file that could not be written.");
   nodes->callback([=, &exit_code] { exit_code = writeNodes(*nodes_workcell, *nodes_format, *nodes_all, *nodes_out); });
 
   CLI::App* workcells = app.add_subcommand("workcells", "List the workcells this build knows");

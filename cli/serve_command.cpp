@@ -2,6 +2,7 @@
 
 #include <iostream>
 
+#include "cli/number_options.h"
 #include "server/serve.h"
 
 namespace costar::cli {
@@ -34,10 +35,10 @@ void addServeCommand(CLI::App& app, int& exit_code) {
   serve
       ->add_option("--pace", options->pace,
                    "simulated seconds per wall second in simulated cells (0: runs as fast as possible)")
-      ->check(CLI::Range(0.0, 1000.0))
+      ->check(numberIn(0.0, 1000.0))
       ->capture_default_str();
   serve->add_option("--stream-rate", options->stream_hz, "snapshots per second on the live stream")
-      ->check(CLI::Range(1.0, 100.0))
+      ->check(numberIn(1.0, 100.0, false, " Hz"))
       ->capture_default_str();
   serve->add_flag("--test-endpoints", options->test_endpoints,
                   "TEST ONLY: expose the simulator's true state at /api/test/ground_truth (end-to-end tests)");

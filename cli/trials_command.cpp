@@ -1,7 +1,6 @@
 #include "cli/trials_command.h"
 
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <iostream>
 #include <thread>
@@ -11,6 +10,10 @@
 
 #include "bt/plan.h"
 #include "cli/inject_option.h"
+#include "cli/number_options.h"
+#include "cli/stop_signals.h"
+#include "core/files.h"
+#include "core/json_file.h"
 #include "trials/disturbance.h"
 #include "trials/judge.h"
 #include "trials/trials.h"
@@ -50,11 +53,14 @@ void parseShard(const std::string& text, trials::TrialOptions& options) {
   }
 }
 
-/// Prints the summary, writes the JSON and the plot where asked; the exit code.
-int report(const trials::Summary& summary, const Options& options) {
+/// Prints the summary, writes the JSON and the plot where asked; the exit code (`code` unless an
+/// output could not be written, or the success rate is below --require).
+int report(const trials::Summary& summary, const Options& options, int code = 0) {
   std::printf("\n%s", summary.text().c_str());
   const double rate = summary.trials.empty() ? 0.0 : static_cast<double>(summary.successes()) / summary.trials.size();
-  int code = rate + 1e-12 >= options.require ? 0 : 1;
+  if (code == 0 && rate + 1e-12 < options.require) {
+    code = 1;
+  }
   // Each output on its own: the JSON is written even when the plot cannot be.
   const auto write = [&code](const std::string& file, const std::function<void()>& writer) {
     try {
@@ -77,10 +83,10 @@ int report(const trials::Summary& summary, const Options& options) {
 /// Checks that the outputs can be written at the end, before anything runs.
 void checkOutputs(const Options& options) {
   if (!options.json.empty()) {
-    trials::checkOutputFile(options.json, "--json");
+    checkOutputFile(options.json, "--json");
   }
   if (!options.plot.empty()) {
-    trials::checkOutputFile(options.plot, "--plot");
+    checkOutputFile(options.plot, "--plot");
   }
 }
 
@@ -89,20 +95,16 @@ int merge(const Options& options) {
   try {
     checkOutputs(options);
     for (const std::string& file : options.merge_inputs) {
-      std::ifstream stream(file);
-      if (!stream) {
-        throw std::runtime_error(file + ": cannot be read");
-      }
       try {
-        shards.push_back(trials::Summary::fromJson(nlohmann::json::parse(stream)));
+        shards.push_back(trials::Summary::fromJson(core::readJsonFile(file)));
       } catch (const std::exception& e) {
         throw std::runtime_error(file + ": " + e.what());
       }
     }
     const trials::Summary merged = trials::mergeShards(shards);
+    const std::string scene = merged.options.scene.empty() ? "(the workcell's)" : merged.options.scene.string();
     std::printf("costar trials merge: %zu result file(s), %zu trials of %s on scene %s, judge '%s'\n", shards.size(),
-                merged.trials.size(), merged.options.plan.c_str(), merged.options.scene.c_str(),
-                merged.options.judge.c_str());
+                merged.trials.size(), merged.options.plan.c_str(), scene.c_str(), merged.options.judge.c_str());
     return report(merged, options);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -115,46 +117,55 @@ int run(Options options) {
     std::cerr << "error: costar trials needs a plan and --judge (or: costar trials merge RESULTS.json...)\n";
     return 2;
   }
-  if (options.trials.scene.empty()) {
-    options.trials.scene = "sim/scenes/assembly.json";
-  }
   // Everything that can be checked is checked before the first trial: no result is lost to a
   // bad option or an output that cannot be written at the end.
+  std::filesystem::path scene;
   try {
     if (!options.shard.empty()) {
       parseShard(options.shard, options.trials);
     }
     trials::checkOptions(options.trials);
     checkOutputs(options);
+    scene = trials::effectiveScene(options.trials);  // the workcell's when none is given, as costar run
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
   }
   std::printf("costar trials: %d trial(s) of %s on scene %s, judge '%s', seeds %llu.., %d at a time\n",
-              options.trials.count, options.trials.plan.c_str(), options.trials.scene.c_str(),
-              options.trials.judge.c_str(), static_cast<unsigned long long>(options.trials.seed), options.trials.jobs);
+              options.trials.count, options.trials.plan.c_str(), scene.c_str(), options.trials.judge.c_str(),
+              static_cast<unsigned long long>(options.trials.seed), options.trials.jobs);
   if (options.trials.shard_count > 1) {
     std::printf("shard %d/%d: trials %d, %d, ... of them\n", options.trials.shard_index, options.trials.shard_count,
                 options.trials.shard_index, options.trials.shard_index + options.trials.shard_count);
   }
   std::fflush(stdout);
   trials::Summary summary;
+  bool trace_failed = false;
+  const StopSignals signals;  // SIGINT, SIGTERM: stop launching, cancel the running trials, keep the rest
   try {
     const int total = (options.trials.count - options.trials.shard_index + options.trials.shard_count - 1) /
                       options.trials.shard_count;  // this shard's trials
-    summary = trials::runTrials(options.trials, [total](const trials::TrialResult& result, int done) {
-      if (result.success) {
-        std::printf("[%4d/%d] trial %d (seed %llu): SUCCESS in %.1f s simulated (%.1f s wall)\n", done, total,
-                    result.index, static_cast<unsigned long long>(result.seed), result.cycle_time_s, result.wall_s);
-      } else {
-        std::printf("[%4d/%d] trial %d (seed %llu): FAILURE at %s: %s\n", done, total, result.index,
-                    static_cast<unsigned long long>(result.seed), result.failure_path.c_str(), result.reason.c_str());
-      }
-      for (const std::string& event : result.disturbances) {
-        std::printf("         disturbed: %s\n", event.c_str());
-      }
-      std::fflush(stdout);
-    });
+    summary = trials::runTrials(
+        options.trials,
+        [total, &trace_failed](const trials::TrialResult& result, int done) {
+          if (result.success) {
+            std::printf("[%4d/%d] trial %d (seed %llu): SUCCESS in %.1f s simulated (%.1f s wall)\n", done, total,
+                        result.index, static_cast<unsigned long long>(result.seed), result.cycle_time_s, result.wall_s);
+          } else {
+            std::printf("[%4d/%d] trial %d (seed %llu): FAILURE at %s: %s\n", done, total, result.index,
+                        static_cast<unsigned long long>(result.seed), result.failure_path.c_str(),
+                        result.reason.c_str());
+          }
+          for (const std::string& event : result.disturbances) {
+            std::printf("         disturbed: %s\n", event.c_str());
+          }
+          std::fflush(stdout);
+          if (!result.trace_error.empty()) {
+            std::cerr << "error: trial " << result.index << "'s trace: " << result.trace_error << "\n";
+            trace_failed = true;
+          }
+        },
+        &StopSignals::stopRequested());
   } catch (const bt::PlanError& error) {
     for (const auto& diagnostic : error.diagnostics()) {
       std::cerr << "error: " << diagnostic.str() << "\n";
@@ -164,23 +175,18 @@ int run(Options options) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
   }
-  return report(summary, options);
-}
-
-/// A number from `low` (excluded when `low_open`) to `high`; unlike CLI::Range, nan is refused.
-CLI::Validator numberIn(double low, double high, bool low_open, const std::string& unit) {
-  char range[96];
-  std::snprintf(range, sizeof range, "%s %g%s and at most %g", low_open ? "above" : "from", low, unit.c_str(), high);
-  const std::string description = range;
-  return CLI::Validator(
-      [low, high, low_open, description](std::string& text) -> std::string {
-        double value = 0.0;
-        if (!CLI::detail::lexical_cast(text, value) || !(low_open ? value > low : value >= low) || !(value <= high)) {
-          return "must be a number " + description + ", not " + text;
-        }
-        return {};
-      },
-      "NUMBER " + description);
+  if (summary.interrupted) {
+    const int signal = StopSignals::received();
+    std::cerr << "costar trials: stopped by " << StopSignals::name(signal) << ": " << summary.trials.size() << " of "
+              << summary.planned << " trials finished";
+    if (!summary.cancelled.empty()) {
+      std::cerr << ", " << summary.cancelled.size() << " stopped midway (not counted; their traces end there)";
+    }
+    std::cerr << "; the results written are of the finished trials, marked \"interrupted\": true\n";
+    const int code = report(summary, options, StopSignals::exitCode(signal));
+    return code == 2 ? 2 : StopSignals::exitCode(signal);
+  }
+  return report(summary, options, trace_failed ? 2 : 0);
 }
 
 }  // namespace
@@ -216,17 +222,9 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
   command->add_option_function<std::string>(
       "--camera-move",
       [options](const std::string& text) {
-        const auto comma = text.find(',');
-        try {
-          options->trials.camera_move_m = std::stod(text.substr(0, comma));
-          options->trials.camera_turn_deg = comma == std::string::npos ? 0.0 : std::stod(text.substr(comma + 1));
-        } catch (const std::exception&) {
-          throw CLI::ValidationError("--camera-move", "'" + text + "' should be DISTANCE_M,ANGLE_DEG (e.g. 0.05,5)");
-        }
-        if (options->trials.camera_move_m < 0 || options->trials.camera_move_m > 0.5 ||
-            options->trials.camera_turn_deg < 0 || options->trials.camera_turn_deg > 45) {
-          throw CLI::ValidationError("--camera-move", "at most 0.5 m and 45 degrees");
-        }
+        const auto [distance, angle] = parseCameraMove(text);
+        options->trials.camera_move_m = distance;
+        options->trials.camera_turn_deg = angle;
       },
       "the camera moved from its drawn mounting in each trial: DISTANCE_M,ANGLE_DEG, direction from the trial's seed");
   command->add_flag("--calibrate", options->trials.calibrate,
@@ -273,7 +271,9 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
       "\nMany machines: run `costar trials PLAN --judge J -n 10000 --shard $I/100 --json r$I.json` as jobs I = 0..99 "
       "(a Slurm array, GNU parallel, Kubernetes indexed jobs), then `costar trials merge r*.json --plot trials.png`."
       "\nExit code: 0, or 1 when the success rate is below --require; 2 for an invalid plan or option (checked "
-      "before the first trial) or an output that could not be written.");
+      "before the first trial) or an output (--json, --plot, a --trace file) that could not be written; 130 "
+      "(SIGINT, Ctrl-C) or 143 (SIGTERM) when stopped: no trial starts after the signal, the running ones are "
+      "cancelled, and --json and --plot are written for the trials that finished, marked \"interrupted\": true.");
   command->callback([options, merge_command, &exit_code] {
     if (!merge_command->parsed()) {
       exit_code = run(*options);

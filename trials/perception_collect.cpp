@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <random>
@@ -11,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/files.h"
 #include "core/paths.h"
 #include "perception/aruco_marker.h"
 #include "perception/median_filter.h"
@@ -74,11 +74,7 @@ fs::path makeClutterRoot(const fs::path& directory) {
         "symmetry": {"generators": []},
         "colors": {"black": [0.08, 0.08, 0.08], "pink": [0.9, 0.5, 0.6], "silver": [0.75, 0.75, 0.78]}})"}};
   for (const auto& [name, text] : clutter) {
-    std::ofstream file(root / "data" / "objects" / (name + ".json"));
-    file << text << "\n";
-    if (!file) {
-      throw std::runtime_error("cannot write " + (root / "data" / "objects" / (name + ".json")).string());
-    }
+    writeOutputFile(root / "data" / "objects" / (name + ".json"), std::string(text) + "\n");
   }
   return root;
 }

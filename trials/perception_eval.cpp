@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -12,6 +11,7 @@
 #include <tuple>
 
 #include "core/clock.h"
+#include "core/files.h"
 #include "perception/canonical_orientation.h"
 #include "perception/drawing.h"
 #include "perception/perception_component.h"
@@ -204,11 +204,7 @@ RgbImage labelPicture(const perception::PipelineResult& result, const perception
 /// be written.
 void writeSceneFile(const std::filesystem::path& file, sim::Scene scene, const std::string& description) {
   scene.description = description;
-  std::ofstream out(file);
-  out << sim::sceneFileText(scene);
-  if (!out.flush()) {
-    throw std::runtime_error("cannot write '" + file.string() + "'");
-  }
+  writeOutputFile(file, sim::sceneFileText(scene));
 }
 
 /// The parts of a simulation as a scene with fixed placements (to re-create it after a push).

@@ -20,12 +20,14 @@
 #include "bt/plan_xml.h"
 #include "bt/trace.h"
 #include "core/files.h"
+#include "core/json_file.h"
 #include "core/parallel.h"
 #include "core/paths.h"
 #include "faults/injector.h"
 #include "sim/simulation.h"
 #include "trials/disturbance.h"
 #include "trials/judge.h"
+#include "workcell/sim_cell_description.h"
 #include "workcell/workcell.h"
 
 namespace costar::trials {
@@ -85,11 +87,17 @@ std::unique_ptr<workcell::Workcell> trialWorkcell(const TrialOptions& options, i
 }
 
 /// Runs trial `index` in `built` (its fresh workcell, built by trialWorkcell) or in one it builds.
+/// Once `*stop` is set it starts nothing and stops its run at the next tick.
 TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judge& judge, int index,
-                   std::unique_ptr<workcell::Workcell> built = nullptr) {
+                   const std::atomic<bool>* stop, std::unique_ptr<workcell::Workcell> built = nullptr) {
   TrialResult result;
   result.index = index;
   result.seed = options.seed + static_cast<std::uint64_t>(index);
+  const auto stopping = [stop] { return stop != nullptr && stop->load(); };
+  if (stopping()) {
+    result.started = false;
+    return result;
+  }
   const auto wall_start = std::chrono::steady_clock::now();
   Disturber disturber(parseDisturbances(options.disturb), result.seed);
   try {
@@ -112,32 +120,43 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
         return result;
       }
     }
+    if (stopping()) {  // the cell took a while to build: the stop came meanwhile
+      result.started = false;
+      return result;
+    }
     const std::vector<sim::PartState> initial = simulation.parts();
     bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
-    std::ofstream trace_file;
-    std::optional<bt::JsonLinesTrace> trace;
+    // The trace is written as the trial goes, each tick's transitions at the next tick.
+    std::optional<bt::JsonLinesFileTrace> trace;
     if (!options.trace_dir.empty()) {
-      const std::filesystem::path file = options.trace_dir / ("trial_" + std::to_string(result.seed) + ".jsonl");
-      trace_file.open(file, std::ios::trunc);
-      if (!trace_file) {
-        throw std::runtime_error("cannot write the trace '" + file.string() + "'");
-      }
-      trace.emplace(trace_file);
+      trace.emplace(options.trace_dir / ("trial_" + std::to_string(result.seed) + ".jsonl"));
       tree.addObserver(&*trace);
     }
-    bt::Executor executor(tree, cell->clock(), {.time_limit = fromSeconds(options.time_limit_s)});
-    executor.setBeforeTick([&cell, &disturber, &simulation] {
+    bt::Executor executor(tree, cell->clock(), {.time_limit = checkedDuration(options.time_limit_s, "--time-limit")});
+    executor.setBeforeTick([&cell, &disturber, &simulation, &trace, &executor, &stopping] {
+      if (stopping()) {
+        executor.requestStop();  // halts the tree: its operations are cancelled, the arm stops
+      }
+      if (trace) {
+        trace->flush();
+      }
       disturber.watch(simulation);
       cell->beforeTick();
     });
     const bt::RunResult run = executor.run();
+    if (trace) {
+      trace->close();
+      result.trace_error = trace->error();
+    }
     result.disturbances = disturber.events();
     result.cycle_time_s = toSeconds(run.elapsed);
-    if (run.status != bt::Status::kSuccess) {
+    if (run.stopped) {
+      result.interrupted = true;
+    } else if (run.status != bt::Status::kSuccess) {
       result.failure_path = run.failure_path;
       result.reason = run.failure_reason;
     } else {
-      simulation.stepTo(simulation.time() + fromSeconds(options.settle_s));
+      simulation.stepTo(simulation.time() + checkedDuration(options.settle_s, "settle time"));
       const Verdict verdict = judge(simulation, initial);
       result.success = verdict.success;
       if (!verdict.success) {
@@ -157,6 +176,15 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
 #endif
   result.rss_kb = residentKilobytes();
   return result;
+}
+
+/// The fingerprint of the plan file and the files it includes, in order.
+std::string planFingerprint(const bt::Plan& plan) {
+  std::string text = readFile(plan.file.path);
+  for (const bt::PlanFile& included : plan.included) {
+    text += "\n" + readFile(included.path);
+  }
+  return fingerprint(text);
 }
 
 double percentile(std::vector<double> values, double p) {
@@ -199,56 +227,43 @@ void checkOptions(const TrialOptions& options) {
     throw std::invalid_argument("the settle time must be a number of simulated seconds from 0 to " +
                                 shown(kMaxTimeLimitSeconds) + ", not " + shown(options.settle_s));
   }
+  if (!(options.camera_move_m >= 0.0 && options.camera_move_m <= 0.5) ||
+      !(options.camera_turn_deg >= 0.0 && options.camera_turn_deg <= 45.0)) {
+    throw std::invalid_argument("--camera-move: must be DISTANCE_M,ANGLE_DEG from 0 to 0.5 m and 45 degrees, not " +
+                                shown(options.camera_move_m) + "," + shown(options.camera_turn_deg));
+  }
 }
 
-void checkOutputFile(const std::filesystem::path& file, const std::string& what) {
-  const std::string label = what + " '" + file.string() + "'";
-  if (file.empty()) {
-    throw std::invalid_argument(what + ": the file name is empty");
+std::filesystem::path effectiveScene(const TrialOptions& options) {
+  if (!options.scene.empty()) {
+    return options.scene;
   }
-  std::error_code error;
-  const auto status = std::filesystem::status(file, error);
-  if (std::filesystem::is_directory(status)) {
-    throw std::invalid_argument("cannot write " + label + ": it is a folder");
-  }
-  const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : ".";
-  if (!std::filesystem::is_directory(folder, error)) {
-    throw std::invalid_argument("cannot write " + label + ": there is no folder '" + folder.string() + "'");
-  }
-  // A regular file is replaced by a new one written in its folder; a device is written to.
-  const bool exists = std::filesystem::exists(status);
-  const std::filesystem::path written = exists && !std::filesystem::is_regular_file(status) ? file : folder;
-  if (::access(written.c_str(), W_OK) != 0) {
-    throw std::invalid_argument("cannot write " + label + ": " + std::strerror(errno));
-  }
+  return workcell::loadSimCellDescription(workcell::simCellFile(options.workcell)).scene;
 }
 
 void writeJson(const Summary& summary, const std::filesystem::path& file) {
-  const std::string text = summary.toJson().dump(2) + "\n";
-  std::error_code error;
-  const auto status = std::filesystem::status(file, error);
-  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status) &&
-      !std::filesystem::is_directory(status)) {
-    std::ofstream stream(file);
-    stream << text << std::flush;
-    if (!stream) {
-      throw std::runtime_error("cannot write '" + file.string() + "': " + std::strerror(errno));
-    }
-    return;
-  }
-  writeFileAtomically(file, text);
+  writeOutputFile(file, summary.toJson().dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
-Summary runTrials(const TrialOptions& options, const std::function<void(const TrialResult&, int)>& progress) {
+Summary runTrials(const TrialOptions& options, const std::function<void(const TrialResult&, int)>& progress,
+                  const std::atomic<bool>* stop) {
   checkOptions(options);
   const Judge judge = trials::judge(options.judge);
   parseDisturbances(options.disturb);  // a bad one is an error before any trial
   const bt::Plan plan = bt::loadPlan(options.plan);
+  Summary summary;
+  summary.options = options;
+  summary.fingerprints["plan"] = planFingerprint(plan);
+  summary.fingerprints["scene"] = fingerprint(readFile(effectiveScene(options)));
+  if (!options.waypoints.empty()) {
+    summary.fingerprints["waypoints"] = fingerprint(readFile(options.waypoints));
+  }
   // This shard's trials: every shard_count-th index, so that slices take about as long.
   std::vector<int> indices;
   for (int index = options.shard_index; index < options.count; index += options.shard_count) {
     indices.push_back(index);
   }
+  summary.planned = static_cast<int>(indices.size());
   // Validate once, before any trial, against the workcell the trials use (the faults too):
   // the first trial's, which that trial then runs in (a workcell load saved per run; nothing
   // has ticked in it: validation only reads the node models).
@@ -257,20 +272,29 @@ Summary runTrials(const TrialOptions& options, const std::function<void(const Tr
   if (auto diagnostics = bt::validatePlan(plan, first_cell->nodes()); !diagnostics.empty()) {
     throw bt::PlanError(std::move(diagnostics));
   }
-  Summary summary;
-  summary.options = options;
   // Slot 0 runs on this thread, in first_cell: a workcell shares the perception pipeline of the
   // thread that built it (workcell/sim_workcell.cpp), so it must run on that thread.
-  summary.trials = runIndexed(
+  std::vector<TrialResult> results = runIndexed(
       indices.size(), options.jobs,
       [&](std::size_t slot) {
-        return runOne(options, plan, judge, indices[slot], slot == 0 ? std::move(first_cell) : nullptr);
+        return runOne(options, plan, judge, indices[slot], stop, slot == 0 ? std::move(first_cell) : nullptr);
       },
       [&](const TrialResult& result, std::size_t, int done) {
-        if (progress) {
+        if (progress && result.started && !result.interrupted) {
           progress(result, done);
         }
       });
+  // A stopped batch keeps the trials that finished; those stopped midway or never started are
+  // not results.
+  for (TrialResult& result : results) {
+    if (result.interrupted) {
+      summary.cancelled.push_back(result.index);
+    }
+    if (result.started && !result.interrupted) {
+      summary.trials.push_back(std::move(result));
+    }
+  }
+  summary.interrupted = stop != nullptr && stop->load();
   return summary;
 }
 
@@ -338,6 +362,18 @@ nlohmann::json Summary::toJson() const {
   json["count"] = options.count;
   json["shard"] = {{"index", options.shard_index}, {"count", options.shard_count}};
   json["time_limit_s"] = options.time_limit_s;
+  // Every option that affects outcomes, so that shards run differently are not merged.
+  json["settle_s"] = options.settle_s;
+  json["waypoints"] = options.waypoints.string();
+  json["inject"] = options.inject;
+  json["camera_move"] = {{"distance_m", options.camera_move_m}, {"angle_deg", options.camera_turn_deg}};
+  json["calibrate"] = options.calibrate;
+  json["fingerprints"] = fingerprints;
+  if (interrupted) {
+    json["interrupted"] = true;
+    json["planned"] = planned;
+    json["cancelled"] = cancelled;
+  }
   json["successes"] = successes();
   json["success_rate"] = trials.empty() ? 0.0 : static_cast<double>(successes()) / trials.size();
   json["cycle_time_s"] = cycleTimes();
@@ -406,7 +442,35 @@ Summary Summary::fromJson(const nlohmann::json& json) {
   summary.options.judge = field<std::string>(json, "judge", where);
   summary.options.seed = field<std::uint64_t>(json, "seed", where);
   summary.options.count = json.contains("count") ? field<int>(json, "count", where) : field<int>(json, "trials", where);
-  summary.options.time_limit_s = json.value("time_limit_s", summary.options.time_limit_s);
+  if (json.contains("time_limit_s")) {
+    summary.options.time_limit_s = field<double>(json, "time_limit_s", where);
+  }
+  if (json.contains("settle_s")) {
+    summary.options.settle_s = field<double>(json, "settle_s", where);
+  }
+  if (json.contains("waypoints")) {
+    summary.options.waypoints = field<std::string>(json, "waypoints", where);
+  }
+  if (json.contains("inject")) {
+    summary.options.inject = field<std::vector<std::string>>(json, "inject", where);
+  }
+  if (json.contains("camera_move")) {
+    summary.options.camera_move_m = field<double>(json.at("camera_move"), "distance_m", where + ", camera_move");
+    summary.options.camera_turn_deg = field<double>(json.at("camera_move"), "angle_deg", where + ", camera_move");
+  }
+  if (json.contains("calibrate")) {
+    summary.options.calibrate = field<bool>(json, "calibrate", where);
+  }
+  if (json.contains("fingerprints")) {
+    summary.fingerprints = field<std::map<std::string, std::string>>(json, "fingerprints", where);
+  }
+  if (json.contains("interrupted")) {
+    summary.interrupted = field<bool>(json, "interrupted", where);
+    summary.planned = json.contains("planned") ? field<int>(json, "planned", where) : 0;
+    if (json.contains("cancelled")) {
+      summary.cancelled = field<std::vector<int>>(json, "cancelled", where);
+    }
+  }
   if (json.contains("disturb")) {
     summary.options.disturb = field<std::vector<std::string>>(json, "disturb", where);
   }
@@ -455,23 +519,44 @@ Summary mergeShards(const std::vector<Summary>& shards) {
   merged.options = first;
   merged.options.shard_index = 0;
   merged.options.shard_count = 1;
+  merged.fingerprints = shards.front().fingerprints;
   merged.trials.resize(static_cast<std::size_t>(first.count));
   std::vector<bool> seen(static_cast<std::size_t>(first.count), false);
   for (std::size_t s = 0; s < shards.size(); ++s) {
     const TrialOptions& options = shards[s].options;
+    if (shards[s].interrupted) {
+      throw std::runtime_error("results " + std::to_string(s + 1) + " are of an interrupted run (" +
+                               std::to_string(shards[s].trials.size()) + " of " + std::to_string(shards[s].planned) +
+                               " trials finished): run that shard again");
+    }
     const auto differs = [&](const std::string& what, const std::string& a, const std::string& b) {
       if (a != b) {
         throw std::runtime_error("results " + std::to_string(s + 1) + " are of another batch: " + what + " '" + b +
-                                 "', not '" + a + "'");
+                                 "', not '" + a + "' as in results 1");
       }
     };
+    const auto list = [](const std::vector<std::string>& items) { return nlohmann::json(items).dump(); };
     differs("plan", first.plan.string(), options.plan.string());
     differs("workcell", first.workcell, options.workcell);
     differs("scene", first.scene.string(), options.scene.string());
     differs("judge", first.judge, options.judge);
     differs("first seed", std::to_string(first.seed), std::to_string(options.seed));
     differs("trial count", std::to_string(first.count), std::to_string(options.count));
-    differs("disturbances", nlohmann::json(first.disturb).dump(), nlohmann::json(options.disturb).dump());
+    differs("--time-limit", shown(first.time_limit_s), shown(options.time_limit_s));
+    differs("settle time", shown(first.settle_s), shown(options.settle_s));
+    differs("--waypoints", first.waypoints.string(), options.waypoints.string());
+    differs("--inject", list(first.inject), list(options.inject));
+    differs("--disturb", list(first.disturb), list(options.disturb));
+    differs("--camera-move", shown(first.camera_move_m) + "," + shown(first.camera_turn_deg),
+            shown(options.camera_move_m) + "," + shown(options.camera_turn_deg));
+    differs("--calibrate", first.calibrate ? "on" : "off", options.calibrate ? "on" : "off");
+    for (const char* file : {"plan", "scene", "waypoints"}) {
+      const auto value = [file](const Summary& summary) {
+        const auto found = summary.fingerprints.find(file);
+        return found == summary.fingerprints.end() ? std::string("(none)") : found->second;
+      };
+      differs(std::string("the ") + file + " file's contents (fingerprint)", value(shards.front()), value(shards[s]));
+    }
     for (const TrialResult& trial : shards[s].trials) {
       if (trial.index < 0 || trial.index >= first.count) {
         throw std::runtime_error("results " + std::to_string(s + 1) + ": trial " + std::to_string(trial.index) +
@@ -506,6 +591,11 @@ std::string Summary::text() const {
   if (options.shard_count > 1) {
     std::snprintf(line, sizeof line, "shard %d/%d (trials %d, %d, ... of %d): ", options.shard_index,
                   options.shard_count, options.shard_index, options.shard_index + options.shard_count, options.count);
+    out += line;
+  }
+  if (interrupted) {
+    std::snprintf(line, sizeof line, "INTERRUPTED: %zu of %d trials finished (%zu stopped midway, not counted)\n",
+                  trials.size(), planned, cancelled.size());
     out += line;
   }
   std::snprintf(line, sizeof line, "%d of %zu trials succeeded (%.1f %%)\n", successes(), trials.size(),

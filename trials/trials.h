@@ -4,6 +4,7 @@
 // each from the simulator's true state, and summarizes: success rate, failures by node and
 // reason, cycle times. The paper's evaluation, repeatable with one command.
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -67,12 +68,27 @@ struct TrialResult {
   /// With --calibrate: the farthest any part moved while Calibrate ran (m; the arm knows no
   /// part before the camera is calibrated, so this is how much it disturbed the table).
   std::optional<double> calibrate_moved_part_m;
+  /// Stopped midway by a stop request (runTrials' `stop`): not a result, left out of the summary.
+  bool interrupted = false;
+  /// Not started: the stop came first.
+  bool started = true;
+  /// The trial's --trace could not be written: "cannot write 'FILE': ERROR" (the trial ran).
+  std::string trace_error;
 };
 
 struct Summary {
   TrialOptions options;
   /// The trials this summary holds, by index (a shard holds every shard_count-th).
   std::vector<TrialResult> trials;
+  /// A stop request (SIGINT, SIGTERM) ended the batch early: `trials` holds the trials that
+  /// finished, of `planned`; `cancelled` the indices of those stopped midway (not results; their
+  /// traces end where they stopped). An interrupted summary is not merged.
+  bool interrupted = false;
+  int planned = 0;
+  std::vector<int> cancelled;
+  /// Fingerprints (core/files.h) of what the trials read, by name: "plan" (with its included
+  /// files), "scene", "waypoints"; shards of one batch must agree on them.
+  std::map<std::string, std::string> fingerprints;
   int successes() const;
   /// Failures grouped by node path and reason, numbers masked ("# candidates"), most first.
   std::vector<std::pair<std::string, int>> failureHistogram() const;
@@ -89,29 +105,37 @@ struct Summary {
 };
 
 /// Checks the numbers: count and jobs at least 1, time limit a finite number of seconds above 0
-/// (at most kMaxTimeLimitSeconds), settle time finite and not negative.
-/// @throws std::invalid_argument naming the option and the problem.
+/// (at most kMaxTimeLimitSeconds), settle time finite and not negative, camera move finite, from
+/// 0 to 0.5 m and 45 degrees. @throws std::invalid_argument naming the option and the problem.
 void checkOptions(const TrialOptions& options);
 inline constexpr double kMaxTimeLimitSeconds = 1e6;
 
-/// Checks, before any trial runs, that `file` can be written at the end: its folder exists, it
-/// is not a folder itself, and it may be written. `what` names it in the error ("--json").
-/// @throws std::invalid_argument naming the file and the problem.
-void checkOutputFile(const std::filesystem::path& file, const std::string& what);
-
-/// Combines shard summaries of one batch (same plan, scene, judge, first seed and count) into
-/// the summary a single run would give. @throws std::runtime_error when they do not belong
-/// together, a trial appears twice, or trials are missing (listing the first missing ones).
+/// Combines shard summaries of one batch into the summary a single run would give. Shards of
+/// one batch agree on every option that affects outcomes (plan, workcell, scene, judge, first
+/// seed, count, time limit, settle time, waypoints, faults, disturbances, camera move,
+/// calibrate) and on the fingerprints of the files read. @throws std::runtime_error naming the
+/// option and both values when they do not, for an interrupted shard, when a trial appears
+/// twice, or when trials are missing (listing the first missing ones).
 Summary mergeShards(const std::vector<Summary>& shards);
 
 /// Runs the trials; `progress` is called as each one ends (from the trial's thread, one at a
-/// time). @throws std::invalid_argument or std::runtime_error before the first trial when an
+/// time). Once `*stop` is set (a signal handler's flag) no trial starts, the running ones are
+/// stopped at their next tick (their operations cancelled, the arm stopped), and the summary of
+/// the trials that finished is returned, marked interrupted.
+/// @throws std::invalid_argument or std::runtime_error before the first trial when an
 /// option is out of range (checkOptions), the plan is invalid or a file is missing.
-Summary runTrials(const TrialOptions& options, const std::function<void(const TrialResult&, int done)>& progress = {});
+Summary runTrials(const TrialOptions& options, const std::function<void(const TrialResult&, int done)>& progress = {},
+                  const std::atomic<bool>* stop = nullptr);
 
-/// Writes Summary::toJson() to `file`: atomically for a regular file (a crash leaves the old
-/// file or the new one), straight through for a device such as /dev/stdout.
-/// @throws std::runtime_error naming the file and the system error.
+/// The scene the trials read: options.scene, or the workcell's default scene (an absolute path
+/// under the data root, wherever the command runs). @throws std::runtime_error for an unknown
+/// workcell.
+std::filesystem::path effectiveScene(const TrialOptions& options);
+
+/// Writes Summary::toJson() to `file` (core/files.h writeOutputFile): atomically for a regular
+/// file (a crash leaves the old file or the new one), straight through for a device such as
+/// /dev/stdout; every write checked. @throws std::runtime_error naming the file and the system
+/// error.
 void writeJson(const Summary& summary, const std::filesystem::path& file);
 
 /// A PNG a person can read: success rate, failures by reason, cycle-time histogram.

@@ -4,9 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include "bt/test/test_support.h"
+#include "bt/trace.h"
 
 namespace costar::bt {
 namespace {
@@ -99,6 +103,51 @@ TEST(Executor, BeforeTickHookRunsBeforeEveryTick) {
   const RunResult result = executor.run();
   EXPECT_EQ(calls, 5);
   EXPECT_EQ(result.ticks, 5u);
+}
+
+std::string contents(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+TEST(Executor, AFileTraceHoldsEveryTickButTheCurrentOneWhileTheRunGoesOnAndAllAfterClose) {
+  // What SIGKILL leaves: the file as it is between two ticks.
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("costar_trace_" + std::to_string(::getpid()) + ".jsonl");
+  testing::TestTree t(R"(<Sequence><TestLeaf name="a" ticks="2"/><TestLeaf name="b" ticks="3"/></Sequence>)");
+  JsonLinesFileTrace trace(file);
+  std::ostringstream expected;
+  JsonLinesTrace all(expected);
+  t.tree.addObserver(&trace);
+  t.tree.addObserver(&all);
+  Executor executor(t.tree, t.clock);
+  int checked = 0;
+  executor.setBeforeTick([&] {
+    trace.flush();
+    EXPECT_EQ(contents(file), expected.str()) << "before tick " << checked;
+    ++checked;
+  });
+  const RunResult result = executor.run();
+  EXPECT_EQ(result.status, Status::kSuccess);
+  EXPECT_EQ(checked, static_cast<int>(result.ticks));  // checked before every tick
+  trace.close();
+  EXPECT_TRUE(trace.error().empty()) << trace.error();
+  EXPECT_EQ(contents(file), expected.str());
+  EXPECT_NE(expected.str().find(R"("to":"SUCCESS")"), std::string::npos);
+  std::filesystem::remove(file);
+}
+
+TEST(Executor, AFileTraceThatCannotBeWrittenSaysSoAndTheRunGoesOn) {
+  testing::TestTree t(R"(<TestLeaf name="a" ticks="2"/>)");
+  JsonLinesFileTrace trace("/dev/full");
+  t.tree.addObserver(&trace);
+  Executor executor(t.tree, t.clock);
+  executor.setBeforeTick([&] { trace.flush(); });
+  EXPECT_EQ(executor.run().status, Status::kSuccess);
+  trace.close();
+  EXPECT_EQ(trace.error(), "cannot write '/dev/full': No space left on device");
 }
 
 }  // namespace

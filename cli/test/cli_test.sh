@@ -67,7 +67,53 @@ check "calibrate eval: 0"     2 "--setups: Value 0 not in range" -- "$costar" ca
 check "calibrate eval: bad cell" 2 "unknown workcell 'nosuch' for calibrate eval \(simulated cells: iiwa-3f-sim, iiwa-sim, ur5-sim\)" \
   -- "$costar" calibrate eval -w nosuch --setups 1
 check "calibrate eval: no sim"  2 "unknown workcell 'test' for calibrate eval" -- "$costar" calibrate eval -w test --setups 1
-check "trials: bad move"      2 "--camera-move: at most 0.5 m and 45 degrees" -- "$costar" trials examples/ur5/pick_up_node.xml --judge lift --camera-move 1,1
+check "trials: bad move"      2 "--camera-move: '1,1' should be DISTANCE_M,ANGLE_DEG, numbers from 0 to 0.5 m and 45 degrees" \
+  -- "$costar" trials examples/ur5/pick_up_node.xml --judge lift --camera-move 1,1
+
+# Issue 27: numbers are read strictly and checked against the clock's range; messages print them
+# short. No cell is built for any of these.
+for bad in nan,5 0.05junk,5 inf,0 0.05,nan 1e400,1; do
+  check "trials --camera-move $bad" 2 "--camera-move: '$bad' should be DISTANCE_M,ANGLE_DEG" \
+    -- "$costar" trials examples/ur5/pick_up_node.xml --judge lift --camera-move "$bad"
+done
+for bad in nan inf -1 1e10 5junk; do
+  check "run --time-limit $bad" 2 "--time-limit: must be a number from 0 s and at most 1e\+09, not $bad" \
+    -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit "$bad"
+done
+check "run --rate nan"        2 "--rate: must be a number from 0.1 Hz and at most 10000, not nan" \
+  -- "$costar" run examples/test_workcell/demo.xml -w test --rate nan
+check "inject at t=1e10s"     2 "fault 'nan:arm-driver@t=1e10s': t= needs a time in seconds from 0 to 1e9" \
+  -- "$costar" run examples/ur5/pick_up_node.xml --inject nan:arm-driver@t=1e10s
+check "calibrate eval --methods bogus" 2 "--methods: unknown hand-eye method 'bogus' \(known: daniilidis, " \
+  -- "$costar" calibrate eval --setups 1 --methods daniilidis,bogus
+check "perception eval --min-found nan" 2 "--min-found: must be a number from 0 and at most 1, not nan" \
+  -- "$costar" perception eval --scenes 1 --min-found nan
+if grep -qE '[0-9]{40}' "$tmp/out"; then echo "FAIL a number of 40 digits in a message"; failures=$((failures + 1)); fi
+
+# Issue 27: unchecked writes reported success. Every output is checked: an error naming the path
+# and the system's words, exit 2, no "wrote".
+claims_nothing() {  # claims_nothing NAME: the last check's output claims no file written
+  if grep -q '^wrote' "$tmp/out"; then echo "FAIL $1: claims a file written"; failures=$((failures + 1)); fi
+}
+check "nodes -o /dev/full" 2 "^error: cannot write '/dev/full': No space left on device" \
+  -- "$costar" nodes -w test -o /dev/full
+claims_nothing "nodes -o /dev/full"
+check "nodes > /dev/full" 2 "^error: cannot write the standard output: No space left on device" \
+  -- bash -c "'$costar' nodes -w test > /dev/full"
+check "run --trace /dev/full" 2 "^error: cannot write '/dev/full': No space left on device" \
+  -- "$costar" run examples/test_workcell/demo.xml -w test -q --trace /dev/full
+check "run --trace in a missing folder" 2 "^error: cannot write '$tmp/no/t.jsonl': No such file or directory" \
+  -- "$costar" run examples/test_workcell/demo.xml -w test -q --trace "$tmp/no/t.jsonl"
+check "calibrate --json in a missing folder" 2 "^error: cannot write --json '$tmp/no/c.json': there is no folder" \
+  -- "$costar" calibrate --json "$tmp/no/c.json"
+check "calibrate --calibration in a missing folder" 2 \
+  "^error: cannot write --calibration '$tmp/no/c.json': there is no folder" \
+  -- "$costar" calibrate --calibration "$tmp/no/c.json"
+check "perception eval --json /dev/full is written to" 2 "error: cannot write --json '$tmp/no/e.json': there is no folder" \
+  -- "$costar" perception eval --scenes 1 --json "$tmp/no/e.json"
+check "sim snapshot to /dev/full" 2 "cannot write '/dev/full': No space left on device" \
+  -- "$costar" sim snapshot sim/scenes/one_node.json --out /dev/full --width 16 --height 16
+claims_nothing "sim snapshot to /dev/full"
 
 # Teaching: jog, teach, move back, rename; waypoints persist in the file.
 printf 'jog z 0.05\nteach up\nhome\nmove up\nrename up lifted\nmove nowhere\nquit\n' |
@@ -142,7 +188,84 @@ done
 kill -INT $pid
 wait $pid
 code=$?
-if [[ $code -eq 130 ]] && grep -q STOPPED "$tmp/out"; then echo "ok   ctrl-c"; else echo "FAIL ctrl-c: exit $code"; cat "$tmp/out"; failures=$((failures + 1)); fi
+if [[ $code -eq 130 ]] && grep -q 'STOPPED by SIGINT (Ctrl-C)' "$tmp/out"; then echo "ok   ctrl-c"; else echo "FAIL ctrl-c: exit $code"; cat "$tmp/out"; failures=$((failures + 1)); fi
+
+# Issue 27: SIGTERM (a batch scheduler's time limit) stops a run like Ctrl-C, with its trace
+# complete; SIGKILL keeps every tick's lines but the last tick's (the trace is written as it goes).
+trace_ok() {  # trace_ok FILE ENDED: every line a transition; ENDED=1: the run's halt is the last
+  python3 - "$1" "$2" <<'PY'
+import json, sys
+text = open(sys.argv[1]).read()
+assert text and text.endswith("\n"), "empty, or a line cut short"
+lines = [json.loads(l) for l in text.splitlines()]
+assert all({"t", "uid", "path", "node", "from", "to"} <= l.keys() for l in lines), "missing keys"
+if sys.argv[2] == "1":
+    # the root (the first node made: the smallest uid) is the last to be halted
+    assert lines[-1]["uid"] == min(l["uid"] for l in lines) and lines[-1]["to"] == "IDLE", lines[-1]
+PY
+}
+wait_for_trace() {  # wait_for_trace FILE: until the run has ticked
+  for _ in $(seq 300); do
+    [[ -s "$1" ]] && break
+    sleep 0.1
+  done
+}
+"$costar" run "$tmp/long.xml" -w none -q --trace "$tmp/term.jsonl" >"$tmp/out" 2>&1 &
+pid=$!
+wait_for_trace "$tmp/term.jsonl"
+kill -TERM $pid
+wait $pid
+code=$?
+if [[ $code -eq 143 ]] && grep -q 'STOPPED by SIGTERM' "$tmp/out" && trace_ok "$tmp/term.jsonl" 1; then
+  echo "ok   sigterm: exit 143, trace complete"
+else
+  echo "FAIL sigterm: exit $code"; cat "$tmp/out"; failures=$((failures + 1))
+fi
+"$costar" run "$tmp/long.xml" -w none -q --trace "$tmp/kill.jsonl" >"$tmp/out" 2>&1 &
+pid=$!
+wait_for_trace "$tmp/kill.jsonl"
+sleep 0.3
+kill -KILL $pid
+wait $pid 2>/dev/null
+if trace_ok "$tmp/kill.jsonl" 0 && [[ $(wc -l <"$tmp/kill.jsonl") -gt 2 ]]; then
+  echo "ok   sigkill: the trace holds $(wc -l <"$tmp/kill.jsonl") whole lines"
+else
+  echo "FAIL sigkill: trace"; failures=$((failures + 1))
+fi
+
+# Issue 27: `costar trials` on SIGTERM starts no further trial, cancels the running one, and writes
+# --json for the trials that finished, marked interrupted; no empty trace file is left.
+mkdir -p "$tmp/traces"
+"$costar" trials examples/ur5/blind_pick_place.xml --judge blind_place --scene sim/scenes/one_node.json \
+  --waypoints examples/ur5/blind_waypoints.json -n 20 -j 1 --json "$tmp/int.json" --trace "$tmp/traces" >"$tmp/out" 2>&1 &
+pid=$!
+for _ in $(seq 600); do
+  grep -qE '^\[ *1/20\]' "$tmp/out" && break
+  sleep 0.1
+done
+kill -TERM $pid
+wait $pid
+code=$?
+if [[ $code -eq 143 ]] && grep -q 'costar trials: stopped by SIGTERM: [0-9]* of 20 trials finished' "$tmp/out" &&
+   python3 - "$tmp/int.json" "$tmp/traces" <<'PY'
+import json, os, sys
+summary = json.load(open(sys.argv[1]))
+assert summary["interrupted"] is True and summary["planned"] == 20, summary
+assert 1 <= len(summary["results"]) < 20, len(summary["results"])
+for name in os.listdir(sys.argv[2]):
+    assert os.path.getsize(os.path.join(sys.argv[2], name)) > 0, name + " is empty"
+PY
+then
+  echo "ok   trials: sigterm keeps the finished trials"
+else
+  echo "FAIL trials: sigterm: exit $code"; cat "$tmp/out"; failures=$((failures + 1))
+fi
+check "trials merge refuses an interrupted shard" 2 "are of an interrupted run" -- "$costar" trials merge "$tmp/int.json"
+
+# Issue 27: the default scene of `costar trials` is the workcell's wherever the command runs.
+repo=$PWD
+check "trials outside the repository" 0 "on scene $repo/sim/scenes/assembly.json" \
+  -- bash -c "cd '$tmp' && '$(realpath "$costar")' trials '$repo/examples/ur5/blind_pick_place.xml' --judge blind_place -n 1 --time-limit 0.5"
 
 # The light costar links no robot library; costar-robot (beside it) runs the commands that do.
 robot="$(dirname "$costar")/costar-robot"

@@ -2,13 +2,16 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <thread>
 
 #include "bt/plan.h"
+#include "core/files.h"
 #include "core/paths.h"
 #include "trials/judge.h"
 
@@ -187,6 +190,143 @@ TEST(Trials, ShardsRunTheirSliceAndMergeIntoTheWholeBatch) {
   EXPECT_THROW(Summary::fromJson(nlohmann::json::parse(R"({"plan": "p.xml"})")), std::runtime_error);
   options.shard_index = 2;
   EXPECT_THROW(runTrials(options), std::invalid_argument);
+}
+
+// Issue 27: shards run with different --inject, --camera-move, --calibrate, --time-limit or
+// --waypoints merged silently into one "batch". Every option that affects outcomes goes into each
+// shard's JSON, and shards that differ are refused naming the option and both values.
+TEST(Trials, ShardsRunWithDifferentOptionsAreNotMerged) {
+  Summary first;
+  first.options = blind(2, "blind_place");
+  first.options.shard_count = 2;
+  first.fingerprints = {{"plan", "fnv1a64:1"}, {"scene", "fnv1a64:2"}, {"waypoints", "fnv1a64:3"}};
+  first.trials.resize(1);
+  Summary second = first;
+  second.options.shard_index = 1;
+  second.trials[0].index = 1;
+  const auto refused = [&first](Summary other) {
+    try {
+      mergeShards({Summary::fromJson(nlohmann::json::parse(first.toJson().dump())),
+                   Summary::fromJson(nlohmann::json::parse(other.toJson().dump()))});
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("merged");
+  };
+  EXPECT_EQ(refused(second), "merged");
+  Summary other = second;
+  other.options.inject = {"nan:arm-driver@t=2s"};
+  EXPECT_EQ(refused(other),
+            R"(results 2 are of another batch: --inject '["nan:arm-driver@t=2s"]', not '[]' as in results 1)");
+  other = second;
+  other.options.camera_move_m = 0.05;
+  other.options.camera_turn_deg = 5;
+  EXPECT_EQ(refused(other), "results 2 are of another batch: --camera-move '0.05,5', not '0,0' as in results 1");
+  other = second;
+  other.options.calibrate = true;
+  EXPECT_EQ(refused(other), "results 2 are of another batch: --calibrate 'on', not 'off' as in results 1");
+  other = second;
+  other.options.time_limit_s = 30;
+  EXPECT_EQ(refused(other), "results 2 are of another batch: --time-limit '30', not '600' as in results 1");
+  other = second;
+  other.options.waypoints = "mine.json";
+  EXPECT_NE(refused(other).find("another batch: --waypoints 'mine.json', not '"), std::string::npos);
+  other = second;
+  other.fingerprints["waypoints"] = "fnv1a64:4";
+  EXPECT_EQ(refused(other),
+            "results 2 are of another batch: the waypoints file's contents (fingerprint) 'fnv1a64:4', not "
+            "'fnv1a64:3' as in results 1");
+  other = second;
+  other.fingerprints["plan"] = "fnv1a64:5";
+  EXPECT_NE(refused(other).find("the plan file's contents (fingerprint) 'fnv1a64:5'"), std::string::npos);
+  other = second;
+  other.options.scene = "elsewhere.json";
+  EXPECT_NE(refused(other).find("another batch: scene 'elsewhere.json'"), std::string::npos);
+  other = second;
+  other.interrupted = true;
+  other.planned = 3;
+  EXPECT_EQ(refused(other), "results 2 are of an interrupted run (1 of 3 trials finished): run that shard again");
+}
+
+// Issue 27: `costar trials` on SIGINT or SIGTERM wrote no --json and left empty trace files. A
+// stop request starts no further trial, stops the running one at its next tick, and the summary
+// holds the trials that finished, marked interrupted; the stopped trial's trace is complete.
+TEST(Trials, AStopRequestKeepsTheTrialsThatFinishedAndMarksTheBatchInterrupted) {
+  const auto traces = std::filesystem::temp_directory_path() / "costar_trials_stop_test";
+  std::filesystem::remove_all(traces);
+  std::filesystem::create_directories(traces);
+  TrialOptions options = blind(4, "blind_place");
+  options.jobs = 1;
+  options.trace_dir = traces;
+  std::atomic<bool> stop{false};
+  int reported = 0;
+  // The stop comes as the first trial ends: trial 1 sees it before it starts.
+  const Summary summary = runTrials(
+      options,
+      [&](const TrialResult&, int) {
+        ++reported;
+        stop = true;
+      },
+      &stop);
+  EXPECT_TRUE(summary.interrupted);
+  EXPECT_EQ(summary.planned, 4);
+  ASSERT_EQ(summary.trials.size(), 1u);
+  EXPECT_EQ(summary.trials[0].index, 0);
+  EXPECT_EQ(reported, 1);
+  EXPECT_TRUE(summary.cancelled.empty());
+  const nlohmann::json json = nlohmann::json::parse(summary.toJson().dump());
+  EXPECT_EQ(json.at("interrupted"), true);
+  EXPECT_EQ(json.at("planned"), 4);
+  EXPECT_EQ(json.at("results").size(), 1u);
+  EXPECT_NE(summary.text().find("INTERRUPTED: 1 of 4 trials finished"), std::string::npos) << summary.text();
+  // One trace, of the trial that ran, and not empty; none for the trials never started.
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(traces)) {
+    files.push_back(entry.path());
+  }
+  ASSERT_EQ(files.size(), 1u);
+  EXPECT_EQ(files[0].filename(), "trial_5.jsonl");
+  EXPECT_GT(std::filesystem::file_size(files[0]), 0u);
+
+  // A stop while a trial runs (a plan that never ends): it is stopped at its next tick (its
+  // operations cancelled), left out of the results, and its trace ends with the halt.
+  const auto forever = traces / "forever.xml";
+  std::ofstream(forever) << R"(<root BTCPP_format="4"><BehaviorTree ID="m"><Repeat num_cycles="-1">)"
+                         << R"(<Sleep msec="10"/></Repeat></BehaviorTree></root>)";
+  options.plan = forever;
+  options.count = 1;
+  options.time_limit_s = 1e5;
+  std::filesystem::remove(traces / "trial_5.jsonl");
+  std::atomic<bool> stop_later{false};
+  std::thread stopper([&stop_later, &traces] {
+    // Once the trial has ticked: its trace is written as it goes.
+    std::error_code error;
+    for (int i = 0; i < 12000 && (std::filesystem::file_size(traces / "trial_5.jsonl", error) == 0 || error); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    stop_later = true;
+  });
+  const Summary stopped = runTrials(options, {}, &stop_later);
+  stopper.join();
+  EXPECT_TRUE(stopped.interrupted);
+  EXPECT_TRUE(stopped.trials.empty());
+  EXPECT_EQ(stopped.cancelled, std::vector<int>{0});
+  const std::string trace = contents(traces / "trial_5.jsonl");
+  ASSERT_FALSE(trace.empty());
+  const std::string last = trace.substr(trace.rfind('\n', trace.size() - 2) + 1);
+  EXPECT_NE(last.find(R"("to":"IDLE")"), std::string::npos) << last;
+  std::filesystem::remove_all(traces);
+}
+
+// Issue 27: the default scene of `costar trials` was relative to the working directory.
+TEST(Trials, TheDefaultSceneIsTheWorkcellsWhereverTheCommandRuns) {
+  TrialOptions options;
+  options.workcell = "ur5-sim";
+  const std::filesystem::path scene = effectiveScene(options);
+  EXPECT_TRUE(scene.is_absolute()) << scene;
+  EXPECT_TRUE(std::filesystem::is_regular_file(scene)) << scene;
+  options.scene = "mine.json";
+  EXPECT_EQ(effectiveScene(options), "mine.json");
 }
 
 // How far Calibrate moved a part (--calibrate) goes into the JSON in millimetres and comes back;
