@@ -1,14 +1,21 @@
 #include "arm/waypoints.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include "core/files.h"
+#include "core/json_file.h"
 
 namespace costar::arm {
 
@@ -142,6 +149,38 @@ Waypoint fromJson(const json& item, const std::string& field, int joint_count) {
   return waypoint;
 }
 
+/// The waypoint file's advisory lock, FILE.lock beside it (flock: released when the process
+/// dies, so a crashed writer never blocks the others). Held around every read-modify-write.
+class FileLock {
+ public:
+  explicit FileLock(const std::filesystem::path& file) {
+    std::filesystem::path lock_file = file;
+    lock_file += ".lock";
+    fd_ = ::open(lock_file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) {
+      throw std::runtime_error("cannot lock waypoint file '" + file.string() + "': cannot open '" + lock_file.string() +
+                               "': " + std::strerror(errno));
+    }
+    // A writer holds it for one read and one write: a few milliseconds. 10 s is a writer stuck.
+    for (int attempt = 0; ::flock(fd_, LOCK_EX | LOCK_NB) != 0; ++attempt) {
+      if ((errno != EWOULDBLOCK && errno != EINTR) || attempt == 1000) {
+        const std::string problem = errno == EWOULDBLOCK
+                                        ? "another process has held its lock '" + lock_file.string() + "' for 10 s"
+                                        : std::strerror(errno);
+        ::close(fd_);
+        throw std::runtime_error("cannot lock waypoint file '" + file.string() + "': " + problem);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+  ~FileLock() { ::close(fd_); }  // releases the lock
+
+ private:
+  int fd_ = -1;
+};
+
 }  // namespace
 
 WaypointStore::WaypointStore(std::filesystem::path file, bool persist, int joint_count)
@@ -153,6 +192,21 @@ WaypointStore::WaypointStore(std::filesystem::path file, bool persist, int joint
   if (file_.empty()) {
     return;
   }
+  stamp_ = stamp();
+  waypoints_ = read();
+}
+
+WaypointStore::Stamp WaypointStore::stamp() const {
+  struct stat info {};
+  if (::stat(file_.c_str(), &info) != 0) {
+    return {};
+  }
+  return {true, static_cast<unsigned long long>(info.st_dev), static_cast<unsigned long long>(info.st_ino),
+          static_cast<unsigned long long>(info.st_size),
+          static_cast<long long>(info.st_mtim.tv_sec) * 1000000000LL + info.st_mtim.tv_nsec};
+}
+
+WaypointStore::Map WaypointStore::read() const {
   const std::string label = "waypoint file '" + file_.string() + "'";
   std::error_code error;
   const bool exists = std::filesystem::exists(file_, error);
@@ -160,22 +214,12 @@ WaypointStore::WaypointStore(std::filesystem::path file, bool persist, int joint
     throw std::runtime_error("cannot read " + label + ": " + error.message());
   }
   if (!exists) {
-    return;
+    return {};
   }
-  if (std::filesystem::is_directory(file_, error)) {
-    throw std::runtime_error("cannot read " + label + ": it is a folder");
-  }
-  std::ifstream stream(file_);
-  if (!stream) {
-    throw std::runtime_error("cannot read " + label + ": " + std::strerror(errno));
-  }
-  std::stringstream text;
-  text << stream.rdbuf();
-  if (stream.bad()) {
-    throw std::runtime_error("cannot read " + label + ": " + std::strerror(errno));
-  }
+  const std::string text = readFile(file_, "waypoint file");
+  Map waypoints;
   try {
-    const json document = json::parse(text.str());
+    const json document = core::parseJson(text);
     if (!document.is_object() || !document.contains("waypoints") || !document.at("waypoints").is_array()) {
       fail("waypoints", "missing: the file is {\"waypoints\": [...]}");
     }
@@ -193,19 +237,59 @@ WaypointStore::WaypointStore(std::filesystem::path file, bool persist, int joint
         fail(field + ".name", "'" + waypoint.name + "' is taken already (by waypoints[" +
                                   std::to_string(previous->second) + "]); names must differ");
       }
-      waypoints_[waypoint.name] = std::move(waypoint);
+      waypoints[waypoint.name] = std::move(waypoint);
     }
   } catch (const std::exception& e) {
     throw std::runtime_error(label + ": " + e.what());
   }
+  return waypoints;
+}
+
+void WaypointStore::refresh() const {
+  if (!watched()) {
+    return;
+  }
+  const Stamp now = stamp();
+  if (now == stamp_) {
+    return;
+  }
+  stamp_ = now;
+  try {
+    waypoints_ = read();
+  } catch (const std::exception&) {
+    // Being rewritten by hand, or broken: the last good contents stay in use; a change is
+    // refused with the file's problem (update reads it again).
+  }
+}
+
+template <typename Change>
+auto WaypointStore::update(Change&& change) {
+  std::lock_guard lock(mutex_);
+  if (!watched()) {
+    return change(waypoints_);
+  }
+  if (file_.has_parent_path()) {
+    std::filesystem::create_directories(file_.parent_path());
+  }
+  const FileLock file_lock(file_);
+  Map current = read();  // the file as it is now: another writer's changes are kept
+  const auto result = change(current);
+  save(current);
+  waypoints_ = std::move(current);
+  stamp_ = stamp();
+  return result;
 }
 
 std::optional<Waypoint> WaypointStore::find(const std::string& name) const {
+  std::lock_guard lock(mutex_);
+  refresh();
   const auto it = waypoints_.find(name);
   return it == waypoints_.end() ? std::nullopt : std::optional<Waypoint>(it->second);
 }
 
 std::vector<Waypoint> WaypointStore::all() const {
+  std::lock_guard lock(mutex_);
+  refresh();
   std::vector<Waypoint> all;
   for (const auto& [name, waypoint] : waypoints_) {
     all.push_back(waypoint);
@@ -223,66 +307,40 @@ void WaypointStore::put(const Waypoint& waypoint) {
                                 " joint angles, the arm " +
                                 (joint_count_ > 0 ? std::to_string(joint_count_) : std::string("at least one")));
   }
-  auto previous = waypoints_;
-  waypoints_[waypoint.name] = waypoint;
-  try {
-    save();
-  } catch (...) {
-    waypoints_ = std::move(previous);
-    throw;
-  }
+  update([&waypoint](Map& waypoints) {
+    waypoints[waypoint.name] = waypoint;
+    return true;
+  });
 }
 
 bool WaypointStore::remove(const std::string& name) {
-  const auto it = waypoints_.find(name);
-  if (it == waypoints_.end()) {
-    return false;
-  }
-  const Waypoint removed = it->second;
-  waypoints_.erase(it);
-  try {
-    save();
-  } catch (...) {
-    waypoints_[name] = removed;
-    throw;
-  }
-  return true;
+  return update([&name](Map& waypoints) { return waypoints.erase(name) > 0; });
 }
 
 void WaypointStore::rename(const std::string& from, const std::string& to) {
   if (const std::string problem = checkWaypointName(to); !problem.empty()) {
     throw std::invalid_argument(problem);
   }
-  const auto it = waypoints_.find(from);
-  if (it == waypoints_.end()) {
-    throw std::invalid_argument("unknown waypoint '" + from + "'");
-  }
-  if (waypoints_.contains(to)) {
-    throw std::invalid_argument("a waypoint named '" + to + "' exists already");
-  }
-  auto previous = waypoints_;
-  Waypoint waypoint = it->second;
-  waypoints_.erase(it);
-  waypoint.name = to;
-  waypoints_[to] = waypoint;
-  try {
-    save();
-  } catch (...) {
-    waypoints_ = std::move(previous);
-    throw;
-  }
+  update([&from, &to](Map& waypoints) {
+    const auto it = waypoints.find(from);
+    if (it == waypoints.end()) {
+      throw std::invalid_argument("unknown waypoint '" + from + "'");
+    }
+    if (waypoints.contains(to)) {
+      throw std::invalid_argument("a waypoint named '" + to + "' exists already");
+    }
+    Waypoint waypoint = it->second;
+    waypoints.erase(it);
+    waypoint.name = to;
+    waypoints[to] = std::move(waypoint);
+    return true;
+  });
 }
 
-void WaypointStore::save() const {
-  if (file_.empty() || !persist_) {
-    return;
-  }
+void WaypointStore::save(const Map& waypoints) const {
   nlohmann::json json = {{"waypoints", nlohmann::json::array()}};
-  for (const auto& [name, waypoint] : waypoints_) {
+  for (const auto& [name, waypoint] : waypoints) {
     json["waypoints"].push_back(toJson(waypoint));
-  }
-  if (file_.has_parent_path()) {
-    std::filesystem::create_directories(file_.parent_path());
   }
   writeFileAtomically(file_, json.dump(2) + "\n");
 }

@@ -6,7 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <filesystem>
+#include <functional>
 
 #include "component/registry.h"
 #include "core/paths.h"
@@ -52,8 +56,10 @@ world::Pose toolDown(double x, double y, double z, double yaw = 0.0) {
 
 class ArmTest : public ::testing::Test {
  protected:
-  ArmTest()
-      : robot(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5_arm.urdf",
+  /// `waypoint_file`: where the arm's waypoints are kept (none: in memory).
+  explicit ArmTest(std::filesystem::path waypoint_file = {})
+      : waypoints(std::move(waypoint_file), /*persist=*/true, 6),
+        robot(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5_arm.urdf",
                                              dataRoot() / "sim/models/gripper_parallel-2f.urdf", "tool0", "base_link",
                                              "tcp")),
         collisions(robot, kBase, {.padding = 0.005}, {kHome.eigen()}),
@@ -104,9 +110,9 @@ class ArmTest : public ::testing::Test {
   }
 
   SimClock clock;
+  WaypointStore waypoints;
   planning::RobotModel robot;
   planning::CollisionWorld collisions;
-  WaypointStore waypoints;
   IdealDriver driver;
   ArmComponent arm;
 };
@@ -306,6 +312,67 @@ TEST_F(ArmTest, FollowJointPathRefusesABadPathOrOneFromElsewhereAndCancelStopsIt
   ASSERT_EQ(driver.executed.size(), 2u);
   clock.advanceBy(driver.executed.back()->duration() + std::chrono::milliseconds(10));
   EXPECT_FALSE(holds("arm_moving"));
+}
+
+/// The arm with its waypoints in a file, as in a workcell.
+class ArmWithAWaypointFile : public ArmTest {
+ protected:
+  ArmWithAWaypointFile() : ArmTest(freshFile()) {}
+  static std::filesystem::path freshFile() {
+    const auto folder = std::filesystem::temp_directory_path() / ("costar_arm_waypoints_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(folder);
+    std::filesystem::create_directories(folder);
+    return folder / "waypoints.json";
+  }
+  ~ArmWithAWaypointFile() override { std::filesystem::remove_all(waypoints.file().parent_path()); }
+
+  /// Runs `change` on the file in another process, as `costar teach` beside the editor would.
+  void inAnotherProcess(const std::function<void(WaypointStore&)>& change) {
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      try {
+        WaypointStore other(waypoints.file(), /*persist=*/true, 6);
+        change(other);
+      } catch (...) {
+        ::_exit(1);
+      }
+      ::_exit(0);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  }
+
+  bool offers(const std::string& name) {
+    world::WorldState state;
+    state.update("arm", arm.report());
+    return state.symbol(name) != nullptr;
+  }
+};
+
+// Issue 27: the server kept offering (and moving to) waypoints as it had read them at start-up.
+TEST_F(ArmWithAWaypointFile, TheArmFollowsWaypointsAnotherProcessTeachesAndDeletes) {
+  EXPECT_FALSE(offers("taught_elsewhere"));
+  inAnotherProcess([](WaypointStore& other) {
+    other.put({"taught_elsewhere", Waypoint::Kind::kPose, {}, toolDown(0.5, -0.2, 0.15), "world"});
+  });
+  EXPECT_TRUE(offers("taught_elsewhere"));
+  const OperationResult moved = run("Move", {{"waypoint", "taught_elsewhere"}, {"speed", 0.5}});
+  ASSERT_EQ(moved.state, OperationState::kSuccess) << moved.reason;
+  EXPECT_TRUE(arm.endpoint().isApprox(toolDown(0.5, -0.2, 0.15), 1e-6));
+  // Taught here, deleted there: this arm teaches beside the other process without losing it.
+  ASSERT_EQ(run("Teach", {{"waypoint", "taught_here"}, {"kind", "joints"}}).state, OperationState::kSuccess);
+  inAnotherProcess([](WaypointStore& other) {
+    if (!other.remove("taught_elsewhere")) {
+      throw std::runtime_error("not in the file");
+    }
+  });
+  EXPECT_FALSE(offers("taught_elsewhere"));
+  EXPECT_TRUE(offers("taught_here"));
+  const OperationResult gone = run("Move", {{"waypoint", "taught_elsewhere"}});
+  EXPECT_EQ(gone.state, OperationState::kFailure);
+  EXPECT_EQ(gone.reason, "unknown waypoint 'taught_elsewhere' (known: taught_here)");
 }
 
 TEST(WaypointStore, PersistsAtomicallyAndReloads) {

@@ -5,8 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <set>
 
 namespace costar::arm {
 namespace {
@@ -133,6 +138,99 @@ TEST_F(WaypointFile, AnUnreadableFileIsReportedAsUnreadableNotAsBadJson) {
   EXPECT_EQ(message(loop), "cannot read waypoint file '" + loop.string() + "': Too many levels of symbolic links");
   // A file that does not exist yet is an empty store (the first waypoint taught creates it).
   EXPECT_TRUE(WaypointStore(folder_ / "new.json").all().empty());
+}
+
+Waypoint joints(const std::string& name, double first) {
+  Waypoint waypoint;
+  waypoint.name = name;
+  waypoint.kind = Waypoint::Kind::kJoints;
+  waypoint.joints = JointVector::zero(6);
+  waypoint.joints[0] = first;
+  return waypoint;
+}
+
+std::set<std::string> names(const WaypointStore& store) {
+  std::set<std::string> out;
+  for (const Waypoint& waypoint : store.all()) {
+    out.insert(waypoint.name);
+  }
+  return out;
+}
+
+// Issue 27: the editor's server and `costar teach` each kept the whole file in memory and wrote
+// it back whole, so each deleted what the other had taught, and a reader kept offering a
+// waypoint no longer in the file. Two stores of one file stand for the two writers.
+TEST_F(WaypointFile, TwoWritersOfOneFileKeepEachOthersChangesAndSeeThem) {
+  const auto file = folder_ / "waypoints.json";
+  WaypointStore editor(file, /*persist=*/true, 6);
+  WaypointStore teach(file, /*persist=*/true, 6);
+  editor.put(joints("from_editor", 0.1));
+  teach.put(joints("from_teach", 0.2));  // used to write back its own copy: from_editor lost
+  EXPECT_EQ(names(WaypointStore(file, false)), (std::set<std::string>{"from_editor", "from_teach"}));
+  EXPECT_EQ(names(editor), (std::set<std::string>{"from_editor", "from_teach"}));  // sees the other's
+  editor.rename("from_teach", "renamed");
+  EXPECT_FALSE(teach.find("from_teach").has_value());  // no longer offered
+  EXPECT_EQ(teach.find("renamed")->joints[0], 0.2);
+  EXPECT_TRUE(teach.remove("from_editor"));
+  EXPECT_FALSE(editor.remove("from_editor"));  // gone from the file: nothing to remove
+  EXPECT_THROW(editor.rename("from_editor", "again"), std::invalid_argument);
+  EXPECT_EQ(names(editor), (std::set<std::string>{"renamed"}));
+  EXPECT_EQ(names(WaypointStore(file, false)), (std::set<std::string>{"renamed"}));
+}
+
+TEST_F(WaypointFile, AFileBrokenByHandKeepsTheLastGoodWaypointsAndIsNotOverwritten) {
+  const auto file = folder_ / "waypoints.json";
+  WaypointStore store(file, /*persist=*/true, 6);
+  store.put(joints("kept", 0.3));
+  std::ofstream(file) << "{\"waypoints\": [";  // a person's editor, half-way
+  EXPECT_EQ(names(store), (std::set<std::string>{"kept"}));
+  EXPECT_THROW(store.put(joints("new", 0.4)), std::runtime_error);
+  std::ifstream in(file);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "{\"waypoints\": [");
+}
+
+// Two processes teaching, renaming and deleting in one file at once: nothing of either is lost.
+TEST_F(WaypointFile, TwoProcessesInterleavingChangesLoseNothing) {
+  const auto file = folder_ / "waypoints.json";
+  constexpr int kEach = 40;
+  const auto work = [&file](const std::string& who) {
+    WaypointStore store(file, /*persist=*/true, 6);
+    for (int i = 0; i < kEach; ++i) {
+      const std::string name = who + "_" + std::to_string(i);
+      store.put(joints(name, i));
+      if (i % 4 == 1) {
+        store.rename(name, name + "_renamed");
+      } else if (i % 4 == 2) {
+        store.remove(name);
+      }
+    }
+  };
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    try {
+      work("child");
+    } catch (...) {
+      ::_exit(1);
+    }
+    ::_exit(0);
+  }
+  work("parent");
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  std::set<std::string> expected;
+  for (const std::string who : {"child", "parent"}) {
+    for (int i = 0; i < kEach; ++i) {
+      const std::string name = who + "_" + std::to_string(i);
+      if (i % 4 == 1) {
+        expected.insert(name + "_renamed");
+      } else if (i % 4 != 2) {
+        expected.insert(name);
+      }
+    }
+  }
+  EXPECT_EQ(names(WaypointStore(file, false)), expected);
 }
 
 }  // namespace
