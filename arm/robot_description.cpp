@@ -2,14 +2,14 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 
+#include "core/files.h"
 #include "core/json_fields.h"
+#include "core/json_file.h"
 #include "core/paths.h"
 
 namespace costar::arm {
@@ -305,31 +305,32 @@ std::filesystem::path robotDescriptionFile(const std::string& name, const std::f
 
 RobotDescription loadRobotDescription(const std::filesystem::path& file, const std::filesystem::path& data_root) {
   const std::string label = "robot description '" + file.string() + "'";
-  std::ifstream in(file);
-  if (!in) {
-    throw std::runtime_error("cannot read " + label + ": no such file or not readable");
-  }
-  std::stringstream content;
-  content << in.rdbuf();
+  const std::string content = readFile(file, "robot description");
+  RobotDescription robot;
+  bool generated = false;
   try {
     json parsed;
     try {
-      parsed = json::parse(content.str());
+      parsed = core::parseJson(content);
     } catch (const json::parse_error& e) {
       throw std::runtime_error(std::string("not valid JSON: ") + e.what());
     }
-    const bool generated = parsed.is_object() && parsed.contains("format");
+    generated = parsed.is_object() && parsed.contains("format");
     if (generated && parsed.at("format") != kGeneratedFormat) {
       throw std::runtime_error("format: must be \"" + std::string(kGeneratedFormat) + "\", not " +
                                shown(parsed.at("format")));
     }
-    RobotDescription robot =
-        generated ? parseGenerated(parsed) : parse(parsed, data_root.empty() ? dataRoot() : data_root);
+    robot = generated ? parseGenerated(parsed) : parse(parsed, data_root.empty() ? dataRoot() : data_root);
     robot.file = file;
-    return robot;
   } catch (const std::exception& e) {
     throw std::runtime_error(label + ": " + e.what());
   }
+  // The simulator and the planner use the models generated from this file at build time: the
+  // file must be the one they came from.
+  if (generated) {
+    checkGeneratedFrom(file, generatedRoot() / "robots" / robot.name / (robot.name + ".fingerprint"));
+  }
+  return robot;
 }
 
 }  // namespace costar::arm

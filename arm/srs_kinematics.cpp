@@ -3,11 +3,13 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <stdexcept>
 #include <utility>
+
+#include "core/files.h"
+#include "core/json_file.h"
 
 namespace costar::arm {
 
@@ -179,15 +181,14 @@ SrsLimits SrsLimits::iiwa14() {
 // The description file
 
 SrsArmDescription readSrsArmDescription(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) {
-    throw std::runtime_error(file.string() + ": cannot open the robot description");
-  }
+  const std::string text_of_file = readFile(file, "robot description");
   nlohmann::json root;
   try {
-    root = nlohmann::json::parse(in);
+    root = core::parseJson(text_of_file);
   } catch (const nlohmann::json::parse_error& error) {
     throw std::runtime_error(file.string() + ": not valid JSON: " + error.what());
+  } catch (const std::runtime_error& error) {
+    throw std::runtime_error(file.string() + ": " + error.what());
   }
   auto number = [&](const nlohmann::json& object, const char* key, const std::string& field) {
     if (!object.is_object() || !object.contains(key) || !object[key].is_number()) {
@@ -232,6 +233,12 @@ SrsArmDescription readSrsArmDescription(const std::filesystem::path& file) {
       throw descriptionError(file, field + ".origin",
                              "the analytic S-R-S solver needs every joint origin on the z axis of its parent "
                              "link, without rotation");
+    }
+    // A link of zero length puts a joint on the one before it; 10 m is beyond any arm.
+    if (origin.z() == 0.0 || std::abs(origin.z()) > 10.0) {
+      throw descriptionError(file, field + ".origin",
+                             origin.z() == 0.0 ? "[0, 0, 0] puts this joint on the one before it: a link of zero length"
+                                               : "a link longer than 10 m");
     }
     offsets[i] = origin.z();
     const Eigen::Vector3d axis = vec3(joint, "axis", field, false);

@@ -1,11 +1,10 @@
 #include "calibration/calibration_file.h"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 
 #include "core/files.h"
+#include "core/json_file.h"
 
 namespace costar::calibration {
 
@@ -83,6 +82,14 @@ CellCalibration calibrationFromJson(const nlohmann::json& json, const std::strin
     if (!json.is_object()) {
       throw std::runtime_error("the file must hold a JSON object with \"marker\" and/or \"camera\"");
     }
+    // Any other JSON file (an object class, a scene) is not a calibration.
+    for (const auto& [key, value] : json.items()) {
+      if (key != "marker" && key != "camera") {
+        throw std::runtime_error(key +
+                                 ": unknown field: a calibration holds \"marker\" and/or \"camera\" (is this "
+                                 "a calibration file?)");
+      }
+    }
     CellCalibration c;
     if (json.contains("marker")) {
       const auto& marker = json.at("marker");
@@ -108,17 +115,14 @@ std::optional<CellCalibration> loadCalibration(const std::filesystem::path& file
   if (file.empty() || !std::filesystem::exists(file, error)) {
     return std::nullopt;
   }
-  std::ifstream stream(file);
-  if (!stream) {
-    throw std::runtime_error("calibration '" + file.string() + "': cannot open the file");
-  }
-  std::stringstream text;
-  text << stream.rdbuf();
+  const std::string text = readFile(file, "calibration");
   nlohmann::json json;
   try {
-    json = nlohmann::json::parse(text.str());
+    json = core::parseJson(text);
   } catch (const nlohmann::json::parse_error& e) {
     throw std::runtime_error("calibration '" + file.string() + "': not valid JSON: " + e.what());
+  } catch (const std::exception& e) {
+    throw std::runtime_error("calibration '" + file.string() + "': " + e.what());
   }
   return calibrationFromJson(json, file.string());
 }

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
+#include <cstdio>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "core/files.h"
+#include "core/json_file.h"
 #include "core/paths.h"
 
 namespace costar::gripper {
@@ -54,18 +56,37 @@ class Fields {
     }
     return object.at(key);
   }
-  double number(const nlohmann::json& object, const std::string& key, const std::string& field) const {
+  /// A finite number of magnitude at most `at_most` (1e308 is a typing error).
+  double number(const nlohmann::json& object, const std::string& key, const std::string& field,
+                double at_most = 1e6) const {
     const auto& value = at(object, key, field);
     if (!value.is_number() || !std::isfinite(value.get<double>())) {
       fail(field.empty() ? key : field + "." + key, "must be a finite number");
     }
+    if (std::abs(value.get<double>()) > at_most) {
+      char problem[96];
+      std::snprintf(problem, sizeof problem, "must be at most %g in magnitude, not %g", at_most, value.get<double>());
+      fail(field.empty() ? key : field + "." + key, problem);
+    }
     return value.get<double>();
   }
+  /// A length (m) above 0 and at most `at_most`.
+  double length(const nlohmann::json& object, const std::string& key, const std::string& field, double at_most) const {
+    const double value = number(object, key, field, at_most);
+    if (!(value > 0.0)) {
+      char problem[96];
+      std::snprintf(problem, sizeof problem, "must be a length above 0 and at most %g m, not %g", at_most, value);
+      fail(field + "." + key, problem);
+    }
+    return value;
+  }
+  /// 3 finite numbers, each of magnitude at most 1 (m: a hand is well under a metre across).
   Eigen::Vector3d vec3(const nlohmann::json& object, const std::string& key, const std::string& field) const {
     const auto& value = at(object, key, field);
-    if (!value.is_array() || value.size() != 3 ||
-        !std::all_of(value.begin(), value.end(), [](const auto& x) { return x.is_number(); })) {
-      fail(field.empty() ? key : field + "." + key, "must be 3 numbers");
+    if (!value.is_array() || value.size() != 3 || !std::all_of(value.begin(), value.end(), [](const auto& x) {
+          return x.is_number() && std::isfinite(x.template get<double>()) && std::abs(x.template get<double>()) <= 1.0;
+        })) {
+      fail(field.empty() ? key : field + "." + key, "must be 3 numbers from -1 to 1 (m)");
     }
     return {value[0].get<double>(), value[1].get<double>(), value[2].get<double>()};
   }
@@ -78,15 +99,14 @@ class Fields {
 
 AdaptiveGripperDescription loadAdaptiveGripperDescription(const std::filesystem::path& file) {
   const Fields fields("gripper description '" + file.string() + "'");
-  std::ifstream in(file);
-  if (!in) {
-    throw std::runtime_error("gripper description '" + file.string() + "': cannot open");
-  }
+  const std::string text = readFile(file, "gripper description");
   nlohmann::json root;
   try {
-    root = nlohmann::json::parse(in);
+    root = core::parseJson(text);
   } catch (const nlohmann::json::parse_error& e) {
     fields.fail("(syntax)", e.what());
+  } catch (const std::runtime_error& e) {  // a key given twice: "FIELD: key 'K' appears twice ..."
+    throw std::runtime_error("gripper description '" + file.string() + "': " + e.what());
   }
   if (!root.is_object() || root.value("format", "") != "costar-gripper-description/1") {
     fields.fail("format", "must be \"costar-gripper-description/1\"");
@@ -115,10 +135,12 @@ AdaptiveGripperDescription loadAdaptiveGripperDescription(const std::filesystem:
   }
   for (std::size_t i = 0; i < phalanges.size(); ++i) {
     const std::string field = "phalanges[" + std::to_string(i) + "]";
-    description.finger_length += fields.number(phalanges[i], "length", field);
-    description.finger_width = std::max(description.finger_width, fields.number(phalanges[i], "width", field));
+    constexpr double kLargestPhalanx = 0.5;  // m
+    description.finger_length += fields.length(phalanges[i], "length", field, kLargestPhalanx);
+    description.finger_width =
+        std::max(description.finger_width, fields.length(phalanges[i], "width", field, kLargestPhalanx));
     description.finger_thickness =
-        std::max(description.finger_thickness, fields.number(phalanges[i], "thickness", field));
+        std::max(description.finger_thickness, fields.length(phalanges[i], "thickness", field, kLargestPhalanx));
   }
   description.open_lean_deg = std::max(0.0, -fields.number(phalanges[0], "lower_deg", "phalanges[0]"));
   description.proximal_upper_deg = fields.number(phalanges[0], "upper_deg", "phalanges[0]");

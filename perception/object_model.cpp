@@ -9,6 +9,8 @@
 #include <set>
 #include <stdexcept>
 
+#include "core/json_file.h"
+
 namespace costar::perception {
 
 void Cloud::append(const Cloud& other, std::size_t index) {
@@ -196,7 +198,7 @@ std::vector<ObjectModel> loadObjectModels(const std::filesystem::path& objects_d
   }
   std::map<std::string, ClassParameters> parameters;
   try {
-    json = nlohmann::json::parse(stream);
+    json = core::readJsonFile(classes_file);
     ClassParameters defaults;
     const nlohmann::json default_json = json.value("defaults", nlohmann::json::object());
     const auto read = [](const nlohmann::json& entry, ClassParameters base) {

@@ -18,6 +18,9 @@
 #include <set>
 #include <stdexcept>
 
+#include "core/files.h"
+#include "core/json_file.h"
+
 namespace costar::perception {
 
 namespace {
@@ -435,14 +438,7 @@ void SvmClassifier::save(const std::filesystem::path& file) const {
         {"name", entry.name}, {"examples", entry.examples}, {"cross_validated_accuracy", entry.accuracy()}};
   }
   json["training"] = training;
-  std::ofstream stream(file);
-  if (!stream) {
-    throw std::runtime_error("cannot write the SVM model '" + file.string() + "'");
-  }
-  stream << json.dump() << "\n";
-  if (!stream) {
-    throw std::runtime_error("cannot write the SVM model '" + file.string() + "'");
-  }
+  writeOutputFile(file, json.dump() + "\n");
 }
 
 SvmClassifier SvmClassifier::load(const std::filesystem::path& file) {
@@ -452,7 +448,7 @@ SvmClassifier SvmClassifier::load(const std::filesystem::path& file) {
                              "' (train one with `costar perception train`)");
   }
   try {
-    const nlohmann::json json = nlohmann::json::parse(stream);
+    const nlohmann::json json = core::readJsonFile(file);
     if (json.value("format", "") != "costar-svm-rbf-1") {
       throw std::runtime_error("not a costar SVM model (format costar-svm-rbf-1)");
     }

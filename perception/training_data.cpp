@@ -5,6 +5,8 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "core/files.h"
+#include "core/json_file.h"
 #include "perception/clustering.h"
 #include "perception/features.h"
 
@@ -97,16 +99,12 @@ void saveTrainingSet(const TrainingSet& set, const std::filesystem::path& folder
     json["names"][std::to_string(label)] = name;
     json["counts"][name] = std::count(set.labels.begin(), set.labels.end(), label);
   }
-  std::ofstream(folder / "dataset.json") << json.dump(2) << "\n";
-  std::ofstream features(folder / "features.f32", std::ios::binary);
   const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows = set.features;
-  features.write(reinterpret_cast<const char*>(rows.data()), static_cast<std::streamsize>(rows.size() * sizeof(float)));
-  std::ofstream labels(folder / "labels.i32", std::ios::binary);
-  labels.write(reinterpret_cast<const char*>(set.labels.data()),
-               static_cast<std::streamsize>(set.labels.size() * sizeof(int)));
-  if (!features || !labels) {
-    throw std::runtime_error("cannot write the training examples to '" + folder.string() + "'");
-  }
+  writeOutputFile(folder / "features.f32",
+                  std::string_view(reinterpret_cast<const char*>(rows.data()), rows.size() * sizeof(float)));
+  writeOutputFile(folder / "labels.i32",
+                  std::string_view(reinterpret_cast<const char*>(set.labels.data()), set.labels.size() * sizeof(int)));
+  writeOutputFile(folder / "dataset.json", json.dump(2) + "\n");  // last: it describes the other two
 }
 
 TrainingSet loadTrainingSet(const std::filesystem::path& folder) {
@@ -117,7 +115,7 @@ TrainingSet loadTrainingSet(const std::filesystem::path& folder) {
                              "' (collect them with `costar perception collect`)");
   }
   try {
-    const nlohmann::json json = nlohmann::json::parse(header);
+    const nlohmann::json json = core::readJsonFile(folder / "dataset.json");
     if (json.value("format", "") != "costar-perception-examples-1") {
       throw std::runtime_error("unknown format");
     }

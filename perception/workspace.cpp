@@ -15,6 +15,9 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "core/files.h"
+#include "core/json_file.h"
+
 namespace costar::perception {
 
 world::Pose loadTableCenter(const std::filesystem::path& file) {
@@ -24,7 +27,7 @@ world::Pose loadTableCenter(const std::filesystem::path& file) {
                              "' (find the workspace centre with `costar perception collect`)");
   }
   try {
-    const nlohmann::json json = nlohmann::json::parse(stream);
+    const nlohmann::json json = core::readJsonFile(file);
     const auto& center = json.at("table_center");
     const auto xyz = center.at("xyz").get<std::vector<double>>();
     const auto rpy = center.value("rpy_deg", std::vector<double>{0, 0, 0});
@@ -47,11 +50,7 @@ void saveTableCenter(const std::filesystem::path& file, const world::Pose& table
   json["table_center"] = {{"xyz", {round(xyz.x(), 1e-5), round(xyz.y(), 1e-5), round(xyz.z(), 1e-5)}},
                           {"rpy_deg", {round(rpy.x(), 1e-3), round(rpy.y(), 1e-3), round(rpy.z(), 1e-3)}}};
   json["source"] = note;
-  std::ofstream stream(file);
-  stream << json.dump(2) << "\n";
-  if (!stream) {
-    throw std::runtime_error("cannot write the workspace file '" + file.string() + "'");
-  }
+  writeOutputFile(file, json.dump(2) + "\n");
 }
 
 PixelRect workspaceRegion(const camera::Intrinsics& intrinsics, const world::Pose& camera_pose,

@@ -9,8 +9,35 @@ class DescriptionError(Exception):
     pass
 
 
+def fingerprint(path):
+    """FNV-1a (64 bits) of the file's bytes, as core/files.h fingerprint() writes it: the runtime
+    compares it with the description it reads, so that a description edited after the build is
+    refused instead of applied in part (the simulator uses these models, the runtime the JSON)."""
+    value = 14695981039346656037
+    for byte in pathlib.Path(path).read_bytes():
+        value ^= byte
+        value = (value * 1099511628211) % (1 << 64)
+    return f"fnv1a64:{value:016x}"
+
+
+def write_fingerprint(source, out_file):
+    """NAME.fingerprint beside the generated models: the fingerprint of the description they
+    were generated from (core/files.h checkGeneratedFrom reads it)."""
+    pathlib.Path(out_file).write_text(fingerprint(source) + "\n")
+
+
 def fmt(values):
     return " ".join(f"{float(x):.12g}" for x in values)
+
+
+def _no_duplicates(pairs):
+    """An object's keys, each once: a key given twice is refused (json keeps the last silently)."""
+    seen = {}
+    for key, value in pairs:
+        if key in seen:
+            raise DescriptionError(f"key '{key}' appears twice (a key may appear once in an object)")
+        seen[key] = value
+    return seen
 
 
 def _finite(x):
@@ -23,19 +50,26 @@ class Reader:
     def __init__(self, path):
         self.path = path
         try:
-            self.root = json.loads(pathlib.Path(path).read_text())
+            self.root = json.loads(pathlib.Path(path).read_text(), object_pairs_hook=_no_duplicates)
         except OSError as error:
             raise DescriptionError(f"{path}: cannot read: {error.strerror}")
         except json.JSONDecodeError as error:
             raise DescriptionError(f"{path}: line {error.lineno}, column {error.colno}: {error.msg}")
+        except DescriptionError as error:
+            raise DescriptionError(f"{path}: {error}")
         if not isinstance(self.root, dict):
             raise DescriptionError(f"{path}: the top level must be an object")
 
     def fail(self, field, problem):
         raise DescriptionError(f"{self.path}: {field}: {problem}")
 
-    def get(self, obj, key, field, kind, optional=False, default=None, positive=False):
-        """obj[key], checked to be of `kind` (number, string, vec3, list, object); `field` names obj."""
+    # No number in a description is larger than this (1e308 is a typing error, and overflows what
+    # the simulator computes from it); fields with a tighter bound pass it as `at_most`.
+    LARGEST = 1e6
+
+    def get(self, obj, key, field, kind, optional=False, default=None, positive=False, at_most=LARGEST):
+        """obj[key], checked to be of `kind` (number, string, vec3, list, object); `field` names obj.
+        A number or each of a vec3's is at most `at_most` in magnitude."""
         name = f"{field}.{key}" if field else key
         if not isinstance(obj, dict):
             self.fail(field, "must be an object")
@@ -49,6 +83,8 @@ class Reader:
                 self.fail(name, f"must be a finite number, not {json.dumps(value)}")
             if positive and value <= 0:
                 self.fail(name, f"must be positive, not {value}")
+            if abs(value) > at_most:
+                self.fail(name, f"must be at most {at_most:g} in magnitude, not {value:g}")
         elif kind == "string":
             if not isinstance(value, str) or not value:
                 self.fail(name, "must be a non-empty string")
@@ -57,6 +93,8 @@ class Reader:
                 self.fail(name, f"must be 3 finite numbers, not {json.dumps(value)}")
             if positive and min(value) <= 0:
                 self.fail(name, "must be 3 positive numbers")
+            if max(abs(x) for x in value) > at_most:
+                self.fail(name, f"must be 3 numbers of magnitude at most {at_most:g}, not {fmt(value)}")
         elif kind == "list":
             if not isinstance(value, list) or not value:
                 self.fail(name, "must be a non-empty list")

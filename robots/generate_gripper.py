@@ -32,11 +32,18 @@ import math
 import pathlib
 import sys
 
-from description_reader import DescriptionError, Reader, fmt
+from description_reader import DescriptionError, Reader, fmt, write_fingerprint
 
 FORMAT = "costar-gripper-description/1"
 PHALANGES = ("proximal", "medial", "distal")
 FINGERS = ("finger_middle", "finger_1", "finger_2")
+
+
+# The largest sizes a gripper description may give: a hand is well under a metre across, a
+# phalanx a few centimetres long.
+MAX_M = 1.0
+MAX_PHALANX_M = 0.5
+MAX_KG = 100.0
 
 
 def read_description(path):
@@ -48,16 +55,16 @@ def read_description(path):
     if not g["name"].replace("_", "").isalnum():
         reader.fail("name", "must be letters, digits and underscores")
     palm = reader.get(root, "palm", "", "object")
-    g["palm"] = {"size": reader.get(palm, "size", "palm", "vec3", positive=True),
-                 "centre": reader.get(palm, "centre", "palm", "vec3"),
-                 "mass": reader.get(palm, "mass", "palm", "number", positive=True)}
-    g["tcp"] = reader.get(root, "tcp", "", "vec3")
+    g["palm"] = {"size": reader.get(palm, "size", "palm", "vec3", positive=True, at_most=MAX_M),
+                 "centre": reader.get(palm, "centre", "palm", "vec3", at_most=MAX_M),
+                 "mass": reader.get(palm, "mass", "palm", "number", positive=True, at_most=MAX_KG)}
+    g["tcp"] = reader.get(root, "tcp", "", "vec3", at_most=MAX_M)
 
     fingers = []
     for i, finger in enumerate(reader.get(root, "fingers", "", "list")):
         field = f"fingers[{i}]"
         entry = {"name": reader.get(finger, "name", field, "string"),
-                 "base": reader.get(finger, "base", field, "vec3"),
+                 "base": reader.get(finger, "base", field, "vec3", at_most=MAX_M),
                  "yaw_deg": reader.get(finger, "yaw_deg", field, "number"),
                  "scissor_sign": reader.get(finger, "scissor_sign", field, "number")}
         if entry["name"] in (f["name"] for f in fingers):
@@ -83,8 +90,9 @@ def read_description(path):
     for i, phalanx in enumerate(phalanges):
         field = f"phalanges[{i}]"
         entry = {"name": phalanx["name"]}
-        for key in ("length", "width", "thickness", "mass"):
-            entry[key] = reader.get(phalanx, key, field, "number", positive=True)
+        for key in ("length", "width", "thickness"):
+            entry[key] = reader.get(phalanx, key, field, "number", positive=True, at_most=MAX_PHALANX_M)
+        entry["mass"] = reader.get(phalanx, "mass", field, "number", positive=True, at_most=MAX_KG)
         for key in ("lower_deg", "upper_deg"):
             entry[key] = reader.get(phalanx, key, field, "number")
         entry["stiffness"] = reader.get(phalanx, "stiffness_nm_rad", field, "number", positive=True)
@@ -120,7 +128,7 @@ def read_description(path):
         entry = {"name": reader.get(mode, "name", field, "string"),
                  "scissor_deg": reader.get(mode, "scissor_deg", field, "number"),
                  "closing": reader.get(mode, "closing", field, "list"),
-                 "grasp_centre": reader.get(mode, "grasp_centre", field, "vec3"),
+                 "grasp_centre": reader.get(mode, "grasp_centre", field, "vec3", at_most=MAX_M),
                  "fingertip": mode.get("fingertip", False)}
         if not isinstance(entry["fingertip"], bool):
             reader.fail(f"{field}.fingertip", "must be true or false")
@@ -345,6 +353,7 @@ def main(argv):
         wrap(mount, f"{n}_mount", shown,
              "The gripper as a workcell's gripper piece (sim/cell_model.h): body \"mount\" is the flange."))
     (out / f"{n}.urdf").write_text(urdf(gripper, shown))
+    write_fingerprint(source, out / f"{n}.fingerprint")  # last: the models are complete
     return 0
 
 

@@ -21,7 +21,7 @@ import math
 import pathlib
 import sys
 
-from description_reader import DescriptionError, Reader, fmt
+from description_reader import DescriptionError, Reader, fmt, write_fingerprint
 
 FORMAT = "costar-robot-description/1"
 
@@ -51,6 +51,11 @@ def mat_mat(a, b):
     return [[sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
 
 
+# The largest length (m) and mass (kg) a description may give: an arm is a few metres long.
+MAX_M = 10.0
+MAX_KG = 1000.0
+
+
 def read_description(path):
     reader = Reader(path)
     root = reader.root
@@ -63,8 +68,8 @@ def read_description(path):
         name = reader.get(link, "name", field, "string")
         if name in links:
             reader.fail(f"{field}.name", f'"{name}" appears twice')
-        mass = reader.get(link, "mass", field, "number")
-        inertia = reader.get(link, "inertia", field, "vec3")
+        mass = reader.get(link, "mass", field, "number", at_most=MAX_KG)
+        inertia = reader.get(link, "inertia", field, "vec3", at_most=MAX_KG * MAX_M ** 2)
         if mass <= 0 or min(inertia) <= 0:
             reader.fail(field, "mass and inertia must be positive")
         a, b, c = inertia
@@ -76,13 +81,13 @@ def read_description(path):
             kind = reader.get(shape, "type", shape_field, "string")
             if kind not in ("capsule", "cylinder"):
                 reader.fail(f"{shape_field}.type", f'"{kind}" is not one of capsule, cylinder')
-            start = reader.get(shape, "from", shape_field, "vec3")
-            end = reader.get(shape, "to", shape_field, "vec3")
-            radius = reader.get(shape, "radius", shape_field, "number")
+            start = reader.get(shape, "from", shape_field, "vec3", at_most=MAX_M)
+            end = reader.get(shape, "to", shape_field, "vec3", at_most=MAX_M)
+            radius = reader.get(shape, "radius", shape_field, "number", at_most=MAX_M)
             if radius <= 0 or math.dist(start, end) <= 0:
                 reader.fail(shape_field, "needs a positive radius and distinct from/to")
             shapes.append({"type": kind, "from": start, "to": end, "radius": radius})
-        links[name] = {"name": name, "mass": mass, "com": reader.get(link, "com", field, "vec3"),
+        links[name] = {"name": name, "mass": mass, "com": reader.get(link, "com", field, "vec3", at_most=MAX_M),
                        "inertia": inertia, "collision": shapes}
     if robot["base_link"] not in links:
         reader.fail("base_link", f'"{robot["base_link"]}" is not a link')
@@ -97,7 +102,9 @@ def read_description(path):
             reader.fail(f"{field}.parent", f'must be "{parent}" (the joints form one chain from the base link)')
         if entry["child"] not in links:
             reader.fail(f"{field}.child", f'"{entry["child"]}" is not a link')
-        entry["origin"] = reader.get(joint, "origin", field, "vec3")
+        entry["origin"] = reader.get(joint, "origin", field, "vec3", at_most=MAX_M)
+        if not any(entry["origin"]):
+            reader.fail(f"{field}.origin", f'[0, 0, 0] puts {entry["name"]} on the joint before it: a link of zero length')
         entry["rpy"] = reader.get(joint, "rpy", field, "vec3", optional=True, default=[0, 0, 0])
         axis = reader.get(joint, "axis", field, "vec3")
         norm = math.sqrt(sum(x * x for x in axis))
@@ -117,7 +124,7 @@ def read_description(path):
     tool = reader.get(root, "tool", "", "object")
     robot["tool"] = {"name": reader.get(tool, "name", "tool", "string"),
                      "parent": reader.get(tool, "parent", "tool", "string"),
-                     "origin": reader.get(tool, "origin", "tool", "vec3"),
+                     "origin": reader.get(tool, "origin", "tool", "vec3", at_most=MAX_M),
                      "rpy": reader.get(tool, "rpy", "tool", "vec3", optional=True, default=[0, 0, 0])}
     if robot["tool"]["parent"] != parent:
         reader.fail("tool.parent", f'must be "{parent}", the last link of the chain')
@@ -281,6 +288,7 @@ def main(argv):
     shown = "/".join(source.resolve().parts[-3:])
     write_mjcf(robot, out / f'{robot["name"]}.xml', shown)
     write_urdf(robot, out / f'{robot["name"]}.urdf', shown)
+    write_fingerprint(source, out / f'{robot["name"]}.fingerprint')  # last: the models are complete
     return 0
 
 

@@ -2,15 +2,15 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 #include <stdexcept>
+
+#include "core/files.h"
+#include "core/json_file.h"
 
 namespace costar::sim {
 
@@ -255,7 +255,7 @@ world::Pose cameraOffsetPose(const CameraOffset& offset, std::uint64_t seed) {
 
 Scene parseScene(const std::string& text, const std::string& label) {
   try {
-    const json file = json::parse(text);
+    const json file = core::parseJson(text);
     onlyKnownFields(object(file, "the file"), "",
                     {"description", "seed", "min_gap", "camera_offset", "regions", "parts"});
     Scene scene;
@@ -304,20 +304,8 @@ Scene parseScene(const std::string& text, const std::string& label) {
 }
 
 Scene loadScene(const std::filesystem::path& file) {
-  std::error_code error;
-  if (std::filesystem::is_directory(file, error)) {
-    throw std::runtime_error("cannot read scene file '" + file.string() + "': it is a folder");
-  }
-  std::ifstream stream(file);
-  if (!stream) {
-    throw std::runtime_error("cannot read scene file '" + file.string() + "': " + std::strerror(errno));
-  }
-  std::stringstream text;
-  text << stream.rdbuf();
-  if (stream.bad()) {
-    throw std::runtime_error("cannot read scene file '" + file.string() + "': " + std::strerror(errno));
-  }
-  return parseScene(text.str(), file.string());
+  // A regular file of a sane size: not /dev/zero, not a folder.
+  return parseScene(readFile(file, "scene file"), file.string());
 }
 
 Footprint Footprint::of(const world::ObjectClass& object, double x, double y, double yaw) {
@@ -369,6 +357,41 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
                              "' (known: " + known + ")");
   };
 
+  // Parts placed with "at" first: two that overlap (physics would throw them apart) are refused,
+  // and random placements keep clear of every one, wherever it comes in the list.
+  struct Fixed {
+    std::size_t request;
+    Footprint footprint;
+    double bottom;  // m above the table
+    double top;
+  };
+  std::vector<Fixed> fixed;
+  for (std::size_t r = 0; r < scene.parts.size(); ++r) {
+    const PartRequest& request = scene.parts[r];
+    if (!request.at) {
+      continue;
+    }
+    const world::ObjectClass& object = findClass(request.object_class, "parts[" + std::to_string(r) + "]");
+    const Fixed part{r, Footprint::of(object, request.at->x(), request.at->y(), request.at->z() * M_PI / 180.0),
+                     request.height, request.height + object.bounds().sizes().z()};
+    for (const Fixed& other : fixed) {
+      // Touching is fine (the perception evaluation's scenes place parts 1 mm apart, give or take
+      // 0.4 mm); more than 1 mm into each other is not. One above the other is fine too.
+      const bool apart_vertically = std::min(part.top, other.top) - std::max(part.bottom, other.bottom) <= 0.001;
+      if (!apart_vertically && closerThan(part.footprint, other.footprint, -0.001)) {
+        const PartRequest& first = scene.parts[other.request];
+        throw std::runtime_error("scene '" + scene.label + "': parts[" + std::to_string(other.request) + "] (" +
+                                 first.object_class + " at " + format(first.at->x()) + ", " + format(first.at->y()) +
+                                 ") and parts[" + std::to_string(r) + "] (" + request.object_class + " at " +
+                                 format(request.at->x()) + ", " + format(request.at->y()) +
+                                 ") overlap: the simulation would throw them apart (move one, or give it a \"height\" "
+                                 "to lie on the other)");
+      }
+    }
+    fixed.push_back(part);
+    footprints.push_back(part.footprint);
+  }
+
   for (std::size_t r = 0; r < scene.parts.size(); ++r) {
     const PartRequest& request = scene.parts[r];
     const std::string field = "parts[" + std::to_string(r) + "]";
@@ -411,7 +434,9 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
                                    "min_gap)");
         }
       }
-      footprints.push_back(Footprint::of(object, xy.x(), xy.y(), yaw));
+      if (!request.at) {
+        footprints.push_back(Footprint::of(object, xy.x(), xy.y(), yaw));
+      }
       part.pose = world::poseFromXyzRpy(xy.x(), xy.y(), request.height + object.rest_height + 0.0005, 0, 0, yaw);
       placed.push_back(std::move(part));
     }

@@ -9,6 +9,8 @@
 // "at" is x, y (m, world frame: the robot's base, table top z = 0) and yaw (degrees); with
 // "height" (m, 0 to 0.5) such a part starts that far above the table and falls onto what lies
 // under it: {"class": "link", "at": [0.6, 0.05, 90], "height": 0.05} across a node at (0.6, 0.05).
+// Two parts placed with "at" that overlap by more than 1 mm (and are not one above the other)
+// are refused naming both: the physics would throw them apart at the first step.
 // Optional: "min_gap" (m, 0 to 0.5, default 0.02) between randomly placed parts. Custom
 // regions add to (or replace) the default ones. A field the format does not know, a value of
 // the wrong type or out of range (a count of 4294967297, a negative min_gap, a region or an
@@ -110,8 +112,8 @@ struct PartPlacement {
 /// uniformly in their region with a uniform yaw, keeping `min_gap` between footprints (each
 /// part's bounding rectangle turned by its yaw, so long parts can lie side by side).
 /// Deterministic for a given `seed` (the scene's seed unless overridden).
-/// @throws std::runtime_error for an unknown class, colour or region, or when the parts do
-/// not fit.
+/// @throws std::runtime_error for an unknown class, colour or region, when the parts do not
+/// fit, or when two parts placed with "at" overlap (naming both).
 std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<world::ObjectClass>& classes,
                                       std::optional<std::uint64_t> seed = std::nullopt);
 

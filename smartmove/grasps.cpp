@@ -1,11 +1,12 @@
 #include "smartmove/grasps.h"
 
 #include <algorithm>
-#include <fstream>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
 #include "core/files.h"
+#include "core/json_file.h"
 
 namespace costar::smartmove {
 
@@ -14,14 +15,21 @@ namespace {
 using Key = std::tuple<std::string, std::string, std::string>;
 
 /// Reads `file`'s grasps into `into`; `order` (when given) gets their keys in the file's order.
+/// A (gripper, class, name) given twice in the file is refused, naming both entries.
 void read(const std::filesystem::path& file, std::map<Key, Grasp>& into, std::vector<Key>* order = nullptr) {
-  std::ifstream stream(file);
-  if (!stream) {
-    throw std::runtime_error("cannot open grasp file '" + file.string() + "'");
+  nlohmann::json json;
+  try {
+    json = core::parseJson(readFile(file, "grasp file"));
+  } catch (const nlohmann::json::parse_error& e) {
+    throw std::runtime_error("grasp file '" + file.string() + "': not valid JSON: " + e.what());
+  } catch (const std::exception& e) {
+    const std::string message = e.what();
+    throw std::runtime_error(message.starts_with("cannot read") ? message
+                                                                : "grasp file '" + file.string() + "': " + message);
   }
   std::size_t index = 0;
   try {
-    const nlohmann::json json = nlohmann::json::parse(stream);
+    std::map<Key, std::size_t> index_of;
     for (const auto& item : json.at("grasps")) {
       Grasp grasp;
       grasp.gripper = item.contains("gripper") ? item.at("gripper").get<std::string>() : kParallelGripper;
@@ -38,9 +46,19 @@ void read(const std::filesystem::path& file, std::map<Key, Grasp>& into, std::ve
       grasp.name = item.at("name").get<std::string>();
       const auto p = item.at("position").get<std::array<double, 3>>();
       const auto rpy = item.at("rpy_degrees").get<std::array<double, 3>>();
+      for (const double value : {p[0], p[1], p[2], rpy[0], rpy[1], rpy[2]}) {
+        if (!std::isfinite(value) || std::abs(value) > 1000.0) {
+          throw std::runtime_error("\"position\" (m) and \"rpy_degrees\" must be numbers of magnitude at most 1000");
+        }
+      }
       constexpr double kDeg = M_PI / 180.0;
       grasp.tcp_in_object = world::poseFromXyzRpy(p[0], p[1], p[2], rpy[0] * kDeg, rpy[1] * kDeg, rpy[2] * kDeg);
       Key key{grasp.gripper, grasp.object_class, grasp.name};
+      if (const auto [previous, added] = index_of.emplace(key, index); !added) {
+        throw std::runtime_error("gripper '" + grasp.gripper + "', class '" + grasp.object_class + "', name '" +
+                                 grasp.name + "' is given twice, in grasps[" + std::to_string(previous->second) +
+                                 "] and here (one grasp per gripper, class and name)");
+      }
       if (order != nullptr && into.count(key) == 0) {
         order->push_back(key);
       }

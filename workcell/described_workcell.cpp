@@ -7,6 +7,7 @@
 
 #include "arm/waypoints.h"
 #include "component/description.h"
+#include "core/json_file.h"
 #include "predicator/pattern.h"
 
 namespace costar::workcell {
@@ -61,7 +62,7 @@ WorkcellDescription loadWorkcellDescription(const std::filesystem::path& file) {
     throw std::runtime_error("cannot read workcell description '" + file.string() + "'");
   }
   try {
-    return workcellDescriptionFromJson(nlohmann::json::parse(in));
+    return workcellDescriptionFromJson(core::readJsonFile(file));
   } catch (const std::exception& e) {
     throw std::runtime_error(file.string() + ": " + e.what());
   }

@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/files.h"
 #include "gripper/adaptive_gripper.h"
 #include "gripper/adaptive_gripper_description.h"
 #include "gripper/parallel_gripper.h"
@@ -127,6 +128,12 @@ std::vector<std::string> gripperKeys() {
 const GripperModel& gripperModel(const std::string& key) {
   for (const GripperModel& model : table()) {
     if (model.key == key) {
+      if (!model.adaptive.empty()) {
+        // The simulator mounts the models generated from the description at build time; the
+        // component reads the description: they must be of the same file.
+        checkGeneratedFrom(gripper::gripperDescriptionFile(model.adaptive),
+                           std::filesystem::path(COSTAR_GRIPPER_MODEL_DIR) / (model.adaptive + ".fingerprint"));
+      }
       return model;
     }
   }

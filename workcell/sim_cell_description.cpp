@@ -2,13 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 
+#include "core/files.h"
 #include "core/json_fields.h"
+#include "core/json_file.h"
 #include "core/paths.h"
 
 namespace costar::workcell {
@@ -44,14 +45,27 @@ std::string text(const json& object, const std::string& field, const std::string
   return value.get<std::string>();
 }
 
-Eigen::Vector3d vec3(const json& object, const std::string& field, const std::string& key) {
+/// The largest distance (m) and angle (rad) a cell's numbers may have: a cell is a few metres
+/// across; 1e308 is a typing error, and would overflow what is computed from it.
+constexpr double kMaxMetres = 10.0;
+constexpr double kMaxRadians = 7.0;  // a little over 2 pi
+
+/// 3 finite numbers, each of magnitude at most `limit` (`unit` for the message: "m").
+Eigen::Vector3d vec3(const json& object, const std::string& field, const std::string& key, double limit,
+                     const char* unit) {
   const json& value = member(object, field, key);
   if (!value.is_array() || value.size() != 3 || !std::all_of(value.begin(), value.end(), [](const json& x) {
         return x.is_number() && std::isfinite(x.get<double>());
       })) {
     fail(join(field, key), "must be 3 finite numbers [x, y, z], not " + shown(value));
   }
-  return {value[0].get<double>(), value[1].get<double>(), value[2].get<double>()};
+  const Eigen::Vector3d v(value[0].get<double>(), value[1].get<double>(), value[2].get<double>());
+  if (v.cwiseAbs().maxCoeff() > limit) {
+    char range[64];
+    std::snprintf(range, sizeof range, "from -%g to %g %s", limit, limit, unit);
+    fail(join(field, key), "must be 3 numbers " + std::string(range) + ", not " + shown(value));
+  }
+  return v;
 }
 
 std::filesystem::path file(const json& object, const std::string& key, const std::filesystem::path& root) {
@@ -77,8 +91,8 @@ SimCellDescription parse(const json& root, const std::filesystem::path& data_roo
   cell.gripper = text(root, "", "gripper");
   const json& base = objectAt(root, "", "robot_base");
   onlyKnown(base, "robot_base", {"position", "rpy"});
-  const Eigen::Vector3d position = vec3(base, "robot_base", "position");
-  const Eigen::Vector3d rpy = vec3(base, "robot_base", "rpy");
+  const Eigen::Vector3d position = vec3(base, "robot_base", "position", kMaxMetres, "m");
+  const Eigen::Vector3d rpy = vec3(base, "robot_base", "rpy", kMaxRadians, "rad");
   cell.robot_base = world::poseFromXyzRpy(position.x(), position.y(), position.z(), rpy.x(), rpy.y(), rpy.z());
   cell.cell_model = file(root, "cell_model", data_root);
   cell.scene = file(root, "scene", data_root);
@@ -88,21 +102,23 @@ SimCellDescription parse(const json& root, const std::filesystem::path& data_roo
   cell.calibration = file(root, "calibration", data_root);
   const json& table = objectAt(root, "", "table");
   onlyKnown(table, "table", {"centre", "size"});
-  cell.table_centre = vec3(table, "table", "centre");
-  cell.table_size = vec3(table, "table", "size");
+  cell.table_centre = vec3(table, "table", "centre", kMaxMetres, "m");
+  cell.table_size = vec3(table, "table", "size", kMaxMetres, "m");
   if ((cell.table_size.array() <= 0.0).any()) {
     fail("table.size", "must be positive (m), not " + shown(table.at("size")));
   }
   const json& workspace = objectAt(root, "", "workspace");
   onlyKnown(workspace, "workspace", {"min", "max"});
-  cell.workspace = Eigen::AlignedBox3d(vec3(workspace, "workspace", "min"), vec3(workspace, "workspace", "max"));
+  cell.workspace = Eigen::AlignedBox3d(vec3(workspace, "workspace", "min", kMaxMetres, "m"),
+                                       vec3(workspace, "workspace", "max", kMaxMetres, "m"));
   if ((cell.workspace.min().array() >= cell.workspace.max().array()).any()) {
     fail("workspace", "min must be below max on every axis");
   }
   if (root.contains("part_area")) {
     const json& area = objectAt(root, "", "part_area");
     onlyKnown(area, "part_area", {"min", "max"});
-    cell.part_area = Eigen::AlignedBox3d(vec3(area, "part_area", "min"), vec3(area, "part_area", "max"));
+    cell.part_area = Eigen::AlignedBox3d(vec3(area, "part_area", "min", kMaxMetres, "m"),
+                                         vec3(area, "part_area", "max", kMaxMetres, "m"));
     if ((cell.part_area->min().array() >= cell.part_area->max().array()).any()) {
       fail("part_area", "min must be below max on every axis");
     }
@@ -118,16 +134,11 @@ std::filesystem::path simCellFile(const std::string& name, const std::filesystem
 
 SimCellDescription loadSimCellDescription(const std::filesystem::path& path, const std::filesystem::path& data_root) {
   const std::string label = "workcell description '" + path.string() + "'";
-  std::ifstream in(path);
-  if (!in) {
-    throw std::runtime_error("cannot read " + label + ": no such file or not readable");
-  }
-  std::stringstream content;
-  content << in.rdbuf();
+  const std::string content = readFile(path, "workcell description");
   try {
     json parsed;
     try {
-      parsed = json::parse(content.str());
+      parsed = core::parseJson(content);
     } catch (const json::parse_error& e) {
       throw std::runtime_error(std::string("not valid JSON: ") + e.what());
     }
@@ -152,8 +163,7 @@ std::vector<std::pair<std::string, std::string>> simCells(const std::filesystem:
     }
     std::string label;
     try {
-      std::ifstream in(entry.path());
-      const json parsed = json::parse(in);
+      const json parsed = core::readJsonFile(entry.path());
       label = parsed.value("label", std::string("simulated workcell"));
     } catch (const std::exception& e) {
       label = std::string("(cannot be read: ") + e.what() + ")";

@@ -279,13 +279,19 @@ class SimWorkcell final : public Workcell {
             ? options.calibration
             : (options.memory_only ? std::filesystem::path() : defaultCalibrationFile(cell_.name));
     calibration::CellCalibration initial = calibration::loadCalibration(file).value_or(calibration::CellCalibration{});
+    // The shipped marker calibration must be one, whether or not a saved one replaces it.
+    const auto shipped = calibration::loadCalibration(cell_.calibration);
+    if (!shipped || !shipped->marker_in_flange) {
+      throw std::runtime_error("workcell description '" + cell_.file.string() + "': calibration: '" +
+                               cell_.calibration.string() +
+                               "' holds no marker calibration (\"marker\": {\"marker_in_flange\": ...}, as `costar "
+                               "calibrate marker` writes)");
+    }
     if (!initial.marker_in_flange) {
-      if (const auto shipped = calibration::loadCalibration(cell_.calibration)) {
-        initial.marker_in_flange = shipped->marker_in_flange;
-        initial.marker_method = shipped->marker_method;
-        initial.marker_residuals = shipped->marker_residuals;
-        initial.marker_views = shipped->marker_views;
-      }
+      initial.marker_in_flange = shipped->marker_in_flange;
+      initial.marker_method = shipped->marker_method;
+      initial.marker_residuals = shipped->marker_residuals;
+      initial.marker_views = shipped->marker_views;
     }
     calibration::CalibrationConfig config;
     config.file = options.memory_only ? std::filesystem::path() : file;

@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "core/json_file.h"
+
 namespace costar::world {
 
 Eigen::AlignedBox3d ObjectClass::bounds() const {
@@ -66,7 +68,7 @@ ObjectClass loadObjectClass(const std::filesystem::path& file) {
     throw std::runtime_error("cannot open object class file '" + file.string() + "'");
   }
   try {
-    const nlohmann::json json = nlohmann::json::parse(stream);
+    const nlohmann::json json = core::readJsonFile(file);
     ObjectClass object;
     object.name = json.at("name").get<std::string>();
     object.description = json.value("description", "");

@@ -5,13 +5,16 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <random>
 
 #include "arm/ur5_kinematics.h"
+#include "core/files.h"
 #include "core/paths.h"
 
 namespace costar::arm {
@@ -164,6 +167,9 @@ TEST(RobotDescription, TheIiwaFileIsTheGeneratorsFile) {
   EXPECT_EQ(makeKinematics(iiwa)->jointCount(), 7);
 }
 
+/// A variant of iiwa14.json, loaded as if the models had been generated from it: the test's
+/// own generated folder ($COSTAR_GENERATED_DIR) holds the build's models and the variant's
+/// fingerprint, so that each check of the file is reached.
 class BadIiwaFile : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -172,15 +178,29 @@ class BadIiwaFile : public ::testing::Test {
                ::testing::UnitTest::GetInstance()->current_test_info()->name());
     std::filesystem::create_directories(folder_);
     std::ifstream in(robotDescriptionFile("iiwa14"));
-    good_ = json::parse(in);
+    good_text_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    good_ = json::parse(good_text_);
+    const RobotDescription built = loadRobotDescription(robotDescriptionFile("iiwa14"));
+    generated_ = folder_ / "generated" / "robots" / "iiwa14";
+    std::filesystem::create_directories(generated_);
+    std::filesystem::copy_file(built.mjcf, generated_ / "iiwa14.xml");
+    std::filesystem::copy_file(built.urdf, generated_ / "iiwa14.urdf");
+    ::setenv("COSTAR_GENERATED_DIR", (folder_ / "generated").c_str(), 1);
   }
-  void TearDown() override { std::filesystem::remove_all(folder_); }
+  void TearDown() override {
+    ::unsetenv("COSTAR_GENERATED_DIR");
+    std::filesystem::remove_all(folder_);
+  }
 
-  /// The error loading `content` (as iiwa14.json, so that its generated models are found),
-  /// without the "robot description 'PATH': " prefix.
-  std::string problem(const json& content) {
+  /// The error loading `content` (as iiwa14.json, with models generated from it unless
+  /// `regenerated` is false), without the "robot description 'PATH': " prefix.
+  std::string problem(const json& content) { return problem(content.dump(2)); }
+  std::string problem(const std::string& text, bool regenerated = true) {
     const auto file = folder_ / "iiwa14.json";
-    std::ofstream(file) << content.dump(2);
+    std::ofstream(file) << text;
+    if (regenerated) {
+      std::ofstream(generated_ / "iiwa14.fingerprint") << fingerprint(text) << "\n";
+    }
     const std::string prefix = "robot description '" + file.string() + "': ";
     try {
       makeKinematics(loadRobotDescription(file));
@@ -192,11 +212,13 @@ class BadIiwaFile : public ::testing::Test {
   }
 
   std::filesystem::path folder_;
+  std::filesystem::path generated_;
+  std::string good_text_;  // the file the build's models were generated from, byte for byte
   json good_;
 };
 
 TEST_F(BadIiwaFile, EachProblemNamesItsField) {
-  EXPECT_EQ(problem(good_), "no error");
+  EXPECT_EQ(problem(good_text_), "no error");
   json j = good_;
   j["format"] = "costar-robot-description/2";
   EXPECT_EQ(problem(j), "format: must be \"costar-robot-description/1\", not \"costar-robot-description/2\"");
@@ -226,12 +248,38 @@ TEST_F(BadIiwaFile, EachProblemNamesItsField) {
   EXPECT_EQ(problem(j).rfind("name: the model generated from this file, '", 0), 0u) << problem(j);
 }
 
+// Issue 27: a description edited after the build was applied in part (the runtime read the
+// file, the simulator the models generated from the old one). The models carry the fingerprint
+// of the file they came from; any other content is refused, naming the file.
+TEST_F(BadIiwaFile, AnEditAfterTheBuildIsRefusedUntilTheModelsAreGeneratedAgain) {
+  json j = good_;
+  j["joints"][1]["upper_deg"] = 100;  // valid, but not what the simulator's model has
+  const std::string file = (folder_ / "iiwa14.json").string();
+  ASSERT_EQ(problem(good_text_), "no error");
+  EXPECT_EQ(problem(j.dump(2), /*regenerated=*/false),
+            "(no file named) " + file + " changed after the build: rebuild (cmake --build build)");
+  EXPECT_EQ(problem(j.dump(2)), "no error");  // the models generated again from it
+  std::filesystem::remove(generated_ / "iiwa14.fingerprint");
+  EXPECT_EQ(problem(good_text_, /*regenerated=*/false)
+                .rfind("(no file named) " + file +
+                           ": the models generated "
+                           "from it carry no fingerprint",
+                       0),
+            0u);
+}
+
+TEST_F(BadIiwaFile, AKeyGivenTwiceIsRefused) {
+  std::string twice = good_text_;
+  twice.insert(twice.find('{') + 1, R"("label": "twice",)");
+  EXPECT_EQ(problem(twice), "(top level): key 'label' appears twice (a key may appear once in an object)");
+}
+
 TEST(RobotDescription, AMissingFileIsNamed) {
   try {
     loadRobotDescription("/nonexistent/robot.json");
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
-    EXPECT_STREQ(e.what(), "cannot read robot description '/nonexistent/robot.json': no such file or not readable");
+    EXPECT_STREQ(e.what(), "cannot read robot description '/nonexistent/robot.json': No such file or directory");
   }
 }
 

@@ -53,5 +53,22 @@ TEST(CalibrationFile, BadFilesNameTheFileAndField) {
   EXPECT_THROW(loadCalibration(file), std::runtime_error);
 }
 
+// Issue 27: a workcell's "calibration" pointing at any JSON object (an object class) was taken
+// as an empty calibration.
+TEST(CalibrationFile, AnotherJsonFileIsNotACalibration) {
+  const auto file = tempFile("object_class.json");
+  std::ofstream(file) << R"({"name": "node", "mass": 0.08})";
+  try {
+    loadCalibration(file);
+    FAIL() << "an object class taken as a calibration";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "calibration '" + file.string() +
+                                         "': mass: unknown field: a calibration holds \"marker\" and/or \"camera\" "
+                                         "(is this a calibration file?)");
+  }
+  std::ofstream(file) << R"({"camera": {}, "camera": {}})";
+  EXPECT_THROW(loadCalibration(file), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace costar::calibration

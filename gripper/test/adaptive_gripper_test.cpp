@@ -139,7 +139,7 @@ TEST(AdaptiveGripperDescriptionTest, BadFilesNameTheFieldAndTheProblem) {
   };
   std::ifstream in(gripperDescriptionFile("robotiq3f"));
   std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_NE(error(dir / "missing.json").find("cannot open"), std::string::npos);
+  EXPECT_NE(error(dir / "missing.json").find("No such file or directory"), std::string::npos);
   EXPECT_NE(error(write("{")).find("bad.json"), std::string::npos);
   std::string unknown_mode = good;
   unknown_mode.replace(unknown_mode.find("\"name\": \"wide\""), 14, "\"name\": \"wild\"");
@@ -149,6 +149,25 @@ TEST(AdaptiveGripperDescriptionTest, BadFilesNameTheFieldAndTheProblem) {
   std::string bad_finger = good;
   bad_finger.replace(bad_finger.find("\"closing\": [\"finger_1\""), 22, "\"closing\": [\"finger_9\"");
   EXPECT_NE(error(write(bad_finger)).find("modes[3].closing[0]"), std::string::npos) << error(write(bad_finger));
+  // Issue 27: negative and 1e308 phalanges passed; a key given twice was taken silently.
+  const auto phalanx = [&good](const std::string& length) {
+    const std::string medial = "\"length\": 0.035";
+    std::string text = good;
+    text.replace(text.find(medial), medial.size(), "\"length\": " + length);
+    return text;
+  };
+  EXPECT_NE(error(write(phalanx("-0.035")))
+                .find("phalanges[1].length: must be a length above 0 and at most 0.5 m, not "
+                      "-0.035"),
+            std::string::npos)
+      << error(write(phalanx("-0.035")));
+  EXPECT_NE(error(write(phalanx("1e308"))).find("phalanges[1].length: must be at most 0.5 in magnitude, not 1e+308"),
+            std::string::npos)
+      << error(write(phalanx("1e308")));
+  std::string twice = good;
+  const std::string tcp = "\"tcp\": [";
+  twice.replace(twice.find(tcp), tcp.size(), "\"tcp\": [0, 0, 0.1], \"tcp\": [");
+  EXPECT_NE(error(write(twice)).find("(top level): key 'tcp' appears twice"), std::string::npos) << error(write(twice));
   std::filesystem::remove_all(dir);
 }
 

@@ -80,6 +80,27 @@ class GenerateGripper(GeneratorCase):
         self.expect_error(setter(["tcp"], [0, 0]), "tcp: must be 3 finite numbers")
         self.expect_error(setter(["actuation", "closed_deg"], 200), "actuation.closed_deg: must be above the open finger")
         self.expect_error(setter(["phalanges", 1, "spring_rest_deg"], 5), "phalanges[1].spring_rest_deg: must be at most 0")
+        # Issue 27: sizes beyond a hand's passed.
+        self.expect_error(setter(["phalanges", 2, "length"], 1e308), "phalanges[2].length: must be at most 0.5 in magnitude")
+        self.expect_error(setter(["palm", "centre"], [0, 0, 1e308]), "palm.centre: must be 3 numbers of magnitude at most 1")
+        self.expect_error(setter(["actuation", "max_force_n"], 1e308), "actuation.max_force_n: must be at most 1e+06")
+
+    def test_a_key_given_twice_is_refused(self):
+        text = self.DESCRIPTION.read_text().replace('"tcp": [', '"tcp": [0, 0, 0.1], "tcp": [', 1)
+        path = self.tmp / "gripper.json"
+        path.write_text(text)
+        result = self.run_generator(path, self.tmp / "out")
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("gripper.json: key 'tcp' appears twice", result.stderr)
+
+    def test_the_models_carry_the_fingerprint_of_their_description(self):
+        result = self.run_generator(self.DESCRIPTION, self.tmp)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        # FNV-1a 64 of the bytes, as core/files.h fingerprint() computes it.
+        value = 14695981039346656037
+        for byte in self.DESCRIPTION.read_bytes():
+            value = ((value ^ byte) * 1099511628211) % (1 << 64)
+        self.assertEqual((self.tmp / "robotiq3f.fingerprint").read_text(), f"fnv1a64:{value:016x}\n")
 
     def test_unreadable_json_names_the_line(self):
         path = self.tmp / "gripper.json"

@@ -43,6 +43,21 @@ class GenerateModels(GeneratorCase):
         # The joint origins must add up to the manufacturer's lengths.
         self.expect_error(lambda d: d["joints"][3].update(origin=[0, 0, 0.2255]), "published_lengths.shoulder_to_elbow",
                           "0.43")
+        # Issue 27: a zero-length link and numbers of 1e308 passed.
+        self.expect_error(lambda d: d["joints"][3].update(origin=[0, 0, 0]), "joints[3].origin",
+                          "a link of zero length")
+        self.expect_error(lambda d: d["joints"][2].update(origin=[0, 0, 1e308]), "joints[2].origin",
+                          "magnitude at most 10")
+        self.expect_error(lambda d: d["links"][2].update(mass=1e308), "links[2].mass", "at most 1000")
+        self.expect_error(lambda d: d["joints"][2].update(effort_nm=1e308), "joints[2].effort_nm", "at most 1e+06")
+
+    def test_the_models_carry_the_fingerprint_of_their_description(self):
+        result = self.run_generator(IIWA, self.tmp)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        value = 14695981039346656037
+        for byte in IIWA.read_bytes():
+            value = ((value ^ byte) * 1099511628211) % (1 << 64)
+        self.assertEqual((self.tmp / "iiwa14.fingerprint").read_text(), f"fnv1a64:{value:016x}\n")
 
     def test_unreadable_input(self):
         broken = self.tmp / "robot.json"

@@ -368,6 +368,55 @@ TEST(Scene, UnreadableFilesAreNamedAsSuch) {
             "cannot read scene file '/nonexistent/scene.json': No such file or directory");
   const std::filesystem::path folder = std::filesystem::temp_directory_path();
   EXPECT_EQ(message(folder), "cannot read scene file '" + folder.string() + "': it is a folder");
+  // Issue 27: --scene /dev/zero read forever (400 MB in 6 s).
+  EXPECT_EQ(message("/dev/zero"), "cannot read scene file '/dev/zero': not a regular file (a device, pipe or socket)");
+}
+
+// Issue 27: two parts placed with "at" on the same spot started inside each other, and the
+// physics threw them apart at the first step.
+TEST(Scene, PartsPlacedInsideEachOtherAreRefusedNamingBoth) {
+  const auto problem = [](const std::string& text) {
+    try {
+      placeParts(parseScene(text, "s.json"), classes());
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("placed");
+  };
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, 0.1, 0]}, {"class": "link", "at": [0.3, -0.2, 0]},
+                                 {"class": "node", "at": [0.51, 0.1, 45]}]})"),
+            "scene 's.json': parts[0] (node at 0.5, 0.1) and parts[2] (node at 0.51, 0.1) overlap: the simulation "
+            "would throw them apart (move one, or give it a \"height\" to lie on the other)");
+  // Apart, touching, or one lying on the other: placed.
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, 0.1, 0]}, {"class": "node", "at": [0.6, 0.1, 0]}]})"),
+            "placed");
+  EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, -0.2, 30]},
+                                 {"class": "link", "at": [0.5, -0.2, 120], "height": 0.05}]})"),
+            "placed");
+  // Random placements keep clear of a fixed part that comes after them in the list.
+  for (std::uint64_t seed = 0; seed < 20; ++seed) {
+    const Scene scene = parseScene(R"({"parts": [{"class": "node", "count": 4, "region": "corner"},
+                                                {"class": "node", "at": [0.575, 0.225, 0]}],
+                                      "regions": {"corner": {"x": [0.45, 0.7], "y": [0.1, 0.35]}}})",
+                                   "s.json");
+    const auto parts = placeParts(scene, classes(), seed);
+    const auto& fixed = parts.back().pose.translation();
+    for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+      // 5 cm cubes: closer than 5 cm, they would be inside each other.
+      EXPECT_GT((parts[i].pose.translation() - fixed).head<2>().norm(), 0.05) << "seed " << seed << ", part " << i;
+    }
+  }
+}
+
+// Issue 27: a key given twice was taken silently (the last one).
+TEST(Scene, AKeyGivenTwiceIsRefused) {
+  try {
+    parseScene(R"({"parts": [{"class": "node", "class": "link", "region": "left"}]})", "s.json");
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "scene 's.json': parts[0]: key 'class' appears twice (a key may appear once in an object)");
+  }
 }
 
 TEST(Scene, TheSceneFilesInTheRepositoryLoad) {

@@ -155,6 +155,25 @@ TEST(Grasps, ABadEntryNamesTheFileAndTheEntry) {
   std::filesystem::remove(file);
 }
 
+// Issue 27: a grasp file with the same (gripper, class, name) twice silently kept the second.
+TEST(Grasps, AGraspGivenTwiceIsRefusedNamingBothEntries) {
+  const auto file = std::filesystem::temp_directory_path() / "costar_grasps_twice_test.json";
+  std::ofstream(file)
+      << R"({"grasps": [{"class": "node", "name": "top", "position": [0, 0, 0], "rpy_degrees": [0, 0, 0]},)"
+         R"( {"class": "link", "name": "top", "position": [0, 0, 0], "rpy_degrees": [0, 0, 0]},)"
+         R"( {"gripper": "parallel2f", "class": "node", "name": "top", "position": [0, 0, 0.01],)"
+         R"( "rpy_degrees": [0, 0, 0]}]})";
+  try {
+    GraspLibrary library(file, {});
+    ADD_FAILURE() << "accepted a grasp given twice";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "grasp file '" + file.string() +
+                                         "': grasps[2]: gripper 'parallel2f', class 'node', name 'top' is given "
+                                         "twice, in grasps[0] and here (one grasp per gripper, class and name)");
+  }
+  std::filesystem::remove(file);
+}
+
 /// An arm that reaches goals with x < 0.6; "joints" encode the goal for the cost.
 ArmModel fakeArm() {
   ArmModel arm;

@@ -117,8 +117,28 @@ TEST(SimCellDescription, AMissingFileIsNamed) {
     loadSimCellDescription("/nonexistent/cell.json");
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
-    EXPECT_STREQ(e.what(), "cannot read workcell description '/nonexistent/cell.json': no such file or not readable");
+    EXPECT_STREQ(e.what(), "cannot read workcell description '/nonexistent/cell.json': No such file or directory");
   }
+}
+
+// Issue 27: numbers of 1e308 were accepted (a robot standing 1e308 m away); a key given twice
+// was taken silently.
+TEST_F(BadCellFile, NumbersBeyondACellsSizeAndKeysGivenTwiceAreRefused) {
+  json j = good_;
+  j["robot_base"]["position"] = {1e308, 0, 0};
+  EXPECT_EQ(problem(j), "robot_base.position: must be 3 numbers from -10 to 10 m, not [1e+308,0,0]");
+  j = good_;
+  j["table"]["size"] = {1.2, 1e308, 0.1};
+  EXPECT_EQ(problem(j).rfind("table.size: must be 3 numbers from -10 to 10 m, not ", 0), 0u) << problem(j);
+  j = good_;
+  j["workspace"]["max"] = {0.5, 0.5, 11};
+  EXPECT_EQ(problem(j).rfind("workspace.max: must be 3 numbers from -10 to 10 m", 0), 0u) << problem(j);
+  j = good_;
+  j["robot_base"]["rpy"] = {0, 0, 1e300};
+  EXPECT_EQ(problem(j).rfind("robot_base.rpy: must be 3 numbers from -7 to 7 rad", 0), 0u) << problem(j);
+  std::string twice = good_.dump();
+  twice.insert(1, R"("label": "one", )");
+  EXPECT_EQ(problem(twice), "(top level): key 'label' appears twice (a key may appear once in an object)");
 }
 
 }  // namespace
