@@ -2,7 +2,7 @@
 // seconds): every one must end as FAILURE with a path and a reason within 1 s of taking
 // effect, with the arm at rest and the waypoint file unchanged.
 
-#include "faults/campaign.h"
+#include "trials/fault_campaign.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -13,7 +13,7 @@
 
 #include "core/paths.h"
 
-namespace costar::faults {
+namespace costar::trials {
 namespace {
 
 TEST(FaultCampaign, EveryFaultStopsTheTaskInTimeWithTheArmAtRest) {
@@ -226,4 +226,4 @@ TEST(FaultCampaign, ALastLineCutShortIsLeftOutWithANoteAndOneInTheMiddleIsAnErro
 }
 
 }  // namespace
-}  // namespace costar::faults
+}  // namespace costar::trials

@@ -1,6 +1,6 @@
 // fault_campaign: the paper's UR5 plans with injected faults, judged from outside
-// (faults/campaign.h). Run from the repository root:
-//   nice -n 10 build/faults/fault_campaign -n 1000 -j 2 --json faults.json
+// (trials/fault_campaign.h). Run from the repository root:
+//   nice -n 10 build/trials/fault_campaign -n 1000 -j 2 --json faults.json
 // Exit code: 0 when every fault that took effect stopped the task in time, 1 when one did not,
 // 2 for a bad option or file, or an output that could not be written.
 
@@ -12,14 +12,14 @@
 #include "cli/number_options.h"
 #include "core/clock.h"
 #include "core/files.h"
-#include "faults/campaign.h"
+#include "trials/fault_campaign.h"
 
 namespace {
 
 int summarize(const std::string& file) {
   try {
     std::vector<std::string> notes;
-    const costar::faults::CampaignSummary summary = costar::faults::readJsonLines(file, notes);
+    const costar::trials::CampaignSummary summary = costar::trials::readJsonLines(file, notes);
     for (const std::string& note : notes) {
       std::fprintf(stderr, "note: %s\n", note.c_str());
     }
@@ -34,7 +34,7 @@ int summarize(const std::string& file) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  costar::faults::CampaignOptions options;
+  costar::trials::CampaignOptions options;
   options.count = 1000;
   std::string json;
   CLI::App app("Runs the paper's three plans with one injected fault each and judges every run");
@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
   }
   bool lines_failed = false;
   try {
-    const auto summary = costar::faults::runCampaign(options, [&](const auto& trial, int done) {
+    const auto summary = costar::trials::runCampaign(options, [&](const auto& trial, int done) {
       if (lines && !lines_failed) {
         try {
           lines->append(trial.toJson().dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");

@@ -1,4 +1,4 @@
-#include "faults/campaign.h"
+#include "trials/fault_campaign.h"
 
 #include <algorithm>
 #include <chrono>
@@ -20,7 +20,7 @@
 #include "sim/simulation.h"
 #include "workcell/workcell.h"
 
-namespace costar::faults {
+namespace costar::trials {
 
 namespace {
 
@@ -69,7 +69,7 @@ FaultTrial runOne(const CampaignOptions& options, const CampaignTask& task, cons
   trial.fault = withMoment(fault, options, task, trial.seed);
   const auto wall_start = std::chrono::steady_clock::now();
   try {
-    auto injector = Injector::fromText({trial.fault}, trial.seed);
+    auto injector = faults::Injector::fromText({trial.fault}, trial.seed);
     const auto cell = workcell::makeWorkcell(
         {.name = options.workcell,
          .scene = options.scene.empty() ? dataRoot() / "sim/scenes/assembly.json" : options.scene,
@@ -86,7 +86,7 @@ FaultTrial runOne(const CampaignOptions& options, const CampaignTask& task, cons
     const bt::RunResult run = executor.run();
     const TimePoint end = start + run.elapsed;
     trial.end_s = toSeconds(end);
-    const FaultRecord& record = injector->records().front();
+    const faults::FaultRecord& record = injector->records().front();
     if (record.activated) {
       trial.due_s = toSeconds(*record.activated);
     }
@@ -121,7 +121,7 @@ FaultTrial runOne(const CampaignOptions& options, const CampaignTask& task, cons
     } else if (run.status == bt::Status::kSuccess) {
       trial.outcome = !record.activated      ? "not-due"
                       : !record.first_effect ? "no-effect"
-                      : record.spec.kind == FaultKind::kThrow && record.spec.target != "arm-driver" &&
+                      : record.spec.kind == faults::FaultKind::kThrow && record.spec.target != "arm-driver" &&
                               record.spec.target != "gripper-driver" && record.spec.target != "camera"
                           ? "recovered"
                           : "missed";
@@ -223,7 +223,7 @@ CampaignSummary runCampaign(const CampaignOptions& options,
                                           : options.workcell == "test" ? testCellFaults()
                                                                        : allFaults();
   for (const std::string& fault : faults) {
-    parseFault(fault.find('@') != std::string::npos ? fault
+    faults::parseFault(fault.find('@') != std::string::npos ? fault
                                                     : fault + "@t=0");  // @throws FaultSpecError, before any run
   }
   // An unknown cell is refused before any run too (each run would fail the same way).
@@ -443,4 +443,4 @@ std::string CampaignSummary::text() const {
   return out;
 }
 
-}  // namespace costar::faults
+}  // namespace costar::trials

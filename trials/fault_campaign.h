@@ -15,7 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace costar::faults {
+namespace costar::trials {
 
 struct CampaignTask {
   std::string name;
@@ -109,4 +109,4 @@ void checkOptions(const CampaignOptions& options);
 CampaignSummary runCampaign(const CampaignOptions& options,
                             const std::function<void(const FaultTrial&, int done)>& progress = {});
 
-}  // namespace costar::faults
+}  // namespace costar::trials
