@@ -223,8 +223,8 @@ CampaignSummary runCampaign(const CampaignOptions& options,
                                           : options.workcell == "test" ? testCellFaults()
                                                                        : allFaults();
   for (const std::string& fault : faults) {
-    faults::parseFault(fault.find('@') != std::string::npos ? fault
-                                                    : fault + "@t=0");  // @throws FaultSpecError, before any run
+    faults::parseFault(
+        fault.find('@') != std::string::npos ? fault : fault + "@t=0");  // @throws FaultSpecError, before any run
   }
   // An unknown cell is refused before any run too (each run would fail the same way).
   workcell::requireKnownWorkcell(options.workcell);
