@@ -1,8 +1,11 @@
 #include "bt/builder.h"
 
 #include <algorithm>
+#include <limits>
 #include <map>
-#include <set>
+#include <optional>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "bt/decorator_nodes.h"
 
@@ -92,10 +95,64 @@ std::string portList(const NodeSpec& spec) {
   return list;
 }
 
+/// The trees of a plan by ID, found as Plan::findTree finds them (the file's own first, then
+/// the included files' in order), in constant time: a plan of thousands of trees stays linear.
+class TreeIndex {
+ public:
+  explicit TreeIndex(const Plan& plan) {
+    add(plan.file);
+    for (const PlanFile& file : plan.included) {
+      add(file);
+    }
+  }
+  /// The number of different tree IDs.
+  std::size_t size() const { return trees_.size(); }
+  const PlanTree* find(std::string_view id) const {
+    const auto it = trees_.find(id);
+    return it == trees_.end() ? nullptr : it->second;
+  }
+  /// The tree a SubTree node names, or nullptr.
+  const PlanTree* find(const PlanNode& subtree) const {
+    for (const auto& [key, value] : subtree.attributes) {
+      if (key == "ID") {
+        return find(value);
+      }
+    }
+    return nullptr;
+  }
+
+ private:
+  void add(const PlanFile& file) {
+    for (const PlanTree& tree : file.trees) {
+      trees_.emplace(tree.id, &tree);
+    }
+  }
+  std::unordered_map<std::string_view, const PlanTree*> trees_;
+};
+
+/// Sums and products of sizes that saturate instead of wrapping around (a tree used twice at
+/// each of 200 levels has 2^200 nodes).
+constexpr std::size_t kSaturated = std::numeric_limits<std::size_t>::max() / 2;
+std::size_t addSaturated(std::size_t a, std::size_t b) {
+  return a > kSaturated - std::min(b, kSaturated) ? kSaturated : a + b;
+}
+std::size_t mulSaturated(std::size_t a, std::size_t b) { return b != 0 && a > kSaturated / b ? kSaturated : a * b; }
+
+/// At least the bytes of a node's segment of a path (`Sequence "pick"`, `Sequence[12]`).
+std::size_t segmentBytes(const PlanNode& node) {
+  std::size_t name = 0;
+  for (const auto& [key, value] : node.attributes) {
+    if (key == "name") {
+      name = value.size();
+    }
+  }
+  return node.id.size() + name + 24;
+}
+
 class Validator {
  public:
   Validator(const Plan& plan, const NodeRegistry& registry, const BuildLimits& limits)
-      : plan_(plan), registry_(registry), limits_(limits) {}
+      : plan_(plan), registry_(registry), limits_(limits), index_(plan) {}
 
   std::vector<Diagnostic> run() {
     checkDuplicateTrees();
@@ -142,82 +199,134 @@ class Validator {
       diagnostics_.insert(diagnostics_.end(), missing.diagnostics().begin(), missing.diagnostics().end());
       return;
     }
-    const PlanTree* main = plan_.findTree(main_id);
+    const PlanTree* main = index_.find(main_id);
     if (main == nullptr) {
       error({plan_.file.path, 0}, "main_tree_to_execute names '" + main_id + "', but no BehaviorTree has that ID");
       return;
     }
-    // Recursion, size and depth of the main tree once every SubTree is expanded.
-    std::vector<std::string> stack;
-    measure(*main, stack);
+    measure(*main);
   }
 
+  /// A subtree with its SubTrees expanded: nodes, levels, and the bytes of every node's path
+  /// below where it hangs (each node keeps its path: it can dwarf the node count).
   struct Measure {
     std::size_t nodes = 0;
     std::size_t depth = 0;
+    std::size_t path_bytes = 0;
   };
 
-  // Size and depth of a tree with its SubTrees expanded; reports recursion.
-  std::optional<Measure> measure(const PlanTree& tree, std::vector<std::string>& stack) {
-    if (const auto it = measured_.find(tree.id); it != measured_.end()) {
-      return it->second;
+  /// Recursion, size, depth and path bytes of the main tree once every SubTree is expanded,
+  /// reporting the first limit crossed. One walk with an explicit stack, so a chain of any
+  /// number of SubTrees cannot overflow the call stack; nothing deeper than the limit is
+  /// entered; each tree is measured once, however often it is used.
+  void measure(const PlanTree& main) {
+    struct Frame {
+      const PlanNode* node;
+      const PlanTree* tree;  // the tree whose root this is, or nullptr
+      std::size_t segment;   // bytes this node adds to each path below it
+      Measure total;
+      std::size_t next_child = 0;
+      bool expanded = false;  // a SubTree's tree was looked at
+    };
+    std::vector<Frame> frames;
+    std::unordered_set<const PlanTree*> on_stack;
+    const auto enter = [&](const PlanNode& node, const PlanTree* tree, std::size_t prefix) {
+      if (frames.size() >= limits_.max_depth) {
+        error(node.location, tooDeep());
+        return false;
+      }
+      const std::size_t segment = prefix + segmentBytes(node);
+      frames.push_back({&node, tree, segment, {1, 1, segment}});
+      if (tree != nullptr) {
+        on_stack.insert(tree);
+      }
+      return true;
+    };
+    const auto addChild = [](Frame& parent, const Measure& child) {
+      parent.total.nodes = addSaturated(parent.total.nodes, child.nodes);
+      parent.total.depth = std::max(parent.total.depth, child.depth + 1);
+      parent.total.path_bytes = addSaturated(
+          parent.total.path_bytes, addSaturated(child.path_bytes, mulSaturated(child.nodes, parent.segment + 1)));
+    };
+    // Every path starts with the main tree's ID and a slash.
+    if (!enter(main.root, &main, main.id.size() + 1)) {
+      return;
     }
-    if (std::find(stack.begin(), stack.end(), tree.id) != stack.end()) {
-      return std::nullopt;  // reported by the caller, which knows the SubTree's line
+    while (!frames.empty()) {
+      Frame& frame = frames.back();
+      const PlanNode& node = *frame.node;
+      if (!frame.expanded) {
+        frame.expanded = true;
+        const NodeSpec* spec = registry_.find(node.id);
+        const PlanTree* tree =  // an unknown one is reported by checkSubTree
+            spec != nullptr && spec->kind == NodeKind::kSubTree ? index_.find(node) : nullptr;
+        if (tree != nullptr) {
+          if (const auto it = measured_.find(tree); it != measured_.end()) {
+            addChild(frame, it->second);
+          } else if (on_stack.contains(tree)) {
+            std::string cycle;
+            for (const Frame& step : frames) {
+              if (step.tree != nullptr) {
+                cycle += step.tree->id + " -> ";
+              }
+            }
+            error(node.location, "subtree '" + tree->id + "' contains itself: " + cycle + tree->id);
+            return;
+          } else if (!enter(tree->root, tree, 0)) {
+            return;
+          } else {
+            continue;
+          }
+        }
+      }
+      if (frame.next_child < node.children.size()) {
+        if (!enter(node.children[frame.next_child++], nullptr, 0)) {
+          return;
+        }
+        continue;
+      }
+      // Done with this node: the levels above it count towards the depth too. Paths only for
+      // the whole plan: a plan too large in nodes is told so, not that its paths are long.
+      if (!withinLimits(node, frame.total, frames.size() - 1, /*whole_plan=*/frames.size() == 1)) {
+        return;
+      }
+      const Measure done = frame.total;
+      const PlanTree* tree = frame.tree;
+      frames.pop_back();
+      if (tree != nullptr) {
+        measured_[tree] = done;
+        on_stack.erase(tree);
+      }
+      if (!frames.empty()) {
+        addChild(frames.back(), done);
+      }
     }
-    stack.push_back(tree.id);
-    const auto result = measureNode(tree.root, stack);
-    stack.pop_back();
-    if (result) {
-      measured_[tree.id] = *result;
-    }
-    return result;
   }
 
-  std::optional<Measure> measureNode(const PlanNode& node, std::vector<std::string>& stack) {
-    Measure total{1, 1};
-    if (node.id == "SubTree") {
-      const auto id = node.attribute("ID");
-      const PlanTree* tree = id ? plan_.findTree(*id) : nullptr;
-      if (tree == nullptr) {
-        return total;  // reported by checkNode
-      }
-      if (std::find(stack.begin(), stack.end(), *id) != stack.end()) {
-        std::string cycle;
-        for (const auto& step : stack) {
-          cycle += step + " -> ";
-        }
-        error(node.location, "subtree '" + *id + "' contains itself: " + cycle + *id);
-        return std::nullopt;
-      }
-      const auto inner = measure(*tree, stack);
-      if (!inner) {
-        return std::nullopt;
-      }
-      total.nodes += inner->nodes;
-      total.depth += inner->depth;
-    }
-    for (const PlanNode& child : node.children) {
-      const auto inner = measureNode(child, stack);
-      if (!inner) {
-        return std::nullopt;
-      }
-      total.nodes += inner->nodes;
-      total.depth = std::max(total.depth, inner->depth + 1);
-    }
+  std::string tooDeep() const {
+    return "the plan nests deeper than " + std::to_string(limits_.max_depth) +
+           " levels once its subtrees are instantiated";
+  }
+
+  bool withinLimits(const PlanNode& node, const Measure& total, std::size_t levels_above, bool whole_plan) {
     if (total.nodes > limits_.max_nodes) {
       error(node.location, "the plan expands to more than " + std::to_string(limits_.max_nodes) +
                                " nodes once its subtrees are instantiated");
-      return std::nullopt;
+      return false;
     }
-    if (total.depth > limits_.max_depth) {
-      error(node.location, "the plan nests deeper than " + std::to_string(limits_.max_depth) +
-                               " levels once its subtrees are instantiated");
-      return std::nullopt;
+    if (levels_above + total.depth > limits_.max_depth) {
+      error(node.location, tooDeep());
+      return false;
     }
-    return total;
+    if (whole_plan && total.path_bytes > limits_.max_path_bytes) {
+      error(node.location, "the plan's node paths (main/Sequence[1]/..., one per node) add up to more than " +
+                               std::to_string(limits_.max_path_bytes >> 20) +
+                               " MiB once its subtrees are instantiated: use shorter names or fewer levels "
+                               "of subtrees");
+      return false;
+    }
+    return true;
   }
-
   void checkNode(const PlanNode& node) {
     const NodeSpec* spec = registry_.find(node.id);
     if (spec == nullptr) {
@@ -329,35 +438,104 @@ class Validator {
 
   void checkSubTree(const PlanNode& node) {
     const auto id = node.attribute("ID");
-    if (!id || plan_.findTree(*id) != nullptr) {
+    if (!id || index_.find(*id) != nullptr) {
       return;
     }
-    std::string message = "unknown subtree '" + *id + "'";
+    // The first few IDs: a plan of thousands of trees that names a missing one thousands of
+    // times must not make a message per reference that lists them all.
+    constexpr std::size_t kListed = 20;
     std::string known;
+    std::size_t count = 0;
     for (const PlanFile* file : files()) {
-      for (const PlanTree& tree : file->trees) {
-        known += (known.empty() ? "" : ", ") + tree.id;
+      for (std::size_t i = 0; i < file->trees.size() && count < kListed; ++i, ++count) {
+        known += (known.empty() ? "" : ", ") + file->trees[i].id;
       }
     }
-    error(node.location, message + " (the plan defines: " + known + ")");
+    if (index_.size() > count) {
+      known += " and " + std::to_string(index_.size() - count) + " more";
+    }
+    error(node.location, "unknown subtree '" + *id + "' (the plan defines: " + known + ")");
   }
 
-  // Whether a node can return RUNNING, looking through SubTrees.
-  bool mayRun(const PlanNode& node, int depth = 0) {
-    const NodeSpec* spec = registry_.find(node.id);
-    if (spec == nullptr || depth > 64) {
-      return false;
+  /// Visits the nodes below `root` (itself included) that a tick can reach without entering a
+  /// SubTree; `visit` returns whether to look below a node. An explicit stack, not recursion.
+  template <typename Visit>
+  static void visitTree(const PlanNode& root, Visit&& visit) {
+    std::vector<const PlanNode*> pending{&root};
+    while (!pending.empty()) {
+      const PlanNode& node = *pending.back();
+      pending.pop_back();
+      if (visit(node)) {
+        for (const PlanNode& child : node.children) {
+          pending.push_back(&child);
+        }
+      }
     }
-    if (spec->asynchronous) {
-      return true;
+  }
+
+  /// Whether a node can return RUNNING: it is asynchronous, or a node it ticks is, looking
+  /// through SubTrees (their trees worked out once for the whole plan, see runningTrees()).
+  bool mayRun(const PlanNode& node) {
+    const auto& running = runningTrees();
+    bool found = false;
+    visitTree(node, [&](const PlanNode& next) {
+      const NodeSpec* spec = registry_.find(next.id);
+      if (found || spec == nullptr) {
+        return false;
+      }
+      if (spec->asynchronous) {
+        found = true;
+      } else if (spec->kind == NodeKind::kSubTree) {
+        const PlanTree* tree = index_.find(next);
+        found = tree != nullptr && running.contains(tree);
+      }
+      return !found && spec->kind != NodeKind::kSubTree;
+    });
+    return found;
+  }
+
+  /// The trees that can return RUNNING: those with an asynchronous node of their own, and
+  /// those that use one of them through SubTrees, however deep (a search backwards along the
+  /// SubTree references: linear in the plan, without recursion). Once per plan.
+  const std::unordered_set<const PlanTree*>& runningTrees() {
+    if (running_trees_) {
+      return *running_trees_;
     }
-    if (spec->kind == NodeKind::kSubTree) {
-      const auto id = node.attribute("ID");
-      const PlanTree* tree = id ? plan_.findTree(*id) : nullptr;
-      return tree != nullptr && mayRun(tree->root, depth + 1);
+    running_trees_.emplace();
+    std::unordered_map<const PlanTree*, std::vector<const PlanTree*>> used_by;
+    std::vector<const PlanTree*> pending;
+    for (const PlanFile* file : files()) {
+      for (const PlanTree& tree : file->trees) {
+        bool asynchronous = false;
+        visitTree(tree.root, [&](const PlanNode& node) {
+          const NodeSpec* spec = registry_.find(node.id);
+          if (spec == nullptr) {
+            return false;
+          }
+          if (spec->asynchronous) {
+            asynchronous = true;
+          } else if (spec->kind == NodeKind::kSubTree) {
+            if (const PlanTree* used = index_.find(node)) {
+              used_by[used].push_back(&tree);
+            }
+          }
+          return !spec->asynchronous && spec->kind != NodeKind::kSubTree;
+        });
+        if (asynchronous && running_trees_->insert(&tree).second) {
+          pending.push_back(&tree);
+        }
+      }
     }
-    return std::any_of(node.children.begin(), node.children.end(),
-                       [&](const PlanNode& child) { return mayRun(child, depth + 1); });
+    while (!pending.empty()) {
+      const PlanTree* tree = pending.back();
+      pending.pop_back();
+      for (const PlanTree* user : used_by[tree]) {
+        if (running_trees_->insert(user).second) {
+          pending.push_back(user);
+        }
+      }
+    }
+    return *running_trees_;
   }
 
   void checkReactive(const PlanNode& node) {
@@ -375,13 +553,17 @@ class Validator {
   const Plan& plan_;
   const NodeRegistry& registry_;
   const BuildLimits& limits_;
+  const TreeIndex index_;
   std::vector<Diagnostic> diagnostics_;
-  std::map<std::string, Measure> measured_;
+  std::unordered_map<const PlanTree*, Measure> measured_;
+  std::optional<std::unordered_set<const PlanTree*>> running_trees_;
 };
 
 class Instantiator {
  public:
-  Instantiator(const Plan& plan, const NodeRegistry& registry) : plan_(plan), registry_(registry) {}
+  Instantiator(const Plan& plan, const NodeRegistry& registry) : index_(plan), registry_(registry) {}
+
+  // Recursive: the plan was validated, so it nests no deeper than BuildLimits::max_depth.
 
   TreeNode* build(const PlanNode& node) {
     const NodeSpec& spec = *registry_.find(node.id);
@@ -389,7 +571,7 @@ class Instantiator {
     if (spec.kind == NodeKind::kSubTree) {
       const std::string id = *node.attribute("ID");
       auto subtree = std::make_unique<SubTreeNode>(spec.id, node.name(), id);
-      subtree->setChild(build(plan_.findTree(id)->root));
+      subtree->setChild(build(index_.find(id)->root));
       instance = std::move(subtree);
     } else {
       try {
@@ -412,7 +594,7 @@ class Instantiator {
   std::vector<std::unique_ptr<TreeNode>> nodes_;
 
  private:
-  const Plan& plan_;
+  const TreeIndex index_;
   const NodeRegistry& registry_;
 };
 

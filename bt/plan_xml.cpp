@@ -1,6 +1,7 @@
 #include "bt/plan_xml.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <fstream>
 #include <memory>
 #include <pugixml.hpp>
@@ -33,6 +34,47 @@ const char* leadingText(const pugi::xml_node& element) {
   return first.type() == pugi::node_pcdata || first.type() == pugi::node_cdata ? first.value() : nullptr;
 }
 
+/// The length of the UTF-8 character `text` starts with, or 0 when its first bytes are not one
+/// (RFC 3629: no overlong forms, no UTF-16 surrogates, nothing above U+10FFFF).
+std::size_t utf8Length(std::string_view text) {
+  const auto byte = [&text](std::size_t i) { return i < text.size() ? static_cast<unsigned char>(text[i]) : 0u; };
+  const auto in = [](unsigned value, unsigned low, unsigned high) { return value >= low && value <= high; };
+  const unsigned first = byte(0);
+  if (first < 0x80) {
+    return 1;
+  }
+  if (in(first, 0xC2, 0xDF)) {
+    return in(byte(1), 0x80, 0xBF) ? 2 : 0;
+  }
+  if (in(first, 0xE0, 0xEF)) {
+    const unsigned low = first == 0xE0 ? 0xA0 : 0x80;
+    const unsigned high = first == 0xED ? 0x9F : 0xBF;  // ED A0..BF: surrogates
+    return in(byte(1), low, high) && in(byte(2), 0x80, 0xBF) ? 3 : 0;
+  }
+  if (in(first, 0xF0, 0xF4)) {
+    const unsigned low = first == 0xF0 ? 0x90 : 0x80;
+    const unsigned high = first == 0xF4 ? 0x8F : 0xBF;  // F4 90 and above: beyond U+10FFFF
+    return in(byte(1), low, high) && in(byte(2), 0x80, 0xBF) && in(byte(3), 0x80, 0xBF) ? 4 : 0;
+  }
+  return 0;
+}
+
+/// The characters XML 1.0 allows (its production Char).
+bool isXmlCharacter(std::uint64_t code) {
+  return code == 0x9 || code == 0xA || code == 0xD || (code >= 0x20 && code <= 0xD7FF) ||
+         (code >= 0xE000 && code <= 0xFFFD) || (code >= 0x10000 && code <= 0x10FFFF);
+}
+
+std::string hexBytes(std::string_view bytes) {
+  static constexpr char kDigits[] = "0123456789ABCDEF";
+  std::string out;
+  for (const char c : bytes) {
+    const auto value = static_cast<unsigned char>(c);
+    out += (out.empty() ? "" : " ") + std::string{kDigits[value >> 4], kDigits[value & 15]};
+  }
+  return out;
+}
+
 bool isBlank(const char* text) {
   if (text == nullptr) {
     return true;
@@ -52,6 +94,10 @@ class FileParser {
 
   PlanFile parse(std::string_view xml) {
     xml_ = xml;
+    checkCharacters();
+    if (!diagnostics_.empty()) {
+      throw PlanError(std::move(diagnostics_));
+    }
     pugi::xml_document document;
     // Entities and CDATA as XML has them; attribute values kept as written (no whitespace
     // conversion), as BehaviorTree.CPP reads them.
@@ -104,6 +150,100 @@ class FileParser {
     return static_cast<int>(std::upper_bound(line_starts_.begin(), line_starts_.end(), at) - line_starts_.begin());
   }
   int line(const pugi::xml_node& node) { return lineAt(node.offset_debug()); }
+  /// "line L, column C" of a byte offset (columns count bytes from 1).
+  std::string position(std::size_t offset) {
+    const int at = lineAt(static_cast<std::ptrdiff_t>(offset));
+    return "column " + std::to_string(offset - line_starts_[static_cast<std::size_t>(at - 1)] + 1);
+  }
+
+  /// A plan is UTF-8 text whose character references name characters XML allows: its names
+  /// and parameters end up in JSON (the server's answers, `costar trials --json`), which holds
+  /// nothing else, and the XML parser would turn `&#xD800;` into bytes that are not UTF-8.
+  /// The first problem of each line (of the first ten), naming line, column and bytes.
+  void checkCharacters() {
+    constexpr std::size_t kReportedLines = 10;
+    std::size_t lines = 0;
+    int last_line = 0;
+    const auto report = [&](std::size_t offset, const std::string& message) {
+      const int at = lineAt(static_cast<std::ptrdiff_t>(offset));
+      if (at == last_line) {
+        return;
+      }
+      last_line = at;
+      if (lines++ < kReportedLines) {
+        error(at, position(offset) + ": " + message);
+      } else if (lines == kReportedLines + 1) {
+        error(at, "more lines with characters that are not UTF-8 or not allowed in XML follow");
+      }
+    };
+    std::string_view end_of_skipped;  // "-->" inside a comment, "]]>" inside CDATA: no references
+    for (std::size_t i = 0; i < xml_.size();) {
+      const char first = xml_[i];
+      if (first != '<' && first != '&' && first != '-' && first != ']' && static_cast<unsigned char>(first) < 0x80) {
+        ++i;  // most bytes: nothing to look at
+        continue;
+      }
+      const std::string_view rest = xml_.substr(i);
+      if (static_cast<unsigned char>(rest[0]) >= 0x80) {
+        const std::size_t length = utf8Length(rest);
+        if (length == 0) {
+          std::size_t bad = 1;
+          while (bad < 4 && bad < rest.size() && utf8Length(rest.substr(bad)) == 0) {
+            ++bad;
+          }
+          report(i, "invalid UTF-8 (bytes " + hexBytes(rest.substr(0, bad)) +
+                        "): plan files are UTF-8 text (save it as UTF-8)");
+        }
+        i += std::max<std::size_t>(length, 1);
+        continue;
+      }
+      if (!end_of_skipped.empty()) {
+        if (rest.starts_with(end_of_skipped)) {
+          i += end_of_skipped.size();
+          end_of_skipped = {};
+          continue;
+        }
+      } else if (rest.starts_with("<!--")) {
+        end_of_skipped = "-->";
+      } else if (rest.starts_with("<![CDATA[")) {
+        end_of_skipped = "]]>";
+      } else if (rest.starts_with("&#")) {
+        checkReference(i, report);
+      }
+      ++i;
+    }
+  }
+
+  /// A character reference (`&#55296;`, `&#xD800;`) at `offset` names a character XML allows.
+  template <typename Report>
+  void checkReference(std::size_t offset, Report& report) {
+    const bool hex = offset + 2 < xml_.size() && xml_[offset + 2] == 'x';
+    std::size_t i = offset + (hex ? 3 : 2);
+    std::uint64_t code = 0;
+    std::size_t digits = 0;
+    for (; i < xml_.size(); ++i, ++digits) {
+      const char c = xml_[i];
+      int value = -1;
+      if (c >= '0' && c <= '9') {
+        value = c - '0';
+      } else if (hex && c >= 'a' && c <= 'f') {
+        value = c - 'a' + 10;
+      } else if (hex && c >= 'A' && c <= 'F') {
+        value = c - 'A' + 10;
+      } else {
+        break;
+      }
+      code = std::min<std::uint64_t>(code * (hex ? 16 : 10) + static_cast<std::uint64_t>(value), 0x7FFFFFFF);
+    }
+    if (digits == 0 || i >= xml_.size() || xml_[i] != ';') {
+      return;  // not a reference: the XML parser says what is wrong with it
+    }
+    if (!isXmlCharacter(code)) {
+      const std::string written(xml_.substr(offset, std::min<std::size_t>(i + 1 - offset, 24)));
+      report(offset, "the character reference '" + written + "' is not a character XML allows" +
+                         (code >= 0xD800 && code <= 0xDFFF ? " (a UTF-16 surrogate, not a character)" : ""));
+    }
+  }
 
   /// The innermost element open at `offset` of well-formed text before it, and its line.
   std::pair<std::string, int> openElementAt(std::size_t offset) {

@@ -296,6 +296,11 @@ std::optional<std::string> NodeRegistry::suggest(std::string_view id) const {
   std::optional<std::string> best;
   std::size_t best_distance = std::max<std::size_t>(2, id.size() / 3) + 1;
   for (const auto& [candidate, spec] : specs_) {
+    // The distance is at least the difference in length: a name of a megabyte costs nothing.
+    const std::size_t shorter = std::min(id.size(), candidate.size());
+    if (std::max(id.size(), candidate.size()) - shorter >= best_distance) {
+      continue;
+    }
     const std::size_t distance = editDistance(id, candidate);
     if (distance < best_distance) {
       best_distance = distance;

@@ -1,6 +1,6 @@
 #include "server/plan_json.h"
 
-#include <functional>
+#include <unordered_map>
 
 namespace costar::server {
 
@@ -201,44 +201,69 @@ bt::PlanFile planFileFromJson(const nlohmann::json& json, const std::string& lab
   return file;
 }
 
+namespace {
+
+/// Finds the first node written on each of `lines` (as parsed), in one walk over the file
+/// with an explicit stack: a plan with thousands of problems costs one walk, not one each.
+void locateLines(const bt::PlanFile& file, std::unordered_map<int, std::optional<NodeLocation>>& lines) {
+  struct Frame {
+    const bt::PlanNode* node;
+    std::size_t next = 0;  // the next child to visit
+  };
+  std::size_t left = lines.size();
+  for (const auto& tree : file.trees) {
+    std::vector<Frame> frames{{&tree.root}};
+    std::vector<std::size_t> path;
+    const auto visit = [&](const bt::PlanNode& node) {
+      if (const auto it = lines.find(node.location.line); it != lines.end() && !it->second) {
+        it->second = NodeLocation{tree.id, path};
+        --left;
+      }
+    };
+    visit(tree.root);
+    while (!frames.empty() && left > 0) {
+      Frame& frame = frames.back();
+      if (frame.next == frame.node->children.size()) {
+        frames.pop_back();
+        if (!path.empty()) {
+          path.pop_back();
+        }
+        continue;
+      }
+      const bt::PlanNode& child = frame.node->children[frame.next];
+      path.push_back(frame.next++);
+      frames.push_back({&child});
+      visit(child);
+    }
+  }
+}
+
+}  // namespace
+
 std::optional<NodeLocation> nodeAtLine(const bt::PlanFile& file, int line) {
   if (line <= 0) {
     return std::nullopt;
   }
-  std::optional<NodeLocation> found;
-  std::vector<std::size_t> path;
-  std::function<bool(const bt::PlanNode&, const std::string&)> walk = [&](const bt::PlanNode& node,
-                                                                          const std::string& tree) {
-    if (node.location.line == line) {
-      found = NodeLocation{tree, path};
-      return true;
-    }
-    for (std::size_t i = 0; i < node.children.size(); ++i) {
-      path.push_back(i);
-      if (walk(node.children[i], tree)) {
-        return true;
-      }
-      path.pop_back();
-    }
-    return false;
-  };
-  for (const auto& tree : file.trees) {
-    path.clear();
-    if (walk(tree.root, tree.id)) {
-      break;
-    }
-  }
-  return found;
+  std::unordered_map<int, std::optional<NodeLocation>> lines{{line, std::nullopt}};
+  locateLines(file, lines);
+  return lines[line];
 }
 
 nlohmann::json diagnosticsToJson(const std::vector<bt::Diagnostic>& diagnostics, const bt::PlanFile& file) {
+  std::unordered_map<int, std::optional<NodeLocation>> lines;
+  for (const auto& diagnostic : diagnostics) {
+    if (diagnostic.where.file == file.path && diagnostic.where.line > 0) {
+      lines.emplace(diagnostic.where.line, std::nullopt);
+    }
+  }
+  locateLines(file, lines);
   nlohmann::json list = nlohmann::json::array();
   for (const auto& diagnostic : diagnostics) {
     nlohmann::json item = {
         {"where", bt::toString(diagnostic.where)}, {"line", diagnostic.where.line}, {"message", diagnostic.message}};
     if (diagnostic.where.file == file.path) {
-      if (const auto location = nodeAtLine(file, diagnostic.where.line)) {
-        item["node"] = {{"tree", location->tree}, {"path", location->index_path}};
+      if (const auto it = lines.find(diagnostic.where.line); it != lines.end() && it->second) {
+        item["node"] = {{"tree", it->second->tree}, {"path", it->second->index_path}};
       }
     }
     list.push_back(std::move(item));

@@ -23,6 +23,14 @@ std::vector<Diagnostic> problems(const std::string& xml) {
   }
 }
 
+std::string hexBytesForTest(const std::string& bytes) {
+  std::string out;
+  for (const char c : bytes) {
+    out += std::to_string(static_cast<unsigned char>(c)) + " ";
+  }
+  return out;
+}
+
 /// The single problem of `xml`, as "line: message".
 std::string problem(const std::string& xml) {
   const auto diagnostics = problems(xml);
@@ -328,6 +336,135 @@ TEST(Validation, SizeLimitsStopExponentialSubtrees) {
   trees += "<BehaviorTree ID=\"t30\"><AlwaysSuccess/></BehaviorTree>";
   EXPECT_NE(problem(planXml(R"(<SubTree ID="t0"/>)", trees)).find("expands to more than 1000000 nodes"),
             std::string::npos);
+}
+
+TEST(Validation, AChainOf12000SubTreesIsRefusedAsTooDeepNotACrash) {
+  // Issue 27: ~950 KB, a chain of 12,000 SubTrees. The depth measurement recursed to the end of
+  // the chain before checking the limit (and searched the stack at each level): SIGSEGV.
+  const std::string xml = testing::subTreeChainXml(12000);
+  ASSERT_GT(xml.size(), 900'000u);
+  const auto diagnostics = problems(xml);
+  ASSERT_EQ(diagnostics.size(), 1u);
+  EXPECT_EQ(diagnostics[0].where.file, "plan.xml");
+  // 1,000 levels: the Inverter of T0 is level 1, so the 1,001st level is T500's Inverter, line 502.
+  EXPECT_EQ(diagnostics[0].str(),
+            "plan.xml:502: the plan nests deeper than 1000 levels once its subtrees are instantiated");
+  // So is a chain that leads back to its start, and building refuses it the same way.
+  EXPECT_NE(problem(testing::subTreeChainXml(12000, true)).find("nests deeper than 1000 levels"), std::string::npos);
+  testing::EventLog log;
+  SimClock clock;
+  EXPECT_THROW(buildTree(loadPlanText(xml, "plan.xml"), testing::registryWithTestLeaf(log), clock), PlanError);
+}
+
+TEST(Validation, AChainWithinTheDepthLimitBuildsAndRuns) {
+  // 500 trees: 500 Inverters, 499 SubTrees and the leaf, 1,000 levels.
+  testing::EventLog log;
+  SimClock clock;
+  Tree tree =
+      buildTree(loadPlanText(testing::subTreeChainXml(500), "plan.xml"), testing::registryWithTestLeaf(log), clock);
+  EXPECT_EQ(tree.nodes().size(), 1000u);
+  EXPECT_EQ(tree.tick(), Status::kSuccess);  // an even number of Inverters over a SUCCESS
+  EXPECT_NE(problem(testing::subTreeChainXml(501)).find("nests deeper than 1000 levels"), std::string::npos);
+}
+
+TEST(Validation, ALongLoopOfSubTreesIsReportedAsRecursion) {
+  EXPECT_EQ(problem(testing::subTreeChainXml(3, true)), "4: subtree 'T0' contains itself: T0 -> T1 -> T2 -> T0");
+}
+
+TEST(Validation, RunningIsFoundThroughAnyNumberOfSubTrees) {
+  // The RUNNING check looked only 64 levels down: a TestLeaf 100 SubTrees below the first child
+  // of a ReactiveSequence was missed.
+  std::string trees;
+  for (int i = 0; i < 100; ++i) {
+    trees += "<BehaviorTree ID=\"s" + std::to_string(i) + "\"><SubTree ID=\"s" + std::to_string(i + 1) +
+             "\"/></BehaviorTree>";
+  }
+  trees += R"(<BehaviorTree ID="s100"><TestLeaf/></BehaviorTree>)";
+  EXPECT_NE(problem(planXml(R"(<ReactiveSequence><SubTree ID="s0"/><TestLeaf/></ReactiveSequence>)", trees))
+                .find("only the last child of a ReactiveSequence may take time"),
+            std::string::npos);
+}
+
+TEST(Validation, TheRunningCheckLooksAtEachTreeOnce) {
+  // Each tree uses the next twice: 2^40 paths through 40 trees. The check went down every path
+  // (to 64 levels: billions of calls); it looks at each tree once.
+  std::string trees;
+  for (int i = 0; i < 40; ++i) {
+    const std::string next = "<SubTree ID=\"d" + std::to_string(i + 1) + "\"/>";
+    trees += "<BehaviorTree ID=\"d" + std::to_string(i) + "\"><Sequence>" + next + next + "</Sequence></BehaviorTree>";
+  }
+  trees += R"(<BehaviorTree ID="d40"><AlwaysSuccess/></BehaviorTree>)";
+  // Only the size is refused: nothing in it can be RUNNING.
+  const auto diagnostics =
+      problems(planXml(R"(<ReactiveSequence><SubTree ID="d0"/><TestLeaf/></ReactiveSequence>)", trees));
+  ASSERT_EQ(diagnostics.size(), 1u);
+  EXPECT_NE(diagnostics[0].message.find("expands to more than 1000000 nodes"), std::string::npos);
+}
+
+TEST(Validation, PathsThatAddUpToTooManyBytesAreRefused) {
+  // A 100 KB name above 1,000 nodes: each of their paths repeats it (100 MB of paths).
+  std::string wide = "<BehaviorTree ID=\"wide\"><Sequence>";
+  for (int i = 0; i < 1000; ++i) {
+    wide += "<AlwaysSuccess/>";
+  }
+  wide += "</Sequence></BehaviorTree>";
+  const std::string name(100'000, 'n');
+  EXPECT_NE(problem(planXml("<Sequence name=\"" + name + "\"><SubTree ID=\"wide\"/></Sequence>", wide))
+                .find("node paths (main/Sequence[1]/..., one per node) add up to more than 64 MiB"),
+            std::string::npos);
+  EXPECT_TRUE(problems(planXml("<Sequence name=\"short\"><SubTree ID=\"wide\"/></Sequence>", wide)).empty());
+}
+
+TEST(Validation, AnUnknownSubtreeListsTheFirstTwentyTrees) {
+  std::string trees;
+  for (int i = 0; i < 30; ++i) {
+    trees += "<BehaviorTree ID=\"t" + std::to_string(i) + "\"><AlwaysSuccess/></BehaviorTree>";
+  }
+  EXPECT_EQ(problem(planXml(R"(<SubTree ID="nope"/>)", trees)),
+            "1: unknown subtree 'nope' (the plan defines: main, t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11, "
+            "t12, t13, t14, t15, t16, t17, t18 and 11 more)");
+}
+
+TEST(PlanXml, InvalidUtf8IsRefusedAtLoadWithLineColumnAndBytes) {
+  // Issue 27: a name with bytes that are not UTF-8 validated and ran; writing the trials' JSON
+  // threw at the end, losing the batch.
+  EXPECT_EQ(problem("<root BTCPP_format=\"4\">\n<BehaviorTree ID=\"m\">\n  <AlwaysSuccess name=\"ok \xff\xfe\"/>\n"
+                    "</BehaviorTree></root>"),
+            "3: column 27: invalid UTF-8 (bytes FF FE): plan files are UTF-8 text (save it as UTF-8)");
+  // A character cut short, an overlong form, an encoded surrogate, beyond U+10FFFF: each refused.
+  for (const std::string bad : {"\xc3", "\xe2\x82", "\xc0\xaf", "\xed\xa0\x80", "\xf4\x90\x80\x80", "\x80"}) {
+    const auto diagnostics = problems(planXml("<AlwaysSuccess name=\"" + bad + "\"/>"));
+    ASSERT_EQ(diagnostics.size(), 1u) << hexBytesForTest(bad);
+    EXPECT_NE(diagnostics[0].message.find("invalid UTF-8"), std::string::npos) << diagnostics[0].message;
+    EXPECT_EQ(diagnostics[0].where.file, "plan.xml");
+  }
+  // In an element's name too, and each line once.
+  EXPECT_EQ(problems("<root BTCPP_format=\"4\"><BehaviorTree ID=\"m\"><Sequence\xe9 a=\"\xe9\"/>\n<X \xe9/>"
+                     "</BehaviorTree></root>")
+                .size(),
+            2u);
+  // Valid UTF-8 everywhere is read as it is.
+  const Plan plan =
+      loadPlanText(planXml("<AlwaysSuccess name=\"n\xc5\x93ud \xf0\x9f\x99\x82 \xe2\x82\xac\"/>"), "ok.xml");
+  EXPECT_EQ(plan.file.trees[0].root.name(), "n\xc5\x93ud \xf0\x9f\x99\x82 \xe2\x82\xac");
+}
+
+TEST(PlanXml, CharacterReferencesToSurrogatesAndNonCharactersAreRefused) {
+  // Issue 27: the XML parser turns &#xD800; into bytes that are not UTF-8 (the server accepted it).
+  EXPECT_EQ(problem(planXml("\n<AlwaysSuccess name=\"a&#xD800;b\"/>")),
+            "2: column 23: the character reference '&#xD800;' is not a character XML allows (a UTF-16 surrogate, not "
+            "a character)");
+  for (const std::string reference :
+       {"&#55296;", "&#xdfff;", "&#0;", "&#x1;", "&#x110000;", "&#xFFFE;", "&#99999999999999999999;"}) {
+    EXPECT_NE(problem(planXml("<AlwaysSuccess name=\"" + reference + "\"/>")).find("is not a character XML allows"),
+              std::string::npos)
+        << reference;
+  }
+  // Characters XML allows, written as references, are read as those characters.
+  const Plan plan = loadPlanText(planXml("<AlwaysSuccess name=\"&#x10FFFF;&#233;&#x9;&amp;\"/>"), "ok.xml");
+  EXPECT_EQ(plan.file.trees[0].root.name(), "\xf4\x8f\xbf\xbf\xc3\xa9\t&");
+  // In comments and CDATA a reference is text, not a character: not refused.
+  EXPECT_TRUE(problems(planXml("<!-- &#xD800; --><AlwaysSuccess/>")).empty());
 }
 
 // --- includes ---------------------------------------------------------------------------------

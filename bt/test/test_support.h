@@ -122,6 +122,21 @@ inline std::string planXml(const std::string& body, const std::string& extra_tre
          extra_trees + "</root>";
 }
 
+/// The hostile shape of issue 27: a chain of `trees` SubTrees, each tree an Inverter over the
+/// next one (`<BehaviorTree ID="T7"><Inverter><SubTree ID="T8"/></Inverter></BehaviorTree>`),
+/// one tree a line; the last ends in AlwaysSuccess (or, with `loop`, uses T0 again).
+/// 12,000 trees make about 950 KB.
+inline std::string subTreeChainXml(int trees, bool loop = false) {
+  std::string xml = "<root BTCPP_format=\"4\" main_tree_to_execute=\"T0\">\n";
+  for (int i = 0; i < trees; ++i) {
+    const std::string next = i + 1 < trees ? "<SubTree ID=\"T" + std::to_string(i + 1) + "\"/>"
+                             : loop        ? "<SubTree ID=\"T0\"/>"
+                                           : "<AlwaysSuccess/>";
+    xml += "<BehaviorTree ID=\"T" + std::to_string(i) + "\"><Inverter>" + next + "</Inverter></BehaviorTree>\n";
+  }
+  return xml + "</root>\n";
+}
+
 /// A tree built from `body`, with the TestLeaf registry and `clock`.
 struct TestTree {
   TestTree(const std::string& body, const std::string& extra_trees = "")

@@ -36,6 +36,25 @@ check "nodes json"          0 '"category": "knowledge"' -- "$costar" nodes -w te
 check "workcells: iiwa"     0 '^iiwa-sim ' -- "$costar" workcells
 check "validate on iiwa"    0 'valid for workcell .iiwa-sim.' -- "$costar" validate examples/ur5/assemble_structure.xml -w iiwa-sim
 check "nodes of iiwa"       0 '<Action ID="SmartGrasp">' -- "$costar" nodes -w iiwa-sim
+# Hostile plans (issue 27): a chain of 12,000 SubTrees (~950 KB) is refused with its line (it
+# overflowed the stack); a name that is not UTF-8, or a reference to a surrogate, is refused at load.
+{
+  echo '<root BTCPP_format="4" main_tree_to_execute="T0">'
+  for ((i = 0; i < 11999; ++i)); do
+    echo "<BehaviorTree ID=\"T$i\"><Inverter><SubTree ID=\"T$((i + 1))\"/></Inverter></BehaviorTree>"
+  done
+  echo '<BehaviorTree ID="T11999"><Inverter><AlwaysSuccess/></Inverter></BehaviorTree></root>'
+} >"$tmp/deep.xml"
+check "deep subtrees: validate" 2 'deep\.xml:502: the plan nests deeper than 1000 levels once its subtrees are instantiated' \
+  -- "$costar" validate "$tmp/deep.xml" -w none
+check "deep subtrees: run"      2 'deep\.xml:502: the plan nests deeper than 1000 levels' -- "$costar" run "$tmp/deep.xml" -w test
+check "deep subtrees: ur5-sim"  2 'deep\.xml:502: the plan nests deeper than 1000 levels' -- "$costar" validate "$tmp/deep.xml"
+printf '<root BTCPP_format="4"><BehaviorTree ID="m">\n<AlwaysSuccess name="ok \xff"/></BehaviorTree></root>\n' >"$tmp/bytes.xml"
+check "name not UTF-8"          2 'bytes\.xml:2: column 25: invalid UTF-8 \(bytes FF\): plan files are UTF-8 text' \
+  -- "$costar" validate "$tmp/bytes.xml" -w none
+printf '<root BTCPP_format="4"><BehaviorTree ID="m">\n<AlwaysSuccess name="a&#xD800;b"/></BehaviorTree></root>\n' >"$tmp/surrogate.xml"
+check "surrogate reference"     2 "surrogate\.xml:2: column 23: the character reference '&#xD800;' is not a character XML allows" \
+  -- "$costar" run "$tmp/surrogate.xml" -w none
 check "calibrate: bad cell" 2 "unknown workcell .nosuch." -- "$costar" calibrate -w nosuch
 check "help"                0 'Exit code: 0 SUCCESS' -- "$costar" run --help
 check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit 0.1

@@ -220,6 +220,82 @@ TEST_F(HostileTest, HugeBodiesAreRefused) {
   EXPECT_EQ(testing::readResponse(chunked, pending).status, 413);
 }
 
+/// Issue 27's hostile shape: a chain of `trees` SubTrees, each an Inverter over the next, a
+/// tree a line (the first on line 2).
+std::string subTreeChain(int trees) {
+  std::string xml = "<root BTCPP_format=\"4\" main_tree_to_execute=\"T0\">\n";
+  for (int i = 0; i < trees; ++i) {
+    xml += "<BehaviorTree ID=\"T" + std::to_string(i) + "\"><Inverter>" +
+           (i + 1 < trees ? "<SubTree ID=\"T" + std::to_string(i + 1) + "\"/>" : "<AlwaysSuccess/>") +
+           "</Inverter></BehaviorTree>\n";
+  }
+  return xml + "</root>\n";
+}
+
+TEST_F(HostileTest, AChainOfThousandsOfSubTreesIsRefusedNotACrash) {
+  // Issue 27: one authenticated request of ~950 KB overflowed the stack in the validator's
+  // depth measurement, killing the server (and so the arm's run) with nothing printed.
+  const std::string xml = json{{"xml", subTreeChain(11000)}}.dump();
+  ASSERT_GT(xml.size(), 900'000u);
+  ASSERT_LT(xml.size(), 1u << 20);
+  const Response validated = testing::request(port(), "POST", "/api/validate", xml, token());
+  ASSERT_EQ(validated.status, 200) << validated.body.substr(0, 300);
+  const json body = json::parse(validated.body);
+  EXPECT_FALSE(body["valid"].get<bool>());
+  ASSERT_EQ(body["diagnostics"].size(), 1u);
+  EXPECT_TRUE(body["diagnostics"][0]["where"].get<std::string>().starts_with("plan.xml:"));
+  EXPECT_EQ(body["diagnostics"][0]["message"],
+            "the plan nests deeper than 1000 levels once its subtrees are instantiated");
+  EXPECT_EQ(body["diagnostics"][0]["node"]["tree"], "T500");  // the editor's node
+  for (const auto& [method, target] :
+       std::vector<std::pair<std::string, std::string>>{{"PUT", "/api/plans/deep"}, {"POST", "/api/runs"}}) {
+    const Response refused = testing::request(port(), method, target, xml, token());
+    EXPECT_EQ(refused.status, 422) << target << ": " << refused.body.substr(0, 300);
+    EXPECT_NE(refused.body.find("nests deeper than 1000 levels"), std::string::npos) << target;
+  }
+  EXPECT_EQ(testing::request(port(), "GET", "/api/plans/deep").status, 404);
+  // The same chain as the editor's JSON.
+  json trees = json::array();
+  for (int i = 0; i < 6000; ++i) {
+    const json leaf =
+        i + 1 < 6000
+            ? json{{"id", "SubTree"}, {"attributes", json::array({json::array({"ID", "T" + std::to_string(i + 1)})})}}
+            : json{{"id", "AlwaysSuccess"}};
+    trees.push_back({{"id", "T" + std::to_string(i)}, {"root", {{"id", "Inverter"}, {"children", {leaf}}}}});
+  }
+  const std::string editor = json{{"plan", {{"main_tree", "T0"}, {"trees", trees}}}}.dump();
+  ASSERT_LT(editor.size(), 1u << 20);
+  const Response from_editor = testing::request(port(), "POST", "/api/validate", editor, token());
+  ASSERT_EQ(from_editor.status, 200) << from_editor.body.substr(0, 300);
+  EXPECT_NE(from_editor.body.find("nests deeper than 1000 levels"), std::string::npos);
+}
+
+TEST_F(HostileTest, SurrogateReferencesAndBytesThatAreNotUtf8AreRefusedInPlans) {
+  // Issue 27: `&#xD800;` in a name became bytes that are not UTF-8; the plan validated, saved
+  // and ran, and broke every JSON that later held the name.
+  const auto planWith = [](const std::string& name) {
+    return json{{"xml", "<root BTCPP_format=\"4\"><BehaviorTree ID=\"m\"><TestLog name=\"" + name +
+                            "\" message=\"x\"/></BehaviorTree></root>"}}
+        .dump();
+  };
+  for (const auto& [method, target] : std::vector<std::pair<std::string, std::string>>{
+           {"POST", "/api/validate"}, {"PUT", "/api/plans/surrogate"}, {"POST", "/api/runs"}}) {
+    const Response refused = testing::request(port(), method, target, planWith("a&#xD800;b"), token());
+    EXPECT_EQ(refused.status, 422) << target << ": " << refused.body;
+    EXPECT_NE(refused.body.find("column 61: the character reference '&#xD800;' is not a character XML allows"),
+              std::string::npos)
+        << refused.body;
+  }
+  EXPECT_EQ(testing::request(port(), "GET", "/api/plans/surrogate").status, 404);
+  // As a JSON escape: not JSON at all (a lone surrogate).
+  expectClientError(
+      testing::request(
+          port(), "POST", "/api/validate",
+          R"({"xml":"<root BTCPP_format=\"4\"><BehaviorTree ID=\"m\"><TestLog name=\"\ud800\" message=\"x\"/></BehaviorTree></root>"})",
+          token()),
+      "a lone surrogate escape");
+}
+
 TEST_F(HostileTest, NoMotionWithoutTheToken) {
   const std::string body = R"({"node":"TestLog","attributes":{"message":"hi"}})";
   const std::string plan =
