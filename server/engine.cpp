@@ -37,10 +37,12 @@ void Engine::startThread() {
   }
   // An exception that escapes a loop is logged and the loop goes on (guard.h).
   log_thread_ = std::thread([this] {
+    prepareServerThread("runlog");
     while (!guarded("run log writer", [this] { logWriterLoop(); })) {
     }
   });
   thread_ = std::thread([this] {
+    prepareServerThread("engine");
     while (!guarded("engine thread", [this] { loop(); })) {
     }
   });

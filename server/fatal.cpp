@@ -13,6 +13,7 @@
 #include <string>
 
 #include "server/engine.h"
+#include "server/guard.h"
 
 namespace costar::server {
 namespace {
@@ -57,6 +58,12 @@ void stopTheArm() noexcept {
     say("costar serve: no run was active: the arm was not moving under a plan\n");
     return;
   }
+  if (const char* role = serverThreadRole(); role != nullptr && std::strcmp(role, "engine") == 0) {
+    // The thread that would stop the run is this one: waiting for it would only delay dying.
+    say("costar serve: the engine thread, which commands the arm, is the one that failed: it commands nothing "
+        "more (the simulated cell stops with it)\n");
+    return;
+  }
   say("costar serve: stopping the active run first (the arm decelerates and stops)\n");
   // Ask again while waiting: a run that starts meanwhile is stopped too. Ended: not active in
   // three checks in a row.
@@ -88,6 +95,16 @@ void onSignal(int signal, siginfo_t* info, void* /*context*/) {
       : signal == SIGILL  ? "SIGILL"
       : signal == SIGABRT ? "SIGABRT"
                           : "?");
+  // This handler runs on the thread's alternate stack (prepareServerThread), so it runs even
+  // when the thread's own stack is what overflowed.
+  if (signal == SIGSEGV && info != nullptr && info->si_code > 0 && nearStackLimit(info->si_addr)) {
+    say(" (a stack overflow)");
+  }
+  if (const char* role = serverThreadRole()) {
+    say(" in the ");
+    say(role);
+    say(" thread");
+  }
   say("\n");
   stopTheArm();
   // Die as the process would have: the previous action (the default, or e.g. a sanitizer's).
@@ -127,13 +144,14 @@ FatalStop::FatalStop(Engine& engine, std::chrono::milliseconds wait) {
   if (g_engine.exchange(&engine) != nullptr) {
     throw std::logic_error("FatalStop: one at a time");
   }
+  prepareServerThread("main");
   g_wait_ms = static_cast<long>(wait.count());
   g_dying = false;
   g_previous_terminate = std::set_terminate(onTerminate);
   struct sigaction action {};
   action.sa_sigaction = onSignal;
   sigemptyset(&action.sa_mask);
-  action.sa_flags = SA_SIGINFO;
+  action.sa_flags = SA_SIGINFO | SA_ONSTACK;  // on the alternate stack where the thread has one
   for (int i = 0; i < kSignalCount; ++i) {
     ::sigaction(kSignals[i], &action, &g_previous[i]);
   }

@@ -4,7 +4,11 @@
 // the active run (which cancels its operations: the arm decelerates and stops) and wait up to
 // `wait` for the run to end, saying so on stderr; then the process dies as it would have (the
 // signal's previous handler, or abort()). The signal path is async-signal-safe: it only sets
-// and reads the engine's atomics, sleeps and write()s.
+// and reads the engine's atomics, sleeps and write()s. It runs on the faulting thread's
+// alternate signal stack (guard.h: prepareServerThread, which every thread of the server calls
+// first), so a stack overflow stops the arm too, and it says so ("a stack overflow in the io
+// thread"). When the failing thread is the engine's, which would stop the run, it says that
+// nothing commands the arm any more and does not wait.
 
 #include <chrono>
 

@@ -8,6 +8,21 @@
 
 namespace costar::server {
 
+/// Prepares the calling thread for the fatal path (fatal.h): an alternate signal stack, so that
+/// the handler that stops the arm runs even when this thread's own stack is what overflowed,
+/// and a role the fatal message names (`io`, `engine`; threads other than the main one are
+/// named `costar-<role>` too, as `top -H` shows them). Call it first in every thread the server
+/// starts; the stack is freed when the thread ends. A thread that has an alternate stack
+/// already (a sanitizer's) keeps it. `role` must be a string literal.
+void prepareServerThread(const char* role) noexcept;
+
+/// The calling thread's role given to prepareServerThread(), or nullptr. Async-signal-safe.
+const char* serverThreadRole() noexcept;
+
+/// Whether `address` lies within a page or so of the end of the calling thread's stack (as
+/// recorded by prepareServerThread): a fault there is a stack overflow. Async-signal-safe.
+bool nearStackLimit(const void* address) noexcept;
+
 /// Logs "costar serve: <where>: <what>" as an error. Never throws.
 void logServerError(std::string_view where, std::string_view what) noexcept;
 

@@ -302,6 +302,7 @@ void HttpServer::start() {
   net::post(impl_->ioc, [this] { impl_->broadcast(); });
   for (int i = 0; i < std::max(1, impl_->core.options.threads); ++i) {
     impl_->threads.emplace_back([this] {
+      prepareServerThread("io");
       // A handler that throws ends run() with its exception: log it and go on serving.
       while (!guarded("I/O thread", [this] { impl_->ioc.run(); })) {
       }

@@ -3,11 +3,13 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -74,6 +76,19 @@ class Child {
     if (pid_ > 0) {
       ::kill(pid_, number);
     }
+  }
+  /// Sends a signal to one thread of the child, the first named `name` (/proc/PID/task/*/comm);
+  /// false when it has none.
+  bool signalThread(const std::string& name, int number) const {
+    std::error_code error;
+    for (const auto& task : std::filesystem::directory_iterator("/proc/" + std::to_string(pid_) + "/task", error)) {
+      std::string comm;
+      std::getline(std::ifstream(task.path() / "comm"), comm);
+      if (comm == name) {
+        return ::syscall(SYS_tgkill, pid_, std::stoi(task.path().filename().string()), number) == 0;
+      }
+    }
+    return false;
   }
   /// Waits for the child to end (up to `timeout_ms`); its wait status, or -1 if still running.
   int wait(int timeout_ms) {

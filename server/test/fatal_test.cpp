@@ -38,6 +38,7 @@ class FatalTest : public ::testing::Test {
 
   std::vector<std::string> args(const std::string& workcell = "ur5-sim") const {
     return {COSTAR_SERVE_CHILD,
+            "--test-overflow-on-sigusr2",
             "--workcell",
             workcell,
             "--scene",
@@ -110,6 +111,39 @@ TEST_F(FatalTest, FatalSignalMidMotionStopsTheRunBeforeDying) {
   const std::string err = stderrText();
   EXPECT_NE(err.find("fatal signal SIGSEGV"), std::string::npos) << err;
   EXPECT_NE(err.find("the active run was stopped"), std::string::npos) << err;
+}
+
+TEST_F(FatalTest, StackOverflowInAnIoThreadMidMotionStopsTheRunBeforeDying) {
+  // Issue 27: a request that overflowed a thread's stack killed the server with nothing
+  // printed and the arm moving: the handler had no stack to run on. Each server thread has an
+  // alternate signal stack now.
+  Child child(args(), dir_ / "stderr.txt");
+  const std::uint16_t port = child.waitForPort();
+  ASSERT_NE(port, 0) << stderrText();
+  startSlowMove(port);
+  ASSERT_TRUE(child.signalThread("costar-io", SIGUSR2));  // that thread recurses until its stack runs out
+  const int status = child.wait(20'000);
+  ASSERT_NE(status, -1) << "the server did not die";
+  ASSERT_TRUE(WIFSIGNALED(status));
+  EXPECT_EQ(WTERMSIG(status), SIGSEGV);
+  const std::string err = stderrText();
+  EXPECT_NE(err.find("fatal signal SIGSEGV (a stack overflow) in the io thread"), std::string::npos) << err;
+  EXPECT_NE(err.find("the active run was stopped (its operations cancelled)"), std::string::npos) << err;
+}
+
+TEST_F(FatalTest, StackOverflowInTheEngineThreadSaysNothingCommandsTheArm) {
+  Child child(args(), dir_ / "stderr.txt");
+  const std::uint16_t port = child.waitForPort();
+  ASSERT_NE(port, 0) << stderrText();
+  startSlowMove(port);
+  ASSERT_TRUE(child.signalThread("costar-engine", SIGUSR2));
+  const int status = child.wait(20'000);
+  ASSERT_NE(status, -1) << "the server did not die";
+  ASSERT_TRUE(WIFSIGNALED(status));
+  EXPECT_EQ(WTERMSIG(status), SIGSEGV);
+  const std::string err = stderrText();
+  EXPECT_NE(err.find("fatal signal SIGSEGV (a stack overflow) in the engine thread"), std::string::npos) << err;
+  EXPECT_NE(err.find("the engine thread, which commands the arm, is the one that failed"), std::string::npos) << err;
 }
 
 TEST_F(FatalTest, TerminateWhileIdleSaysNothingWasMoving) {

@@ -4,6 +4,8 @@
 // --test-endpoints and --test-oracle-perception. Prints what `costar serve` prints, including "listening on URL".
 // --test-terminate-on-sigusr1: on SIGUSR1 an exception escapes a thread (std::terminate), to
 // test that the arm is stopped before the process dies (fatal_test.cpp).
+// --test-overflow-on-sigusr2: a thread sent SIGUSR2 (tgkill) recurses until its stack
+// overflows, to test that the fatal path runs on such a thread too (fatal_test.cpp).
 
 #include <pthread.h>
 #include <signal.h>
@@ -15,6 +17,22 @@
 #include <thread>
 
 #include "server/serve.h"
+
+namespace {
+
+/// Recurses until the stack runs out: each frame holds a buffer the compiler cannot drop.
+__attribute__((noinline)) int overflowTheStack(int depth) {
+  volatile char frame[1024];
+  frame[0] = static_cast<char>(depth);
+  if (depth < 0) {  // never: keeps the recursion from being proven infinite
+    return 0;
+  }
+  return overflowTheStack(depth + 1) + frame[0];
+}
+
+void onSigusr2(int /*signal*/) { overflowTheStack(0); }
+
+}  // namespace
 
 int main(int argc, char** argv) {
   costar::server::ServeOptions options;
@@ -40,6 +58,14 @@ int main(int argc, char** argv) {
         sigwait(&usr1, &signal);
         throw std::runtime_error("TEST: an exception escapes a thread");
       }).detach();
+      continue;
+    }
+    if (key == "--test-overflow-on-sigusr2") {
+      // Runs on the thread's own stack (no SA_ONSTACK): what overflows is that stack.
+      struct sigaction action {};
+      action.sa_handler = onSigusr2;
+      sigemptyset(&action.sa_mask);
+      sigaction(SIGUSR2, &action, nullptr);
       continue;
     }
     if (key == "--test-oracle-perception") {  // TEST ONLY: true part poses as object symbols
