@@ -5,8 +5,10 @@
 #include <boost/asio/strand.hpp>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 #include "server/guard.h"
 #include "server/http_session.h"
@@ -25,25 +27,122 @@ std::string lower(std::string text) {
 
 }  // namespace
 
-std::string hostOf(std::string authority) {
-  if (const auto scheme = authority.find("://"); scheme != std::string::npos) {
-    authority = authority.substr(scheme + 3);
-  }
-  if (const auto slash = authority.find('/'); slash != std::string::npos) {
-    authority = authority.substr(0, slash);
-  }
-  if (!authority.empty() && authority.front() == '[') {
-    const auto close = authority.find(']');
-    return lower(close == std::string::npos ? authority : authority.substr(0, close + 1));
-  }
-  if (const auto colon = authority.rfind(':'); colon != std::string::npos) {
-    authority = authority.substr(0, colon);
-  }
-  return lower(authority);
+namespace {
+
+bool isDigits(std::string_view text) {
+  return !text.empty() && std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
-bool loopbackHost(const std::string& host) {
-  return host == "localhost" || host == "[::1]" || host == "::1" || host.starts_with("127.");
+/// An IPv4 literal in 127.0.0.0/8: four decimal parts of 0-255 without leading zeros, as a
+/// browser writes it (127.1 or 0177.0.0.1 are not this form: another program's spelling).
+bool isLoopbackIpv4(std::string_view text) {
+  std::vector<std::string_view> parts;
+  for (std::size_t start = 0;;) {
+    const std::size_t dot = text.find('.', start);
+    parts.push_back(text.substr(start, dot == std::string_view::npos ? dot : dot - start));
+    if (dot == std::string_view::npos) {
+      break;
+    }
+    start = dot + 1;
+  }
+  const auto octet = [](std::string_view part) {
+    return isDigits(part) && part.size() <= 3 && (part.size() == 1 || part[0] != '0') &&
+           std::stoi(std::string(part)) <= 255;
+  };
+  return parts.size() == 4 && parts[0] == "127" && std::all_of(parts.begin(), parts.end(), octet);
+}
+
+}  // namespace
+
+std::optional<Authority> parseAuthority(std::string_view text) {
+  Authority out;
+  std::string_view port;
+  if (text.starts_with('[')) {
+    const std::size_t close = text.find(']');
+    if (close == std::string_view::npos) {
+      return std::nullopt;
+    }
+    const std::string literal(text.substr(1, close - 1));
+    boost::system::error_code error;
+    const auto address = net::ip::make_address_v6(literal, error);
+    if (error || literal.find('%') != std::string::npos) {  // no zone: a browser never sends one
+      return std::nullopt;
+    }
+    out.host = address.to_string();
+    out.ipv6 = true;
+    const std::string_view rest = text.substr(close + 1);
+    if (!rest.empty()) {
+      if (rest[0] != ':') {
+        return std::nullopt;  // "[::1].evil.com"
+      }
+      port = rest.substr(1);
+      if (port.empty()) {
+        return std::nullopt;
+      }
+    }
+  } else {
+    const std::size_t colon = text.find(':');
+    out.host = lower(std::string(text.substr(0, colon)));
+    if (colon != std::string_view::npos) {
+      port = text.substr(colon + 1);
+      if (port.empty()) {
+        return std::nullopt;
+      }
+    }
+    const auto hostCharacter = [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' || c == '_';
+    };
+    if (out.host.empty() || !std::all_of(out.host.begin(), out.host.end(), hostCharacter)) {
+      return std::nullopt;
+    }
+  }
+  if (!port.empty()) {
+    if (!isDigits(port) || port.size() > 5 || std::stoi(std::string(port)) == 0 ||
+        std::stoi(std::string(port)) > 65535) {
+      return std::nullopt;
+    }
+    out.port = static_cast<std::uint16_t>(std::stoi(std::string(port)));
+  }
+  return out;
+}
+
+bool isLoopback(const Authority& authority) {
+  if (authority.ipv6) {
+    return authority.host == "::1";
+  }
+  return authority.host == "localhost" || isLoopbackIpv4(authority.host);
+}
+
+std::optional<Origin> parseOrigin(std::string_view text) {
+  const std::size_t separator = text.find("://");
+  if (separator == std::string_view::npos) {
+    return std::nullopt;  // "null" (a sandboxed page, a file), or not an origin
+  }
+  Origin out;
+  out.scheme = lower(std::string(text.substr(0, separator)));
+  if (out.scheme != "http" && out.scheme != "https") {
+    return std::nullopt;
+  }
+  auto authority = parseAuthority(text.substr(separator + 3));  // an origin has no path
+  if (!authority) {
+    return std::nullopt;
+  }
+  out.authority = std::move(*authority);
+  return out;
+}
+
+bool originAllowed(std::string_view origin, std::string_view host_header, bool loopback) {
+  if (origin.empty()) {
+    return true;  // not a browser: a browser always sends Origin with a WebSocket
+  }
+  const auto parsed = parseOrigin(origin);
+  const auto host = parseAuthority(host_header);
+  if (!parsed || !host || (loopback && !isLoopback(parsed->authority))) {
+    return false;
+  }
+  // The page's own origin: the scheme's port when none is written; Host's is HTTP's, 80.
+  const std::uint16_t origin_port = parsed->authority.port.value_or(parsed->scheme == "https" ? 443 : 80);
+  return parsed->authority.host == host->host && origin_port == host->port.value_or(80);
 }
 
 namespace {
@@ -153,7 +252,11 @@ std::size_t ServerCore::clients() const {
 }
 
 bool ServerCore::hostAllowed(const std::string& host_header) const {
-  return !loopback || loopbackHost(hostOf(host_header));
+  if (!loopback) {
+    return true;
+  }
+  const auto host = parseAuthority(host_header);
+  return host && isLoopback(*host);
 }
 
 std::vector<std::string> answerStreamMessage(ServerCore& core, const std::string& text, bool& authenticated) {

@@ -76,9 +76,30 @@ struct ServerCore {
   std::vector<std::weak_ptr<StreamClient>> clients_;
 };
 
-/// The host part of a Host header or an Origin's authority ("[::1]:8080" -> "[::1]").
-std::string hostOf(std::string authority);
-bool loopbackHost(const std::string& host);
+/// A Host header's value or an Origin's authority: `host[:port]`.
+struct Authority {
+  /// Lower case; an IPv6 literal without its brackets, in its shortest form ("::1").
+  std::string host;
+  std::optional<std::uint16_t> port;
+  bool ipv6 = false;
+};
+/// Parses `name`, `a.b.c.d` or `[v6]`, each with an optional `:port` (1-65535); nullopt when
+/// it is anything else ("127.0.0.1evil" parses, as a name; "[::1].evil.com" does not).
+std::optional<Authority> parseAuthority(std::string_view text);
+/// `localhost`, an IPv4 literal in 127.0.0.0/8 (four decimal parts), or ::1.
+bool isLoopback(const Authority& authority);
+/// An Origin header: `http://AUTHORITY` or `https://AUTHORITY`; nullopt for anything else
+/// ("null", other schemes, a path).
+struct Origin {
+  std::string scheme;
+  Authority authority;
+};
+std::optional<Origin> parseOrigin(std::string_view text);
+/// Whether a WebSocket upgrade may open the stream: no Origin (not a browser), or the page's
+/// own origin, i.e. http(s) with the host and port the request's Host names (on a loopback
+/// server, a loopback host). A page of another site, or of another port of this machine, is
+/// refused; a page served through a proxy (the editor's development server) is its own origin.
+bool originAllowed(std::string_view origin, std::string_view host_header, bool loopback);
 /// A file of the page under `root` (or 404, or the page saying how to build it).
 HttpResponse staticFile(const std::filesystem::path& root, const std::string& target);
 /// The answers to one WebSocket message from a client (auth, control, ping; else an error
@@ -270,18 +291,20 @@ class HttpSession final : public std::enable_shared_from_this<HttpSession<Stream
     http::request<http::string_body> request = parser_->release();
     const std::string host(request[http::field::host]);
     if (!core_.hostAllowed(host)) {
-      reply(errorResponse(421, "this server answers only requests to 127.0.0.1 or localhost"), request.version(), false,
-            false);
+      reply(errorResponse(421,
+                          "this server answers only requests whose Host is localhost, 127.x.y.z or [::1] (with "
+                          "an optional port): another name for this machine may be a site rebinding its DNS"),
+            request.version(), false, false);
       return true;
     }
     const std::string target(request.target());
     if (websocket::is_upgrade(request)) {
-      const std::string origin(request[http::field::origin]);
-      const bool origin_ok =
-          origin.empty() || (core_.loopback ? loopbackHost(hostOf(origin)) : hostOf(origin) == hostOf(host));
+      const bool origin_ok = originAllowed(request[http::field::origin], host, core_.loopback);
       if (target.substr(0, target.find('?')) != "/api/stream" || !origin_ok) {
         reply(errorResponse(origin_ok ? 404 : 403,
-                            origin_ok ? "the stream is at /api/stream" : "WebSocket from another site refused"),
+                            origin_ok ? "the stream is at /api/stream"
+                                      : "WebSocket refused: its Origin is not this server's page (http(s), the "
+                                        "host and port this request was sent to)"),
               request.version(), false, false);
         return true;
       }

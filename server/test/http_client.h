@@ -144,11 +144,13 @@ inline Response request(std::uint16_t port, const std::string& method, const std
 /// A WebSocket client (RFC 6455), text messages only.
 class WebSocket {
  public:
-  /// Connects to ws://127.0.0.1:port/target; `status` is the handshake's HTTP status.
-  WebSocket(std::uint16_t port, const std::string& target = "/api/stream", const std::string& origin = {})
+  /// Connects to ws://127.0.0.1:port/target (saying `host` in Host, `origin` in Origin when not
+  /// empty); `status` is the handshake's HTTP status.
+  WebSocket(std::uint16_t port, const std::string& target = "/api/stream", const std::string& origin = {},
+            const std::string& host = "127.0.0.1")
       : socket_(port) {
-    std::string text = "GET " + target +
-                       " HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+    std::string text = "GET " + target + " HTTP/1.1\r\nHost: " + host +
+                       "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
                        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n";
     if (!origin.empty()) {
       text += "Origin: " + origin + "\r\n";

@@ -97,8 +97,62 @@ TEST_F(HttpTest, AnswersMalformedRequestsWith400) {
 }
 
 TEST_F(HttpTest, RefusesOtherHostsOnLoopback) {
-  EXPECT_EQ(testing::request(port(), "GET", "/api/info", {}, {}, "evil.example.com").status, 421);
-  EXPECT_EQ(testing::request(port(), "GET", "/api/info", {}, {}, "localhost:8080").status, 200);
+  // Issue 27: any Host starting with "127." passed (a DNS-rebinding site's name can). Only a
+  // loopback literal or localhost, with an optional port.
+  struct Case {
+    std::string host;
+    int status;
+  };
+  const std::string own = std::to_string(port());
+  const std::vector<Case> cases = {
+      {"127.0.0.1", 200},
+      {"127.0.0.1:" + own, 200},
+      {"localhost", 200},
+      {"LocalHost:8080", 200},
+      {"127.1.2.3:1", 200},
+      {"127.255.255.254:65535", 200},
+      {"[::1]", 200},
+      {"[::1]:" + own, 200},
+      {"[0:0:0:0:0:0:0:1]:80", 200},
+      {"evil.example.com", 421},
+      {"127.attacker.example", 421},
+      {"127.0.0.1.nip.io", 421},
+      {"127.0.0.1.nip", 421},
+      {"127.0.0.1evil", 421},
+      {"127.0.0.1evil:" + own, 421},
+      {"[::1].evil.com", 421},
+      {"[::1]evil", 421},
+      {"[::1]:", 421},
+      {"[::1", 421},
+      {"[::1%lo]", 421},
+      {"[::ffff:127.0.0.1]", 421},
+      {"[::2]", 421},
+      {"localhost.evil.com", 421},
+      {"localhost.", 421},
+      {"localhostevil", 421},
+      {"127.0.0.1:", 421},
+      {"127.0.0.1:0", 421},
+      {"127.0.0.1:65536", 421},
+      {"127.0.0.1:99999999999", 421},
+      {"127.0.0.1:80:80", 421},
+      {"127.0.0.1:8o", 421},
+      {"127.00.0.1", 421},
+      {"0177.0.0.1", 421},
+      {"127.1", 421},
+      {"127.0.0.256", 421},
+      {"127.0.0.1.", 421},
+      {"user@127.0.0.1", 421},
+      {"128.0.0.1", 421},
+      {"0.0.0.0", 421},
+      {"", 421},
+  };
+  for (const Case& c : cases) {
+    const testing::Response response = testing::request(port(), "GET", "/api/info", {}, {}, c.host);
+    EXPECT_EQ(response.status, c.status) << "Host: " << c.host;
+    if (c.status == 421) {
+      EXPECT_NE(response.body.find("whose Host is localhost, 127.x.y.z or [::1]"), std::string::npos) << response.body;
+    }
+  }
 }
 
 TEST_F(HttpTest, StaticFilesStayInsideTheWebRoot) {
@@ -201,9 +255,55 @@ TEST_F(HttpTest, StreamShowsARunAndStopHaltsIt) {
 }
 
 TEST_F(HttpTest, RefusesWebSocketsFromOtherSites) {
-  EXPECT_EQ(WebSocket(port(), "/api/stream", "http://evil.example.com").status, 403);
+  // Issue 27: any Origin whose host started with "127." opened the stream, and so did a page on
+  // another port of this machine. Only the page's own origin does now.
+  struct Case {
+    std::string origin;
+    std::string host;
+    int status;
+  };
+  const std::string own = std::to_string(port());
+  const std::string here = "127.0.0.1:" + own;
+  const std::vector<Case> cases = {
+      {"", here, 101},  // not a browser
+      {"http://127.0.0.1:" + own, here, 101},
+      {"HTTP://127.0.0.1:" + own, here, 101},
+      {"https://127.0.0.1:" + own, here, 101},
+      {"http://localhost:" + own, "localhost:" + own, 101},
+      {"http://[::1]:" + own, "[::1]:" + own, 101},
+      {"http://127.0.0.1", "127.0.0.1", 101},            // both on port 80
+      {"https://127.0.0.1", "127.0.0.1:443", 101},       // both on port 443
+      {"http://localhost:5173", "localhost:5173", 101},  // the page's development server, a proxy
+      {"http://localhost:5173", here, 403},              // another port of this machine
+      {"http://127.0.0.1:5173", here, 403},
+      {"http://127.0.0.1", here, 403},
+      {"http://localhost:" + own, here, 403},  // another origin, though the same machine
+      {"http://evil.example.com", here, 403},
+      {"http://127.evil.example:" + own, here, 403},
+      {"http://127.0.0.1.nip.io:" + own, here, 403},
+      {"http://127.0.0.1evil:" + own, here, 403},
+      {"http://[::1].evil.com:" + own, here, 403},
+      {"http://127.0.0.1:" + own + "/", here, 403},
+      {"http://127.0.0.1:" + own + "@evil.example.com", here, 403},
+      {"ws://127.0.0.1:" + own, here, 403},
+      {"file://", here, 403},
+      {"null", here, 403},
+      {"127.0.0.1:" + own, here, 403},
+  };
+  for (const Case& c : cases) {
+    EXPECT_EQ(WebSocket(port(), "/api/stream", c.origin, c.host).status, c.status)
+        << "Origin: " << c.origin << ", Host: " << c.host;
+  }
   EXPECT_EQ(WebSocket(port(), "/api/other").status, 404);
-  EXPECT_EQ(WebSocket(port(), "/api/stream", "http://localhost:5173").status, 101);
+  const testing::Response refused = [&] {
+    testing::Socket socket(port());
+    socket.send("GET /api/stream HTTP/1.1\r\nHost: " + here +
+                "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                "Sec-WebSocket-Version: 13\r\nOrigin: http://127.evil.example\r\n\r\n");
+    std::string pending;
+    return testing::readResponse(socket, pending);
+  }();
+  EXPECT_NE(refused.body.find("its Origin is not this server's page"), std::string::npos) << refused.body;
 }
 
 }  // namespace
