@@ -178,6 +178,52 @@ json runJson(const RunRecord& run) {
   return out;
 }
 
+/// Which transitions of a run log a request asks for: `from` (a seq, default 1) and `limit`
+/// (default and most ApiOptions::run_page_transitions), and at most kRunPageBytes of their
+/// text, so that a read of any log is bounded in time and memory (issue 27: one answer of a
+/// 120,000-transition log took 7 s of CPU and hundreds of MB).
+constexpr std::size_t kRunPageBytes = 4u << 20;
+
+TransitionPage transitionPage(const Target& target, std::size_t most) {
+  TransitionPage page;
+  page.limit = most;
+  page.max_bytes = kRunPageBytes;
+  if (const auto it = target.query.find("from"); it != target.query.end()) {
+    const auto value = parseLong(it->second);
+    if (!value || *value < 1) {
+      throw RequestError(400, "from must be a transition's seq: 1 or more");
+    }
+    page.from = static_cast<std::uint64_t>(*value);
+  }
+  if (const auto it = target.query.find("limit"); it != target.query.end()) {
+    const auto value = parseLong(it->second);
+    if (!value || *value < 1 || *value > static_cast<long long>(most)) {
+      throw RequestError(400, "limit must be 1 to " + std::to_string(most));
+    }
+    page.limit = static_cast<std::size_t>(*value);
+  }
+  return page;
+}
+
+/// A page of transitions: `transition_list`, and `next_from` (the seq to ask for next, null
+/// after the last).
+void addTransitions(json& out, const RunLog& log) {
+  json transitions = json::array();
+  for (const TransitionRecord& t : log.transitions) {
+    json item = {{"seq", t.seq}, {"t", t.t}, {"uid", t.uid}, {"from", t.from}, {"to", t.to}};
+    if (!t.reason.empty()) {
+      item["reason"] = t.reason;
+      item["origin"] = t.origin;
+    }
+    if (!t.data.empty()) {
+      item["data"] = json::parse(t.data, nullptr, false);
+    }
+    transitions.push_back(std::move(item));
+  }
+  out["transition_list"] = std::move(transitions);
+  out["next_from"] = log.next_seq ? json(*log.next_seq) : json(nullptr);
+}
+
 json runLogJson(const RunLog& log) {
   json out = runJson(log.run);
   out["xml"] = log.run.xml;
@@ -192,19 +238,7 @@ json runLogJson(const RunLog& log) {
         {{"uid", node.uid}, {"parent", node.parent}, {"id", node.id}, {"name", node.name}, {"path", node.path}});
   }
   out["nodes"] = std::move(nodes);
-  json transitions = json::array();
-  for (const TransitionRecord& t : log.transitions) {
-    json item = {{"seq", t.seq}, {"t", t.t}, {"uid", t.uid}, {"from", t.from}, {"to", t.to}};
-    if (!t.reason.empty()) {
-      item["reason"] = t.reason;
-      item["origin"] = t.origin;
-    }
-    if (!t.data.empty()) {
-      item["data"] = json::parse(t.data, nullptr, false);
-    }
-    transitions.push_back(std::move(item));
-  }
-  out["transition_list"] = std::move(transitions);
+  addTransitions(out, log);
   return out;
 }
 
@@ -215,6 +249,12 @@ Api::Api(Backend& backend, Store& store, ApiOptions options)
 
 bool Api::authorized(std::string_view authorization) const {
   return sameToken(bearerToken(authorization), options_.token);
+}
+
+bool Api::isBulkRead(const HttpRequest& request) {
+  const std::string_view path = std::string_view(request.target).substr(0, request.target.find('?'));
+  return (request.method == "GET" || request.method == "HEAD") &&
+         (path == "/api/runs" || path.starts_with("/api/runs/") || path == "/api/pointcloud");
 }
 
 bool Api::tokenMatches(std::string_view token) const { return sameToken(token, options_.token); }
@@ -467,7 +507,8 @@ HttpResponse Api::route(const HttpRequest& request) {
     if (!id || *id == 0) {
       throw RequestError(400, "a run id is a nonzero integer (plan runs count up from 1, operations down from -1)");
     }
-    if (const auto log = *id > 0 ? store_.run(*id) : std::nullopt) {
+    if (const auto log =
+            *id > 0 ? store_.run(*id, transitionPage(target, options_.run_page_transitions)) : std::nullopt) {
       json out = runLogJson(*log);
       if (const auto status = backend_.runStatus(*id)) {
         out["live"] = *status;
@@ -476,6 +517,22 @@ HttpResponse Api::route(const HttpRequest& request) {
     }
     const auto status = backend_.runStatus(*id);
     return status ? jsonResponse(*status) : errorResponse(404, "no run " + std::to_string(*id));
+  }
+  if (is({"runs", "*", "transitions"})) {
+    if (!get) {
+      return wrongMethod();
+    }
+    const auto id = parseLong(s[2]);
+    if (!id || *id < 1) {
+      throw RequestError(400, "a logged run's id is a positive integer");
+    }
+    const auto log = store_.run(*id, transitionPage(target, options_.run_page_transitions), /*with_nodes=*/false);
+    if (!log) {
+      return errorResponse(404, "no logged run " + std::to_string(*id));
+    }
+    json out = {{"id", *id}, {"transitions", log->run.transitions}};
+    addTransitions(out, *log);
+    return jsonResponse(out);
   }
   if (is({"control"})) {
     if (method != "POST") {

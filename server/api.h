@@ -42,6 +42,8 @@ struct ApiOptions {
   bool test_endpoints = false;
   /// Larger bodies are refused with 413 (the HTTP layer refuses them before reading them).
   std::size_t max_body_bytes = 1u << 20;
+  /// Transitions of a run log per answer, by default and at most (GET /api/runs/ID?limit=).
+  std::size_t run_page_transitions = 5000;
 };
 
 class Api {
@@ -51,6 +53,11 @@ class Api {
 
   /// Thread-safe. Never throws: every failure is a response.
   HttpResponse handle(const HttpRequest& request);
+
+  /// Whether a request is a long read (run logs, the run list, the point cloud): the HTTP side
+  /// answers those on a thread of their own, so that they never hold up the live stream or a
+  /// command such as stop.
+  static bool isBulkRead(const HttpRequest& request);
 
   /// Whether an Authorization header value carries the token.
   bool authorized(std::string_view authorization) const;

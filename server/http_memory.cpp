@@ -9,7 +9,9 @@ namespace costar::server {
 namespace test = boost::beast::test;
 
 struct MemoryHttpServer::Impl {
-  Impl(Api& api, Backend& backend, HttpServerOptions options) : core(api, backend, std::move(options)) {}
+  Impl(Api& api, Backend& backend, HttpServerOptions options) : core(api, backend, std::move(options)) {
+    core.bulk = ioc.get_executor();  // long reads on the same thread, polled like the rest
+  }
   detail::ServerCore core;
   detail::net::io_context ioc;
 };

@@ -1,6 +1,7 @@
 #include "server/http_server.h"
 
 #include <algorithm>
+#include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 #include <fstream>
@@ -313,13 +314,19 @@ namespace beast = detail::beast;
 /// The TCP side: the acceptor, the I/O threads and the stream's timer.
 struct HttpServer::Impl {
   Impl(Api& api, Backend& backend, HttpServerOptions options)
-      : core(api, backend, std::move(options)), acceptor(ioc), timer(ioc) {}
+      : core(api, backend, std::move(options)), acceptor(ioc), timer(ioc) {
+    core.bulk = bulk_ioc.get_executor();
+  }
 
   detail::ServerCore core;
   net::io_context ioc;
   tcp::acceptor acceptor;
   net::steady_timer timer;
   std::vector<std::thread> threads;
+  // Long reads (run logs) on a thread of their own: the I/O threads stay free for the stream.
+  net::io_context bulk_ioc;
+  std::optional<net::executor_work_guard<net::io_context::executor_type>> bulk_work;
+  std::thread bulk_thread;
   std::atomic<bool> stopped{false};
   std::uint16_t port = 0;
 
@@ -403,6 +410,12 @@ HttpServer::~HttpServer() { stop(); }
 void HttpServer::start() {
   impl_->accept();
   net::post(impl_->ioc, [this] { impl_->broadcast(); });
+  impl_->bulk_work.emplace(impl_->bulk_ioc.get_executor());
+  impl_->bulk_thread = std::thread([this] {
+    prepareServerThread("reads");
+    while (!guarded("long reads thread", [this] { impl_->bulk_ioc.run(); })) {
+    }
+  });
   for (int i = 0; i < std::max(1, impl_->core.options.threads); ++i) {
     impl_->threads.emplace_back([this] {
       prepareServerThread("io");
@@ -430,6 +443,11 @@ void HttpServer::stop() {
     }
   }
   impl_->threads.clear();
+  impl_->bulk_work.reset();
+  impl_->bulk_ioc.stop();
+  if (impl_->bulk_thread.joinable()) {
+    impl_->bulk_thread.join();
+  }
 }
 
 std::uint16_t HttpServer::port() const { return impl_->port; }

@@ -4,8 +4,11 @@
 //
 // Requests are read with limits (1 MiB bodies, 8 KiB headers, 30 s per request); a body over
 // the limit is answered 413 without being read, a malformed request 400, a request whose Host
-// is not this machine 421 when listening on loopback (DNS rebinding). API requests go to
-// Api::handle on the I/O threads; nothing here touches the workcell.
+// is not this machine 421 when listening on loopback (DNS rebinding: http_session.h says which
+// Hosts and WebSocket Origins pass). API requests go to Api::handle on the I/O threads, but long
+// reads (Api::isBulkRead: run logs, read in pages, the run list, the point cloud) on a thread
+// of their own, one at a time, so that however many arrive, the stream and commands such as
+// stop are not held up. Nothing here touches the workcell.
 //
 // No exception ends a thread here: one thrown while answering a request becomes a 500 answer,
 // one thrown anywhere else (the stream, the accept loop, the broadcaster) is logged and the

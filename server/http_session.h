@@ -62,6 +62,10 @@ struct ServerCore {
   /// Listening on loopback: only requests addressed to this machine are answered.
   bool loopback = true;
   std::atomic<std::uint64_t> sent{0};
+  /// Where long reads (Api::isBulkRead) are answered: a thread of their own for TCP, so that
+  /// the I/O threads stay free for the stream and for commands; the sessions' own io_context
+  /// in memory. Set by the owner before the first session.
+  net::any_io_executor bulk;
 
   void addClient(const std::shared_ptr<StreamClient>& client);
   /// Sends what the backend has for the stream to every ready client.
@@ -322,6 +326,10 @@ class HttpSession final : public std::enable_shared_from_this<HttpSession<Stream
       api_request.target = target;
       api_request.body = std::move(request.body());
       api_request.authorization = std::string(request[http::field::authorization]);
+      if (Api::isBulkRead(api_request)) {
+        answerElsewhere(std::move(api_request), request.version(), request.keep_alive(), head);
+        return true;
+      }
       response = core_.api.handle(api_request);
       response.headers.emplace_back("Cache-Control", "no-store");
     } else if (request.method() == http::verb::get || head) {
@@ -331,6 +339,27 @@ class HttpSession final : public std::enable_shared_from_this<HttpSession<Stream
     }
     reply(std::move(response), request.version(), request.keep_alive(), head);
     return true;
+  }
+
+  /// Answers a long read on the bulk executor, then writes the answer from this session's
+  /// own executor. The session lives on in the handlers.
+  void answerElsewhere(HttpRequest api_request, unsigned version, bool keep_alive, bool head) {
+    net::post(core_.bulk, [self = this->shared_from_this(), api_request = std::move(api_request), version, keep_alive,
+                           head]() mutable {
+      auto response = std::make_shared<HttpResponse>();
+      const bool ok = guarded("HTTP long read", [&] {
+        *response = self->core_.api.handle(api_request);
+        response->headers.emplace_back("Cache-Control", "no-store");
+      });
+      if (!ok) {
+        *response = errorResponse(500, "internal error while answering the request");
+      }
+      net::post(self->stream_.get_executor(), [self, response, version, keep_alive, head] {
+        if (!guarded("HTTP answer", [&] { self->reply(std::move(*response), version, keep_alive, head); })) {
+          shutdownSend(self->stream_);
+        }
+      });
+    });
   }
 
   void reply(HttpResponse response, unsigned version, bool keep_alive, bool head) {

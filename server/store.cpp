@@ -2,6 +2,7 @@
 
 #include <sqlite3.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 
@@ -318,7 +319,7 @@ std::vector<RunRecord> Store::runs(std::size_t limit) const {
   return out;
 }
 
-std::optional<RunLog> Store::run(std::int64_t id) const {
+std::optional<RunLog> Store::run(std::int64_t id, const TransitionPage& page, bool with_nodes) const {
   const std::lock_guard lock(mutex_);
   Statement query(db_, (std::string("SELECT ") + kRunColumns + " FROM runs WHERE id = ?").c_str());
   query.bind(1, id);
@@ -327,20 +328,36 @@ std::optional<RunLog> Store::run(std::int64_t id) const {
   }
   RunLog log;
   log.run = readRun(query);
-  Statement nodes(db_, "SELECT uid, parent, id, name, path FROM run_nodes WHERE run = ? ORDER BY uid");
-  nodes.bind(1, id);
-  while (nodes.step()) {
-    log.nodes.push_back(
-        {static_cast<std::uint32_t>(nodes.integer(0)), nodes.integer(1), nodes.text(2), nodes.text(3), nodes.text(4)});
+  if (with_nodes) {
+    Statement nodes(db_, "SELECT uid, parent, id, name, path FROM run_nodes WHERE run = ? ORDER BY uid");
+    nodes.bind(1, id);
+    while (nodes.step()) {
+      log.nodes.push_back({static_cast<std::uint32_t>(nodes.integer(0)), nodes.integer(1), nodes.text(2), nodes.text(3),
+                           nodes.text(4)});
+    }
   }
+  // One row more than the page holds says where the next page starts.
   Statement transitions(db_,
                         "SELECT seq, t, uid, from_status, to_status, reason, origin, data FROM transitions "
-                        "WHERE run = ? ORDER BY seq");
-  transitions.bind(1, id);
+                        "WHERE run = ? AND seq >= ? ORDER BY seq LIMIT ?");
+  const auto clamp = [](std::uint64_t value) {
+    return static_cast<std::int64_t>(std::min<std::uint64_t>(value, std::numeric_limits<std::int64_t>::max()));
+  };
+  const std::size_t limit = std::max<std::size_t>(page.limit, 1);
+  transitions.bind(1, id).bind(2, clamp(page.from));
+  transitions.bind(3, limit == std::numeric_limits<std::size_t>::max() ? clamp(limit) : clamp(limit + 1));
+  std::size_t bytes = 0;
   while (transitions.step()) {
-    log.transitions.push_back({static_cast<std::uint64_t>(transitions.integer(0)), transitions.real(1),
-                               static_cast<std::uint32_t>(transitions.integer(2)), transitions.text(3),
-                               transitions.text(4), transitions.text(5), transitions.text(6), transitions.text(7)});
+    const auto seq = static_cast<std::uint64_t>(transitions.integer(0));
+    if (log.transitions.size() >= limit || bytes >= page.max_bytes) {
+      log.next_seq = seq;
+      break;
+    }
+    log.transitions.push_back({seq, transitions.real(1), static_cast<std::uint32_t>(transitions.integer(2)),
+                               transitions.text(3), transitions.text(4), transitions.text(5), transitions.text(6),
+                               transitions.text(7)});
+    const TransitionRecord& added = log.transitions.back();
+    bytes += added.reason.size() + added.origin.size() + added.data.size() + 64;
   }
   return log;
 }

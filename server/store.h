@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -86,7 +87,18 @@ struct TransitionRecord {
 struct RunLog {
   RunRecord run;
   std::vector<RunNode> nodes;
+  /// The transitions asked for (TransitionPage), in order.
   std::vector<TransitionRecord> transitions;
+  /// The seq of the next stored transition after them; nullopt when they were the last.
+  std::optional<std::uint64_t> next_seq;
+};
+
+/// Which transitions of a run to read: those from seq `from` on, at most `limit` of them, and
+/// no more once `max_bytes` of their text (reasons, origins, data) is reached (at least one).
+struct TransitionPage {
+  std::uint64_t from = 1;
+  std::size_t limit = std::numeric_limits<std::size_t>::max();
+  std::size_t max_bytes = std::numeric_limits<std::size_t>::max();
 };
 
 /// Thrown when the database cannot be opened or written; the message names the file.
@@ -125,7 +137,10 @@ class Store {
   void endRun(const RunRecord& record);
   /// The newest runs first.
   std::vector<RunRecord> runs(std::size_t limit = 100) const;
-  std::optional<RunLog> run(std::int64_t id) const;
+  /// A run with its nodes (unless `with_nodes` is false) and the page of its transitions asked
+  /// for (all by default). The store is locked for one page only: a long log is read in pages
+  /// while the run-log writer goes on.
+  std::optional<RunLog> run(std::int64_t id, const TransitionPage& page = {}, bool with_nodes = true) const;
   std::int64_t maxRunId() const;
 
   /// SQLite's PRAGMA integrity_check: "ok" when the database is sound.

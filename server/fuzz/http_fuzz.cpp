@@ -10,6 +10,8 @@
 // http_socket_fuzz.cpp drives the same server over loopback TCP. The bytes reach the parser
 // all at once, or 256 or 16 at a time (chosen by the input's length), as TCP may cut them.
 //
+// The store holds a run log longer than a page (run 1), so that reading logs in pages is fuzzed.
+//
 // Run: build-fuzz/server/http_fuzz -dict=server/fuzz/http.dict server/fuzz/http_corpus
 
 #include <cstdint>
@@ -17,6 +19,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "server/api.h"
 #include "server/fuzz/fuzz_backend.h"
@@ -30,6 +33,25 @@ namespace {
 
 constexpr const char* kToken = "fuzz-token-0123456789abcdef";
 
+/// Run 1, a log of three pages (GET /api/runs/1 answers it in pages: from=, limit=).
+void seedLongRunLog(server::Store& store) {
+  server::RunRecord run;
+  run.id = 1;
+  run.xml = R"(<root BTCPP_format="4"><BehaviorTree ID="m"><Repeat num_cycles="-1"><AlwaysSuccess/></Repeat>)"
+            "</BehaviorTree></root>";
+  store.beginRun(run,
+                 {{0, -1, "Repeat", "", "m/Repeat[1]"}, {1, 0, "AlwaysSuccess", "", "m/Repeat[1]/AlwaysSuccess[1]"}});
+  std::vector<server::TransitionRecord> transitions;
+  for (std::uint64_t seq = 1; seq <= 120; ++seq) {
+    transitions.push_back({seq, 0.01 * static_cast<double>(seq), static_cast<std::uint32_t>(seq % 2), "IDLE", "RUNNING",
+                           "", "", seq % 10 == 0 ? R"({"candidates":[1,2]})" : ""});
+  }
+  store.appendTransitions(1, transitions);
+  run.result = "STOPPED";
+  run.transitions = 120;
+  store.endRun(run);
+}
+
 /// The server with an in-memory store.
 struct Harness {
   server::fuzzing::FuzzBackend backend;
@@ -41,7 +63,10 @@ struct Harness {
     http.reset();
     api.reset();
     store = std::make_unique<server::Store>(":memory:");
-    api = std::make_unique<server::Api>(backend, *store, server::ApiOptions{.token = kToken, .test_endpoints = true});
+    seedLongRunLog(*store);
+    // Pages of 50 (not 5,000): a long log in few transitions, so that reading it stays cheap.
+    api = std::make_unique<server::Api>(
+        backend, *store, server::ApiOptions{.token = kToken, .test_endpoints = true, .run_page_transitions = 50});
     server::HttpServerOptions options;
     options.address = "127.0.0.1";
     options.web_root = std::filesystem::path("/nonexistent-costar-web-root");

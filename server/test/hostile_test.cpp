@@ -296,6 +296,57 @@ TEST_F(HostileTest, SurrogateReferencesAndBytesThatAreNotUtf8AreRefusedInPlans) 
       "a lone surrogate escape");
 }
 
+TEST_F(HostileTest, ALongRunLogIsReadInBoundedPages) {
+  // Issue 27: one unauthenticated GET of a 120,000-transition log took 7 s of CPU and hundreds
+  // of MB; six at once stalled the server. A log is read in pages now.
+  const std::int64_t id = 1'000'000;  // far beyond what the engine numbers runs
+  RunRecord record;
+  record.id = id;
+  record.xml = "<root BTCPP_format=\"4\"><BehaviorTree ID=\"m\"><AlwaysSuccess/></BehaviorTree></root>";
+  record.started_at = 1;
+  server_->store().beginRun(record, {{0, -1, "AlwaysSuccess", "", "m/AlwaysSuccess[1]"}});
+  std::vector<TransitionRecord> transitions;
+  for (std::uint64_t seq = 1; seq <= 12'001; ++seq) {
+    transitions.push_back({seq, 0.01 * static_cast<double>(seq), 0, "IDLE", "RUNNING", "", "", R"({"n":1})"});
+  }
+  server_->store().appendTransitions(id, transitions);
+  record.result = "SUCCESS";
+  record.transitions = 12'001;
+  server_->store().endRun(record);
+
+  const Response first = testing::request(port(), "GET", "/api/runs/" + std::to_string(id));
+  ASSERT_EQ(first.status, 200);
+  const json head = json::parse(first.body);
+  ASSERT_EQ(head["transition_list"].size(), 5000u);
+  EXPECT_EQ(head["next_from"], 5001);
+  EXPECT_EQ(head["nodes"].size(), 1u);
+  EXPECT_EQ(head["transitions"], 12'001);
+  std::uint64_t expected = 1;
+  for (const json& t : head["transition_list"]) {
+    EXPECT_EQ(t["seq"], expected++);
+  }
+  for (json next = head["next_from"]; !next.is_null();) {
+    const Response page = testing::request(
+        port(), "GET", "/api/runs/" + std::to_string(id) + "/transitions?from=" + next.dump() + "&limit=3000");
+    ASSERT_EQ(page.status, 200);
+    const json body = json::parse(page.body);
+    EXPECT_LE(body["transition_list"].size(), 3000u);
+    EXPECT_FALSE(body.contains("nodes"));
+    for (const json& t : body["transition_list"]) {
+      EXPECT_EQ(t["seq"], expected++);
+      EXPECT_EQ(t["data"]["n"], 1);
+    }
+    next = body["next_from"];
+  }
+  EXPECT_EQ(expected, 12'002u);  // every transition, once, in order
+  for (const char* bad : {"?from=0", "?from=x", "?limit=0", "?limit=5001", "?limit=-1", "?from=1&limit=1e3"}) {
+    expectClientError(testing::request(port(), "GET", "/api/runs/" + std::to_string(id) + bad), bad);
+  }
+  expectClientError(testing::request(port(), "GET", "/api/runs/abc/transitions"), "not an id");
+  expectClientError(testing::request(port(), "GET", "/api/runs/999999/transitions"), "no such run");
+  expectClientError(testing::request(port(), "POST", "/api/runs/1/transitions", "{}", token()), "not GET");
+}
+
 TEST_F(HostileTest, NoMotionWithoutTheToken) {
   const std::string body = R"({"node":"TestLog","attributes":{"message":"hi"}})";
   const std::string plan =

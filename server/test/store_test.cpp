@@ -103,6 +103,37 @@ TEST_F(StoreTest, RunLogsKeepNodesAndTransitions) {
   EXPECT_TRUE(runs[0].xml.empty());  // listings leave the text out
 }
 
+TEST_F(StoreTest, ARunLogIsReadAPageAtATime) {
+  Store store(file_);
+  RunRecord run;
+  run.id = 3;
+  run.xml = "<root/>";
+  store.beginRun(run, {{0, -1, "Sequence", "", "main/Sequence[1]"}});
+  std::vector<TransitionRecord> transitions;
+  for (std::uint64_t seq = 1; seq <= 10; ++seq) {
+    transitions.push_back({seq, 0.0, 0, "IDLE", "RUNNING", "", "", std::string(seq == 7 ? 1000 : 10, 'x')});
+  }
+  store.appendTransitions(3, transitions);
+  EXPECT_FALSE(store.run(3)->next_seq);  // all of it by default
+  EXPECT_EQ(store.run(3)->transitions.size(), 10u);
+  const auto first = store.run(3, {.from = 1, .limit = 4});
+  ASSERT_EQ(first->transitions.size(), 4u);
+  EXPECT_EQ(first->transitions.front().seq, 1u);
+  EXPECT_EQ(first->next_seq, 5u);
+  EXPECT_EQ(first->nodes.size(), 1u);
+  const auto last = store.run(3, {.from = 9, .limit = 4}, /*with_nodes=*/false);
+  ASSERT_EQ(last->transitions.size(), 2u);
+  EXPECT_EQ(last->transitions.back().seq, 10u);
+  EXPECT_FALSE(last->next_seq);
+  EXPECT_TRUE(last->nodes.empty());
+  // The byte limit ends a page after the transition that reaches it (at least one).
+  const auto by_bytes = store.run(3, {.from = 5, .max_bytes = 500});
+  ASSERT_EQ(by_bytes->transitions.size(), 3u);  // 5, 6 and 7 (1,000 bytes of data)
+  EXPECT_EQ(by_bytes->next_seq, 8u);
+  EXPECT_EQ(store.run(3, {.from = 7, .max_bytes = 1})->transitions.size(), 1u);
+  EXPECT_TRUE(store.run(3, {.from = 11})->transitions.empty());
+}
+
 TEST_F(StoreTest, RunsLeftOpenByADeadServerAreMarkedInterrupted) {
   {
     Store store(file_);

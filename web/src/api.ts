@@ -102,6 +102,8 @@ export interface RunLog extends StoredRun {
   plan_json: PlanJson | null;
   nodes: RunNode[];
   transition_list: Transition[];
+  /** The seq of the next page of transitions; null after the last. */
+  next_from?: number | null;
 }
 
 export interface Diagnostic {
@@ -177,7 +179,19 @@ export class Api {
     this.request<{ run: number }>('POST', '/api/operations', { node, attributes });
   runStatus = (id: number) => this.request<RunInfo>('GET', `/api/runs/${id}`);
   runs = () => this.request<StoredRun[]>('GET', '/api/runs');
-  runLog = (id: number) => this.request<RunLog>('GET', `/api/runs/${id}`);
+  /** A logged run with every transition: the server answers a long log in pages. */
+  runLog = async (id: number) => {
+    const log = await this.request<RunLog>('GET', `/api/runs/${id}`);
+    for (let from = log.next_from; from != null; ) {
+      const page = await this.request<{ transition_list: Transition[]; next_from: number | null }>(
+        'GET',
+        `/api/runs/${id}/transitions?from=${from}`,
+      );
+      log.transition_list.push(...page.transition_list);
+      from = page.next_from;
+    }
+    return log;
+  };
   pointCloud = (max = 20000) =>
     this.request<{ points: number[]; colors: number[]; t?: number }>('GET', `/api/pointcloud?max=${max}`);
 }
