@@ -255,6 +255,8 @@ AdaptiveGripper::AdaptiveGripper(AdaptiveGripperDriver& driver, const Clock& clo
                     {}},
                    [this, m](const component::ParamMap&) { return setMode(m); });
   }
+  declared.symbols = {{"gripper_fingers", world::SymbolKind::kJoints,
+                       "the fingers' reading: each finger's position (0 open .. 1 closed), finger_middle first"}};
   declared.predicates = {
       {"gripper_open", 0, "every finger is fully open"},
       {"gripper_closed", 0, "the fingers of the current mode are fully closed, nothing between them"},
@@ -287,6 +289,12 @@ world::Report AdaptiveGripper::report() const {
   // A reading that cannot be trusted makes the report throw: the registry then stops the cell.
   const AdaptiveGripperReading reading = checkedRead();
   world::Report report;
+  world::JointsValue fingers;
+  for (std::size_t i = 0; i < reading.fingers.size(); ++i) {
+    fingers.joint_names.emplace_back(kFingerNames[i]);
+    fingers.positions.push_back(reading.fingers[i].position);
+  }
+  report.symbols.push_back({"gripper_fingers", "", clock_.now(), std::move(fingers), std::nullopt});
   const auto& closing = gripper_.mode(reading.mode).closing;
   bool open = true;
   bool closed = true;

@@ -148,19 +148,42 @@ ParallelGripper::ParallelGripper(GripperDriver& driver, const Clock& clock, Para
                    return std::make_unique<FingerMotion>(*this, driver_, clock_, 0.0, params.at("speed").asDouble(),
                                                          params.at("force").asDouble(), options_.timeout, true);
                  });
-  operations.add({"BasicMode", "Selects Basic mode (3-finger grippers only).", {}},
+  // Check (plan validation) refuses them before a run, with the same reason (the node's type
+  // leads the message already).
+  const std::string only_pinch = "a parallel 2-finger gripper has only Pinch mode (this cell's gripper)";
+  operations.add({"BasicMode",
+                  "Selects Basic mode (3-finger grippers only).",
+                  {},
+                  component::OperationKind::kRobotAction,
+                  [only_pinch](const Params&) { return only_pinch; }},
                  [mode_change](const Params&) { return mode_change("BasicMode", false); });
   operations.add({"PinchMode", "Selects Pinch mode, the only mode of a parallel gripper.", {}},
                  [mode_change](const Params&) { return mode_change("PinchMode", true); });
-  operations.add({"WideMode", "Selects Wide mode (3-finger grippers only).", {}},
+  operations.add({"WideMode",
+                  "Selects Wide mode (3-finger grippers only).",
+                  {},
+                  component::OperationKind::kRobotAction,
+                  [only_pinch](const Params&) { return only_pinch; }},
                  [mode_change](const Params&) { return mode_change("WideMode", false); });
-  operations.add({"ScissorMode", "Selects Scissor mode (3-finger grippers only).", {}},
+  operations.add({"ScissorMode",
+                  "Selects Scissor mode (3-finger grippers only).",
+                  {},
+                  component::OperationKind::kRobotAction,
+                  [only_pinch](const Params&) { return only_pinch; }},
                  [mode_change](const Params&) { return mode_change("ScissorMode", false); });
-  operations.add({"SetMode", "Selects a mode by name: pinch, the only mode of a parallel gripper.", {mode}},
+  operations.add({"SetMode",
+                  "Selects a mode by name: pinch, the only mode of a parallel gripper.",
+                  {mode},
+                  component::OperationKind::kRobotAction,
+                  [only_pinch](const Params& params) {
+                    const std::string chosen = params.at("mode").asString();
+                    return chosen == "pinch" ? std::string() : "mode '" + chosen + "': " + only_pinch;
+                  }},
                  [mode_change](const Params& params) {
                    const std::string chosen = params.at("mode").asString();
                    return mode_change("SetMode(" + chosen + ")", chosen == "pinch");
                  });
+  description.symbols = {{"gripper_fingers", world::SymbolKind::kJoints, "the fingers' reading: their opening (m)"}};
   description.predicates = {{"gripper_open", 0, "the fingers are fully open"},
                             {"gripper_closed", 0, "the fingers are fully closed, nothing between them"},
                             {"gripper_holding", 0, "the fingers stopped on something and squeeze it"},
@@ -180,6 +203,8 @@ world::Report ParallelGripper::report() const {
   // A reading that cannot be trusted makes the report throw: the registry then stops the cell.
   const FingerReading reading = checkedRead();
   world::Report report;
+  report.symbols.push_back(
+      {"gripper_fingers", "", clock_.now(), world::JointsValue{{"opening"}, {reading.opening}}, std::nullopt});
   if (reading.opening >= driver_.maxOpening() - kOpenMargin) {
     report.predicates.push_back({"gripper_open", {}, true, ""});
   }

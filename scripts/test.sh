@@ -77,10 +77,13 @@ if [[ "$FUZZ_RUNS" -gt 0 ]]; then
 fi
 
 # The task editor's page (web/): Vitest unit tests, the production build, then the end-to-end
-# test in Debian's Chromium (headless, driven by playwright-core): the paper's structure
-# assembly built by clicks and keys (at most 30 UI actions), saved, run in the simulated cell,
-# judged from the simulator's true state; screenshots at 1600x1000 and 1280x800.
-# EDITOR_E2E=0 skips the browser test.
+# tests in Debian's Chromium (headless, driven by playwright-core): the paper's three tasks built
+# by clicks and keys, every UI action counted, saved, run in the simulated cell and judged from
+# the simulator's true state (assemble_by_clicks, paper_tasks); the editor as the cell's control
+# panel (control_panel: reload and stop, a second browser, pause, a renamed waypoint, versions,
+# Check, Reset scene, disconnection); every cell drawn as it is (cells). Screenshots and the
+# figures (action counts, readability, drawn tool against the endpoint) in build/test-artifacts.
+# EDITOR_E2E=0 skips the browser tests.
 echo
 echo "test: the editor's page (npm ci, Vitest, vite build)"
 (cd web && npm ci --no-audit --no-fund --loglevel=error && npm test && npm run build)
@@ -96,7 +99,9 @@ if [[ "${EDITOR_E2E:-1}" != "0" ]]; then
   fi
   echo
   echo "test: the editor end to end in Chromium (artifacts in $BUILD_DIR/test-artifacts)"
-  node web/e2e/assemble_by_clicks.mjs --costar "$BUILD_DIR/cli/costar" --artifacts "$BUILD_DIR/test-artifacts"
+  for e2e in assemble_by_clicks paper_tasks control_panel cells; do
+    node "web/e2e/$e2e.mjs" --costar "$BUILD_DIR/cli/costar" --artifacts "$BUILD_DIR/test-artifacts"
+  done
 fi
 echo
 echo "test: all passed in $(( $(date +%s) - start )) s"

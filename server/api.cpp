@@ -130,9 +130,14 @@ ParsedPlan planFromBody(const json& body, const std::string& label) {
   return out;
 }
 
-HttpResponse invalidPlan(const std::vector<bt::Diagnostic>& diagnostics, const bt::PlanFile& file) {
-  const std::string first = diagnostics.empty() ? "the plan cannot be read" : diagnostics.front().str();
-  json body = {{"error", std::to_string(diagnostics.size()) + " problem(s) in the plan: " + first},
+/// How messages name a plan: by its saved name, not the file the server reads it from.
+std::string planLabel(const std::string& name) { return name.empty() ? "this plan" : "plan '" + name + "'"; }
+
+HttpResponse invalidPlan(const std::vector<bt::Diagnostic>& diagnostics, const bt::PlanFile& file,
+                         const std::string& name = {}) {
+  const std::string first = diagnostics.empty() ? "it cannot be read" : diagnostics.front().message;
+  const std::string count = diagnostics.size() == 1 ? "1 problem" : std::to_string(diagnostics.size()) + " problems";
+  json body = {{"error", planLabel(name) + " has " + count + ": " + first},
                {"diagnostics", diagnosticsToJson(diagnostics, file)}};
   return jsonResponse(body, 422);
 }
@@ -140,10 +145,11 @@ HttpResponse invalidPlan(const std::vector<bt::Diagnostic>& diagnostics, const b
 /// Starts a run: 202 with its id, 422 with the plan's problems, or the backend's refusal.
 HttpResponse startRun(Backend& backend, RunRequest run) {
   const bt::PlanFile file = run.plan.file;
+  const std::string name = run.plan_name;
   const StartResult started = backend.start(std::move(run));
   if (!started.started()) {
     if (!started.diagnostics.empty()) {
-      return invalidPlan(started.diagnostics, file);
+      return invalidPlan(started.diagnostics, file, name);
     }
     return errorResponse(started.status != 0 ? started.status : 409, started.error);
   }
@@ -165,6 +171,7 @@ json runJson(const RunRecord& run) {
   json out = {{"id", run.id},
               {"plan", run.plan},
               {"version", run.version},
+              {"workcell", run.workcell},
               {"started_at", run.started_at},
               {"result", run.result},
               {"ended_at", run.ended_at},
@@ -277,9 +284,10 @@ HttpResponse Api::answer(const HttpRequest& request) {
     }
     const bool read = request.method == "GET" || request.method == "HEAD";
     if ((!read || options_.reads_need_token) && !authorized(request.authorization)) {
-      return errorResponse(401, read ? "this server needs the token for every request (it listens beyond loopback)"
-                                     : "changes and motions need 'Authorization: Bearer <token>' (the token "
-                                       "`costar serve` printed or wrote to its token file)");
+      return errorResponse(401, read ? "sign in: this server needs the token for everything (it listens beyond "
+                                       "this machine)"
+                                     : "sign in to change plans or move the robot (with the token `costar serve` "
+                                       "printed or wrote to its token file)");
     }
     return route(request);
   } catch (const RequestError& error) {
@@ -390,7 +398,7 @@ HttpResponse Api::route(const HttpRequest& request) {
           parsed.plan = bt::loadPlanText(parsed.xml, name + ".xml", {.follow_includes = false});
         }
         if (auto diagnostics = backend_.validate(parsed.plan); !diagnostics.empty()) {
-          return invalidPlan(diagnostics, parsed.plan.file);
+          return invalidPlan(diagnostics, parsed.plan.file, name);
         }
         const int version = store_.save(kind, name, parsed.xml);
         return jsonResponse({{"name", name}, {"version", version}}, 201);
@@ -428,12 +436,36 @@ HttpResponse Api::route(const HttpRequest& request) {
     return errorResponse(404, "no such endpoint");
   }
 
+  if (is({"robot"})) {
+    if (!get) {
+      return wrongMethod();
+    }
+    const auto robot = backend_.robot();
+    return robot ? jsonResponse(*robot) : errorResponse(404, "this cell has no robot to draw");
+  }
+  if (is({"scene", "reset"})) {
+    if (method != "POST") {
+      return wrongMethod();
+    }
+    const StartResult reset = backend_.resetScene();
+    return reset.status == 0 ? jsonResponse({{"reset", true}}) : errorResponse(reset.status, reset.error);
+  }
+
   if (is({"validate"})) {
     if (method != "POST") {
       return wrongMethod();
     }
-    const ParsedPlan parsed = planFromBody(body(), "plan.xml");
-    const auto diagnostics = backend_.validate(parsed.plan);
+    // "name": the plan's name in messages (optional; the page sends the name it has).
+    const json request_body = body();
+    std::string label = "plan";
+    if (request_body.is_object()) {
+      if (const auto it = request_body.find("name");
+          it != request_body.end() && it->is_string() && checkName(it->get_ref<const std::string&>()).empty()) {
+        label = it->get<std::string>();
+      }
+    }
+    const ParsedPlan parsed = planFromBody(request_body, label);
+    const auto diagnostics = backend_.checkForCell(parsed.plan);
     return jsonResponse({{"valid", diagnostics.empty()},
                          {"diagnostics", diagnosticsToJson(diagnostics, parsed.plan.file)},
                          {"xml", parsed.xml},
@@ -494,6 +526,27 @@ HttpResponse Api::route(const HttpRequest& request) {
       run.start_paused = it->get<bool>();
     }
     return startRun(backend_, std::move(run));
+  }
+  if (is({"runs", "*", "states"})) {
+    if (!get) {
+      return wrongMethod();
+    }
+    const auto id = parseLong(s[2]);
+    if (!id || *id <= 0) {
+      throw RequestError(400, "a logged run's id is a positive integer");
+    }
+    const std::vector<StateRecord> records = store_.runStates(*id);
+    if (records.empty() && !store_.run(*id)) {
+      return errorResponse(404, "no run " + std::to_string(*id));
+    }
+    json states = json::array();
+    for (const StateRecord& state : records) {
+      json snapshot = json::parse(state.state, nullptr, false);
+      if (!snapshot.is_discarded()) {
+        states.push_back({{"t", state.t}, {"state", std::move(snapshot)}});
+      }
+    }
+    return jsonResponse({{"run", *id}, {"states", std::move(states)}});
   }
   if (is({"runs", "*"})) {
     if (!get) {

@@ -56,8 +56,12 @@ class Backend {
   /// What the system knows now, for the editor's lists: waypoints, frames, object classes,
   /// predicates (name, arity), grasps per class.
   virtual nlohmann::json choices() = 0;
-  /// Every problem of a plan against the workcell's node types.
+  /// Every problem of a plan against the workcell's node types (what saving refuses).
   virtual std::vector<bt::Diagnostic> validate(const bt::Plan& plan) = 0;
+  /// validate() and what the plan names that the cell does not know now (a waypoint renamed
+  /// or deleted, a frame that is gone): what Check shows and a run refuses. A plan saved today
+  /// may name a waypoint taught tomorrow, so saving does not refuse these.
+  virtual std::vector<bt::Diagnostic> checkForCell(const bt::Plan& plan) { return validate(plan); }
   /// Starts a run unless one is active (409) or the plan is invalid (422).
   virtual StartResult start(RunRequest request) = 0;
   /// Pause, resume, single step or stop the active run (stop halts it, which cancels its
@@ -72,6 +76,19 @@ class Backend {
   virtual std::optional<nlohmann::json> groundTruth() = 0;
   /// Points seen by the cell's RGB-D camera, in the world frame (nullopt without one).
   virtual std::optional<nlohmann::json> pointCloud(std::size_t max_points) = 0;
+  /// The cell's robot as the editor draws it: the URDF the planner reads (the arm's with the
+  /// gripper's mounted on its flange), where it stands, its joints and its gripper (nullopt
+  /// for a cell without a robot).
+  virtual std::optional<nlohmann::json> robot() { return std::nullopt; }
+  /// Simulated cells: builds the scene afresh from its file and seed, the arm at home. Status 0
+  /// when done; refused (409) while a run or an operation is active, 404 for a cell without a
+  /// scene.
+  virtual StartResult resetScene() {
+    StartResult refused;
+    refused.status = 404;
+    refused.error = "this cell has no simulated scene to reset";
+    return refused;
+  }
 
   // --- the live stream (the WebSocket of http_server.cpp) ------------------------------------
   /// The messages since the last call, in order (JSON texts). One caller (the broadcaster).

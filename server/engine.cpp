@@ -9,12 +9,18 @@
 #include "bt/builder.h"
 #include "component/nodes.h"
 #include "server/guard.h"
+#include "server/plan_json.h"
 #include "workcell/workcell.h"
 
 namespace costar::server {
 
+Engine::Engine(std::unique_ptr<workcell::Workcell> cell, Store* store, EngineOptions options)
+    : Engine(*cell, store, std::move(options)) {
+  owned_cell_ = std::move(cell);
+}
+
 Engine::Engine(workcell::Workcell& cell, Store* store, EngineOptions options)
-    : cell_(cell), store_(store), options_(std::move(options)) {
+    : cell_(&cell), store_(store), options_(std::move(options)) {
   const double pace = options_.pace;
   pacer_.setFactor(pace > 0 ? pace : 1.0);
   if (store_ != nullptr) {
@@ -109,7 +115,7 @@ void Engine::loop() {
     }
     try {
       hook(false);
-      Clock& clock = cell_.clock();
+      Clock& clock = cell_->clock();
       clock.sleepUntil(clock.now() + options_.tick_period);
     } catch (const std::exception& error) {
       // A component that fails while idle must not take the server down: note it, go on.
@@ -132,7 +138,7 @@ void Engine::hook(bool running) {
     }
     pacer_.setFactor(running && pace <= 0 ? 0.0 : (pace > 0 ? pace : 1.0));
   }
-  cell_.beforeTick();
+  cell_->beforeTick();
   const auto now = std::chrono::steady_clock::now();
   if (now >= next_snapshot_) {
     takeSnapshot();
@@ -145,8 +151,8 @@ void Engine::hook(bool running) {
     const std::lock_guard lock(mutex_);
     ++stats_.ticks;
   }
-  if (cell_.clock().simulated()) {
-    const auto delay = pacer_.delay(cell_.clock().now(), std::chrono::steady_clock::now());
+  if (cell_->clock().simulated()) {
+    const auto delay = pacer_.delay(cell_->clock().now(), std::chrono::steady_clock::now());
     if (delay > std::chrono::steady_clock::duration::zero()) {
       waitWall(delay);
       const std::lock_guard lock(mutex_);
@@ -165,28 +171,16 @@ void Engine::executePending() {
   tree.addObserver(observer_.get());
   bt::ExecutorOptions executor_options;
   executor_options.tick_period = options_.tick_period;
-  bt::Executor executor(tree, cell_.clock(), executor_options);
-  if (start_paused_) {
-    executor.pause();
-    paused_ = true;
-  }
-  executor.setBeforeTick([this, &executor] {
+  bt::Executor executor(tree, cell_->clock(), executor_options);
+  paused_ = start_paused_;
+  next_logged_state_ = cell_->clock().now();
+  executor.setBeforeTick([this, &executor, &run] {
     hook(true);
-    if (stop_requested_.exchange(false)) {
-      executor.requestStop();
+    logState(*run);
+    if (applyControls(executor)) {
+      return;
     }
-    if (const int pause = pause_requested_.exchange(0); pause > 0) {
-      executor.pause();
-    } else if (pause < 0) {
-      executor.resume();
-    }
-    if (const int steps = steps_requested_.exchange(0); steps > 0) {
-      executor.pause();
-      for (int i = 0; i < steps; ++i) {
-        executor.step();
-      }
-    }
-    paused_ = executor.paused();
+    holdWhilePaused(executor);
   });
   pacer_.setFactor(options_.pace);
 
@@ -207,6 +201,9 @@ void Engine::executePending() {
   tree.removeObserver(observer_.get());
   observer_.reset();
   pacer_.setFactor(options_.pace > 0 ? options_.pace : 1.0);
+  cell_->beforeTick();
+  next_logged_state_ = TimePoint::min();  // the cell as the run left it
+  logState(*run);
 
   RunRecord record;
   {
@@ -249,8 +246,77 @@ void Engine::executePending() {
     end.record = std::move(record);
     pushLog(std::move(end));
   }
-  cell_.beforeTick();
+  cell_->beforeTick();
   takeSnapshot();
+}
+
+bool Engine::applyControls(bt::Executor& executor) {
+  if (stop_requested_.exchange(false)) {
+    executor.requestStop();
+    paused_ = false;
+    return true;
+  }
+  if (const int pause = pause_requested_.exchange(0); pause != 0) {
+    paused_ = pause > 0;
+  }
+  if (steps_requested_.load() > 0) {
+    paused_ = true;  // a step while running pauses after it
+  }
+  return false;
+}
+
+void Engine::holdWhilePaused(bt::Executor& executor) {
+  if (!paused_) {
+    return;
+  }
+  bool held = false;
+  while (true) {
+    if (steps_requested_.load() > 0) {
+      --steps_requested_;  // this tick; the executor then lets one tick period pass
+      break;
+    }
+    // The clock stands still: a wall-clock period of waiting (answering the network), the
+    // world refreshed and shown as it is.
+    held = true;
+    waitWall(options_.tick_period);
+    cell_->beforeTick();
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= next_snapshot_) {
+      takeSnapshot();
+      next_snapshot_ = now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                 std::chrono::duration<double>(1.0 / std::max(1.0, options_.stream_hz)));
+    }
+    {
+      const std::lock_guard lock(mutex_);
+      ++stats_.ticks;
+    }
+    if (applyControls(executor) || !paused_ || stopping_) {
+      break;
+    }
+  }
+  if (held) {
+    pacer_.reset();  // the clock stood still on purpose: no burst to catch up
+  }
+}
+
+void Engine::logState(const RunState& run) {
+  if (run.operation || store_ == nullptr || options_.logged_state_hz <= 0) {
+    return;
+  }
+  const TimePoint now = cell_->clock().now();
+  if (now < next_logged_state_) {
+    return;
+  }
+  next_logged_state_ = now + fromSeconds(1.0 / options_.logged_state_hz);
+  json state = buildState();
+  state.erase("waypoints");
+  state.erase("frames");
+  StateRecord record;
+  record.t = toSeconds(now - run.start_time);
+  record.state = state.dump(-1, ' ', false, json::error_handler_t::replace);
+  const std::lock_guard lock(log_mutex_);
+  log_pending_run_ = run.id;
+  log_pending_states_.push_back(std::move(record));
 }
 
 void Engine::onTransition(TimePoint time, const bt::TreeNode& node, bt::Status from, bt::Status to) {
@@ -318,8 +384,21 @@ void Engine::onTransition(TimePoint time, const bt::TreeNode& node, bt::Status f
   }
 }
 
+std::vector<bt::Diagnostic> Engine::problems(const bt::Plan& plan) {
+  std::vector<bt::Diagnostic> diagnostics = bt::validatePlan(plan, cell_->nodes());
+  for (bt::Diagnostic& diagnostic : checkAgainstCell(plan)) {
+    diagnostics.push_back(std::move(diagnostic));
+  }
+  return diagnostics;
+}
+
 std::vector<bt::Diagnostic> Engine::validate(const bt::Plan& plan) {
-  return call([this, copy = std::make_shared<const bt::Plan>(plan)] { return bt::validatePlan(*copy, cell_.nodes()); });
+  return call(
+      [this, copy = std::make_shared<const bt::Plan>(plan)] { return bt::validatePlan(*copy, cell_->nodes()); });
+}
+
+std::vector<bt::Diagnostic> Engine::checkForCell(const bt::Plan& plan) {
+  return call([this, copy = std::make_shared<const bt::Plan>(plan)] { return problems(*copy); });
 }
 
 StartResult Engine::start(RunRequest run_request) {
@@ -340,7 +419,7 @@ StartResult Engine::start(RunRequest run_request) {
       return out;
     }
     if (request.operation && main != nullptr) {
-      const bt::NodeSpec* spec = cell_.nodes().find(main->root.id);
+      const bt::NodeSpec* spec = cell_->nodes().find(main->root.id);
       if (spec != nullptr && spec->kind != bt::NodeKind::kAction && spec->kind != bt::NodeKind::kCondition) {
         out.status = 422;
         out.error = "an operation is one action or condition, not a " + std::string(bt::toString(spec->kind));
@@ -348,12 +427,12 @@ StartResult Engine::start(RunRequest run_request) {
       }
     }
     try {
-      if (auto diagnostics = bt::validatePlan(request.plan, cell_.nodes()); !diagnostics.empty()) {
+      if (auto diagnostics = problems(request.plan); !diagnostics.empty()) {
         out.status = 422;
         out.diagnostics = std::move(diagnostics);
         return out;
       }
-      pending_tree_.emplace(bt::buildTree(request.plan, cell_.nodes(), cell_.clock()));
+      pending_tree_.emplace(bt::buildTree(request.plan, cell_->nodes(), cell_->clock()));
     } catch (const bt::PlanError& error) {
       out.status = 422;
       out.diagnostics = error.diagnostics();
@@ -369,13 +448,17 @@ StartResult Engine::start(RunRequest run_request) {
     run->version = request.version;
     run->label = request.operation ? (main != nullptr ? main->root.id : "") : pending_tree_->mainTreeId();
     run->xml = request.xml;
+    run->workcell = cell_->name();
+    if (!request.operation) {
+      run->plan_json = planFileToJson(request.plan.file);
+    }
     for (const bt::TreeNode* node : pending_tree_->nodes()) {
       run->nodes.push_back({node->uid(),
                             node->parent() != nullptr ? static_cast<std::int64_t>(node->parent()->uid()) : -1,
                             node->id(), node->name(), node->path()});
     }
     run->statuses.resize(run->nodes.size());
-    run->start_time = cell_.clock().now();
+    run->start_time = cell_->clock().now();
     run->started_at = unixNow();
     stop_requested_ = false;
     pause_requested_ = 0;
@@ -401,12 +484,51 @@ StartResult Engine::start(RunRequest run_request) {
       begin.record.version = run->version;
       begin.record.xml = run->xml;
       begin.record.started_at = run->started_at;
+      begin.record.workcell = cell_->name();
       begin.nodes = run->nodes;
       pushLog(std::move(begin));
     }
     pending_run_ = run;
     out.run_id = run->id;
     return out;
+  });
+}
+
+StartResult Engine::resetScene() {
+  return call([this]() -> StartResult {
+    StartResult out;
+    if (!options_.make_cell || cell_->simulation() == nullptr) {
+      out.status = 404;
+      out.error = "this cell has no simulated scene to reset";
+      return out;
+    }
+    if (active_run_ != 0 || pending_tree_) {
+      out.status = 409;
+      out.error = "run " + std::to_string(active_run_.load()) + " is active: stop it before resetting the scene";
+      return out;
+    }
+    try {
+      std::unique_ptr<workcell::Workcell> fresh = options_.make_cell();
+      if (fresh->name() != cell_->name()) {
+        out.status = 500;
+        out.error = "the reset made a different cell ('" + fresh->name() + "')";
+        return out;
+      }
+      owned_cell_ = std::move(fresh);  // the old one (if the engine owned it) goes here
+      cell_ = owned_cell_.get();
+    } catch (const std::exception& error) {
+      out.status = 500;
+      out.error = std::string("the scene could not be made again: ") + error.what();
+      return out;
+    }
+    pacer_.reset();
+    cell_->beforeTick();
+    takeSnapshot();
+    {
+      const std::lock_guard lock(mutex_);
+      events_.push_back(json{{"type", "scene_reset"}, {"t", toSeconds(cell_->clock().now())}}.dump());
+    }
+    return out;  // status 0: done
   });
 }
 

@@ -13,6 +13,11 @@
 //
 // A simulated clock is paced to `pace` times real time for a person watching (0: as fast as
 // the machine allows while a plan runs; the idle loop then runs at real time).
+//
+// Pausing holds the cell: while a run is paused the engine thread does not advance the clock,
+// so a simulated cell stands still (the arm where it was, the fingers as they were) and no
+// operation's time limit runs out while nobody ticks it; a step ticks the tree once and lets one
+// tick period pass. A real clock cannot be held: there the tree is not ticked, and time goes on.
 
 #include <atomic>
 #include <condition_variable>
@@ -28,6 +33,7 @@
 #include <thread>
 #include <vector>
 
+#include "bt/executor.h"
 #include "bt/tree.h"
 #include "server/backend.h"
 #include "server/pacing.h"
@@ -55,11 +61,17 @@ struct EngineOptions {
   /// Grasp files offered as choices (read-only here; SmartMove's GraspLibrary owns them).
   std::filesystem::path grasp_defaults;
   std::filesystem::path grasp_taught;
+  /// Builds the cell afresh (its scene from its file and seed, the arm at home) for "Reset
+  /// scene"; empty: the scene cannot be reset.
+  std::function<std::unique_ptr<workcell::Workcell>()> make_cell;
+  /// Snapshots of the cell kept in a plan run's log per second of clock time (replay draws the
+  /// arm, the gripper and the parts from them); 0: none.
+  double logged_state_hz = 5.0;
 };
 
 /// Counters of the engine thread, for benchmarks and the info endpoint.
 struct EngineStats {
-  std::uint64_t ticks = 0;        // before-tick hooks run (plan ticks and idle ticks)
+  std::uint64_t ticks = 0;        // before-tick hooks run (plan ticks, idle ticks, held periods while paused)
   std::uint64_t snapshots = 0;    // state snapshots taken
   double snapshot_seconds = 0;    // wall time spent taking them
   double paced_wait_seconds = 0;  // wall time waited for the pace
@@ -70,6 +82,8 @@ class Engine final : public Backend {
  public:
   /// `cell` and `store` (may be null: nothing logged) must outlive the engine.
   Engine(workcell::Workcell& cell, Store* store, EngineOptions options = {});
+  /// The same, owning the cell.
+  Engine(std::unique_ptr<workcell::Workcell> cell, Store* store, EngineOptions options = {});
   ~Engine() override;
   Engine(const Engine&) = delete;
   Engine& operator=(const Engine&) = delete;
@@ -85,12 +99,15 @@ class Engine final : public Backend {
   const std::string& nodesJson() override { return nodes_json_; }
   nlohmann::json choices() override;
   std::vector<bt::Diagnostic> validate(const bt::Plan& plan) override;
+  std::vector<bt::Diagnostic> checkForCell(const bt::Plan& plan) override;
   StartResult start(RunRequest request) override;
   bool control(RunControl control) override;
   nlohmann::json state() override;
   std::optional<nlohmann::json> runStatus(std::optional<std::int64_t> id) override;
   std::optional<nlohmann::json> groundTruth() override;
   std::optional<nlohmann::json> pointCloud(std::size_t max_points) override;
+  std::optional<nlohmann::json> robot() override;
+  StartResult resetScene() override;
 
   // --- the live stream ----------------------------------------------------------------------
   /// The messages since the last call, in order: run_started, statuses (each changed node's
@@ -122,9 +139,21 @@ class Engine final : public Backend {
 
   /// The palette (GET /api/nodes) and the workcell's info, built once (engine_lists.cpp).
   void describeNodes();
+  /// What a plan names that the cell does not know now: waypoints (unless the plan teaches
+  /// them), frames (unless it detects parts first), object classes (engine thread).
+  std::vector<bt::Diagnostic> checkAgainstCell(const bt::Plan& plan);
+  /// Every problem of a plan for this cell: the plan's own, then checkAgainstCell (engine thread).
+  std::vector<bt::Diagnostic> problems(const bt::Plan& plan);
   void loop();
   void runTasks();
   void hook(bool running);
+  /// Applies stop, pause and resume requests to a run; true when it is to stop.
+  bool applyControls(bt::Executor& executor);
+  /// Holds a paused run (the clock stands still) until it resumes, a step is asked for (then
+  /// true: tick once) or it is stopped.
+  void holdWhilePaused(bt::Executor& executor);
+  /// Keeps a snapshot of the cell in the run's log when one is due (clock time).
+  void logState(const RunState& run);
   void waitWall(std::chrono::steady_clock::duration duration);
   void executePending();
   void takeSnapshot();
@@ -134,8 +163,11 @@ class Engine final : public Backend {
   nlohmann::json statusesJson(RunState& run, bool all);
   void logWriterLoop();
   void pushLog(LogCommand command);
+  /// Moves the pending transitions and snapshots to the writer's queue (log_mutex_ held).
+  void queuePending();
 
-  workcell::Workcell& cell_;
+  std::unique_ptr<workcell::Workcell> owned_cell_;  // a cell made by the engine (reset), or given to it
+  workcell::Workcell* cell_;                        // the cell now (engine thread only, after construction)
   Store* store_;
   EngineOptions options_;
   std::string nodes_json_;
@@ -165,6 +197,7 @@ class Engine final : public Backend {
   std::atomic<double> pace_request_{-1};
   std::chrono::steady_clock::time_point next_snapshot_{};
   bool start_paused_ = false;
+  TimePoint next_logged_state_{};
 
   // Published for network threads (guarded by mutex_).
   mutable std::mutex mutex_;
@@ -185,6 +218,7 @@ class Engine final : public Backend {
   std::condition_variable log_cv_;
   std::deque<LogCommand> log_queue_;
   std::vector<TransitionRecord> log_pending_;
+  std::vector<StateRecord> log_pending_states_;
   std::int64_t log_pending_run_ = 0;
   bool log_stopping_ = false;
 };

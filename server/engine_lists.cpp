@@ -6,6 +6,7 @@
 #include "server/engine_parts.h"
 
 #include <algorithm>
+#include <functional>
 #include <set>
 #include "sim/simulation.h"
 #include "smartmove/grasps.h"
@@ -31,7 +32,130 @@ json classShape(const world::ObjectClass& object_class) {
   return {{"boxes", std::move(boxes)}, {"colors", std::move(colors)}};
 }
 
+/// The names a plan may use of what the cell knows now (engine thread).
+struct Known {
+  std::set<std::string> waypoints;
+  std::set<std::string> frames = {"world"};
+  std::set<std::string> classes;
+};
+
+Known knownNow(workcell::Workcell& cell) {
+  Known known;
+  const world::WorldState& world = cell.components().world();
+  std::set<std::string> arm_sources;
+  std::set<std::string> declared;
+  for (const auto& component : cell.components().components()) {
+    const auto& description = component->description();
+    if (std::find(description.implements.begin(), description.implements.end(), "Arm") !=
+        description.implements.end()) {
+      arm_sources.insert(description.name);
+    }
+    for (const auto& symbol : description.symbols) {
+      declared.insert(symbol.name);
+    }
+  }
+  for (const world::Symbol* symbol : world.symbols()) {
+    if (symbol->frame() != nullptr) {
+      known.frames.insert(symbol->name);
+    }
+    if (arm_sources.contains(symbol->source) && !declared.contains(symbol->name)) {
+      known.waypoints.insert(symbol->name);
+    }
+  }
+  for (const world::Predicate* predicate : world.predicates("is_a")) {
+    if (predicate->args.size() == 2) {
+      known.classes.insert(predicate->args[1]);
+    }
+  }
+  if (sim::Simulation* simulation = cell.simulation()) {
+    for (const auto& object_class : simulation->objectClasses()) {
+      known.classes.insert(object_class.name);
+    }
+  }
+  return known;
+}
+
+std::string listed(const std::set<std::string>& names) {
+  std::string out;
+  for (const std::string& name : names) {
+    out += (out.empty() ? "" : ", ") + name;
+  }
+  return out.empty() ? "none" : out;
+}
+
+void visit(const bt::PlanNode& node, const std::function<void(const bt::PlanNode&)>& f) {
+  f(node);
+  for (const bt::PlanNode& child : node.children) {
+    visit(child, f);
+  }
+}
+
 }  // namespace
+
+std::vector<bt::Diagnostic> Engine::checkAgainstCell(const bt::Plan& plan) {
+  // What the plan itself makes known before it uses it: waypoints it teaches or renames to,
+  // and parts a detection finds (then frames of parts cannot be known beforehand).
+  std::set<std::string> taught;
+  bool detects = false;
+  for (const bt::PlanTree& tree : plan.file.trees) {
+    visit(tree.root, [&](const bt::PlanNode& node) {
+      if (node.id == "Teach") {
+        taught.insert(node.attribute("waypoint").value_or(""));
+      } else if (node.id == "RenameWaypoint") {
+        taught.insert(node.attribute("new_name").value_or(""));
+      } else if (node.id == "DetectObjects") {
+        detects = true;
+      }
+    });
+  }
+  const Known known = knownNow(*cell_);
+  std::vector<bt::Diagnostic> out;
+  for (const bt::PlanTree& tree : plan.file.trees) {
+    visit(tree.root, [&](const bt::PlanNode& node) {
+      const component::Component* provider = cell_->components().provider(node.id);
+      const component::OperationSpec* operation =
+          provider != nullptr ? provider->description().operation(node.id) : nullptr;
+      if (operation == nullptr) {
+        return;
+      }
+      for (const auto& [name, value] : node.attributes) {
+        const component::ParamSpec* param = operation->param(name);
+        if (param == nullptr || value.empty() || (node.id == "Teach" && name == "waypoint")) {
+          continue;
+        }
+        const auto extra = [&] {
+          return std::find(param->extra_choices.begin(), param->extra_choices.end(), value) !=
+                 param->extra_choices.end();
+        };
+        std::string problem;
+        if (param->choices_from == "waypoint" && !known.waypoints.contains(value) && !taught.contains(value)) {
+          problem = "no waypoint '" + value +
+                    "' in this cell now (renamed or deleted?); its waypoints: " + listed(known.waypoints);
+        } else if (param->choices_from == "frame" && !detects && !extra() && !known.frames.contains(value) &&
+                   !known.waypoints.contains(value) && !taught.contains(value)) {
+          problem = "no frame '" + value + "' in this cell now; its frames: " + listed(known.frames);
+        } else if (param->choices_from == "object_class" && !known.classes.empty() && !extra() &&
+                   !known.classes.contains(value)) {
+          problem = "no object class '" + value + "' in this cell; its classes: " + listed(known.classes);
+        }
+        if (!problem.empty()) {
+          out.push_back({node.location, node.id + ": " + name + ": " + problem});
+        }
+      }
+    });
+  }
+  return out;
+}
+
+std::optional<json> Engine::robot() {
+  return call([this]() -> std::optional<json> {
+    json drawing = cell_->robotDrawing();
+    if (drawing.is_null()) {
+      return std::nullopt;
+    }
+    return drawing;
+  });
+}
 
 void Engine::describeNodes() {
   // The palette: every node type with its ports; operation parameters add where their
@@ -39,8 +163,8 @@ void Engine::describeNodes() {
   json nodes = json::array();
   bool detect = false;
   bool calibrate = false;
-  for (const bt::NodeSpec* spec : cell_.nodes().all()) {
-    const component::Component* provider = cell_.components().provider(spec->id);
+  for (const bt::NodeSpec* spec : cell_->nodes().all()) {
+    const component::Component* provider = cell_->components().provider(spec->id);
     const component::OperationSpec* operation =
         provider != nullptr ? provider->description().operation(spec->id) : nullptr;
     json ports = json::array();
@@ -85,16 +209,16 @@ void Engine::describeNodes() {
     calibrate = calibrate || spec->id == "Calibrate" || spec->id == "HandEyeCalibration";
   }
   nodes_json_ = nodes.dump();
-  info_ = {{"workcell", cell_.name()},
-           {"description", cell_.description()},
-           {"simulated_clock", cell_.clock().simulated()},
-           {"simulator", cell_.simulation() != nullptr},
+  info_ = {{"workcell", cell_->name()},
+           {"description", cell_->description()},
+           {"simulated_clock", cell_->clock().simulated()},
+           {"simulator", cell_->simulation() != nullptr},
            {"features",
             {{"detect", detect},
              {"calibrate", calibrate},
-             {"pointcloud", cell_.simulation() != nullptr},
+             {"pointcloud", cell_->simulation() != nullptr},
              {"detect_node", detect ? "DetectObjects" : ""},
-             {"calibrate_node", cell_.nodes().find("Calibrate") != nullptr ? "Calibrate" : "HandEyeCalibration"}}},
+             {"calibrate_node", cell_->nodes().find("Calibrate") != nullptr ? "Calibrate" : "HandEyeCalibration"}}},
            {"version", "0.1.0"}};
 }
 
@@ -116,44 +240,16 @@ json Engine::info() {
 
 json Engine::choices() {
   return call([this] {
-    const world::WorldState& world = cell_.components().world();
-    std::set<std::string> waypoints;
-    std::set<std::string> frames = {"world"};
-    std::set<std::string> classes;
-    std::set<std::string> arm_sources;
-    std::set<std::string> declared;
+    const Known known = knownNow(*cell_);
+    const std::set<std::string>& classes = known.classes;
     json shapes = json::object();
-    for (const auto& component : cell_.components().components()) {
-      const auto& description = component->description();
-      if (std::find(description.implements.begin(), description.implements.end(), "Arm") !=
-          description.implements.end()) {
-        arm_sources.insert(description.name);
-      }
-      for (const auto& symbol : description.symbols) {
-        declared.insert(symbol.name);
-      }
-    }
-    for (const world::Symbol* symbol : world.symbols()) {
-      if (symbol->frame() != nullptr) {
-        frames.insert(symbol->name);
-      }
-      if (arm_sources.contains(symbol->source) && !declared.contains(symbol->name)) {
-        waypoints.insert(symbol->name);
-      }
-    }
-    for (const world::Predicate* predicate : world.predicates("is_a")) {
-      if (predicate->args.size() == 2) {
-        classes.insert(predicate->args[1]);
-      }
-    }
-    if (sim::Simulation* simulation = cell_.simulation()) {
+    if (sim::Simulation* simulation = cell_->simulation()) {
       for (const auto& object_class : simulation->objectClasses()) {
-        classes.insert(object_class.name);
         shapes[object_class.name] = classShape(object_class);
       }
     }
     json predicates = json::array();
-    for (const auto& [name, decl] : cell_.components().predicates()) {
+    for (const auto& [name, decl] : cell_->components().predicates()) {
       predicates.push_back({{"name", name}, {"arity", decl.arity}, {"description", decl.description}});
     }
     json grasps = json::object();
@@ -171,9 +267,9 @@ json Engine::choices() {
     } catch (const std::exception&) {
       // An unreadable grasp file: SmartMove reports it when it runs; offer no list.
     }
-    return json{{"waypoint", waypoints},      {"frame", frames},
-                {"object_class", classes},    {"predicate", std::move(predicates)},
-                {"grasp", std::move(grasps)}, {"object_shape", std::move(shapes)}};
+    return json{{"waypoint", known.waypoints}, {"frame", known.frames},
+                {"object_class", classes},     {"predicate", std::move(predicates)},
+                {"grasp", std::move(grasps)},  {"object_shape", std::move(shapes)}};
   });
 }
 

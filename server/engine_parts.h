@@ -62,7 +62,9 @@ struct Engine::RunState {
   std::string plan_name;
   int version = 0;
   std::string label;  // the main tree's ID, or the operation's node type
+  std::string workcell;
   std::string xml;
+  json plan_json;  // a plan run's plan as the editor's JSON (any page can show what runs)
   std::vector<RunNode> nodes;
   std::vector<Node> statuses;
   std::vector<std::uint32_t> dirty;
@@ -96,6 +98,7 @@ struct Engine::LogCommand {
   RunRecord record;
   std::vector<RunNode> nodes;
   std::vector<TransitionRecord> transitions;
+  std::vector<StateRecord> states;
 };
 
 template <typename F>

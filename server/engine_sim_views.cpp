@@ -10,7 +10,7 @@ namespace costar::server {
 
 std::optional<json> Engine::groundTruth() {
   return call([this]() -> std::optional<json> {
-    sim::Simulation* simulation = cell_.simulation();
+    sim::Simulation* simulation = cell_->simulation();
     if (simulation == nullptr) {
       return std::nullopt;
     }
@@ -36,7 +36,7 @@ std::optional<json> Engine::groundTruth() {
 
 std::optional<json> Engine::pointCloud(std::size_t max_points) {
   return call([this, max_points]() -> std::optional<json> {
-    sim::Simulation* simulation = cell_.simulation();
+    sim::Simulation* simulation = cell_->simulation();
     if (simulation == nullptr) {
       return std::nullopt;
     }

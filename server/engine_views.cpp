@@ -47,7 +47,9 @@ json Engine::runJson(const RunState& run, bool with_nodes) const {
               {"plan", run.plan_name},
               {"version", run.version},
               {"label", run.label},
+              {"workcell", run.workcell},
               {"active", run.active},
+              {"paused", run.active && paused_.load()},
               {"started_at", run.started_at},
               {"result", run.result},
               {"clock_seconds", run.clock_seconds},
@@ -68,6 +70,9 @@ json Engine::runJson(const RunState& run, bool with_nodes) const {
           {{"uid", node.uid}, {"parent", node.parent}, {"id", node.id}, {"name", node.name}, {"path", node.path}});
     }
     out["nodes"] = std::move(nodes);
+    if (!run.plan_json.is_null()) {
+      out["plan_json"] = run.plan_json;
+    }
   }
   return out;
 }
@@ -101,8 +106,8 @@ std::optional<json> Engine::runStatus(std::optional<std::int64_t> id) {
 }
 
 json Engine::buildState() const {
-  const world::WorldState& world = cell_.components().world();
-  json state = {{"type", "state"}, {"t", rounded(toSeconds(cell_.clock().now()), 1e4)}};
+  const world::WorldState& world = cell_->components().world();
+  json state = {{"type", "state"}, {"t", rounded(toSeconds(cell_->clock().now()), 1e4)}};
   const std::int64_t active = active_run_.load();
   state["run"] = active;
   state["mode"] = active == 0 ? "idle" : (paused_ ? "paused" : "running");
@@ -110,7 +115,7 @@ json Engine::buildState() const {
   std::set<std::string> arm_sources;
   std::set<std::string> declared;
   const arm::ArmComponent* arm = nullptr;
-  for (const auto& component : cell_.components().components()) {
+  for (const auto& component : cell_->components().components()) {
     const auto& description = component->description();
     if (std::find(description.implements.begin(), description.implements.end(), "Arm") !=
         description.implements.end()) {
@@ -145,6 +150,15 @@ json Engine::buildState() const {
     if (predicate->value && !predicate->args.empty()) {
       gripper["mode"] = predicate->args.front();
     }
+  }
+  // The fingers' reading (the gripper's own symbol): the page draws the fingers from it.
+  if (const world::Symbol* fingers = world.symbol("gripper_fingers");
+      fingers != nullptr && fingers->joints() != nullptr) {
+    json positions = json::array();
+    for (const double value : fingers->joints()->positions) {
+      positions.push_back(rounded(value));
+    }
+    gripper["reading"] = {{"names", fingers->joints()->joint_names}, {"positions", std::move(positions)}};
   }
   state["gripper"] = std::move(gripper);
 

@@ -21,18 +21,24 @@ std::filesystem::path defaultStoreFile(const std::string& workcell) {
 
 Server::Server(ServeOptions options) : options_(std::move(options)) {
   token_ = options_.token_file.empty() ? randomToken() : tokenFromFile(options_.token_file);
-  cell_ = workcell::makeWorkcell(options_.workcell);
-  store_ = std::make_unique<Store>(options_.store.empty() ? defaultStoreFile(cell_->name()) : options_.store);
+  std::unique_ptr<workcell::Workcell> cell = workcell::makeWorkcell(options_.workcell);
+  name_ = cell->name();
+  description_ = cell->description();
+  store_ = std::make_unique<Store>(options_.store.empty() ? defaultStoreFile(name_) : options_.store);
   EngineOptions engine_options;
   engine_options.pace = options_.pace;
   engine_options.stream_hz = options_.stream_hz;
-  if (cell_->simulation() != nullptr) {
+  if (cell->simulation() != nullptr) {
     engine_options.grasp_defaults = dataRoot() / "data/grasps.json";
     if (!options_.workcell.memory_only) {
-      engine_options.grasp_taught = workcell::defaultGraspFile(cell_->name());
+      engine_options.grasp_taught = workcell::defaultGraspFile(name_);
     }
+    // Reset scene: the same cell made again from the same options (scene file, seed).
+    engine_options.make_cell = [workcell_options = options_.workcell] {
+      return workcell::makeWorkcell(workcell_options);
+    };
   }
-  engine_ = std::make_unique<Engine>(*cell_, store_.get(), engine_options);
+  engine_ = std::make_unique<Engine>(std::move(cell), store_.get(), engine_options);
   ApiOptions api_options;
   api_options.token = token_;
   api_options.reads_need_token = !HttpServer::isLoopback(options_.address);
@@ -85,7 +91,7 @@ int runServe(const ServeOptions& options, std::ostream& out, std::ostream& err) 
     return 2;
   }
   const bool loopback = HttpServer::isLoopback(options.address);
-  out << "costar serve: " << server->cell().description() << "\n";
+  out << "costar serve: " << server->description() << "\n";
   out << "  store: " << server->store().file().string() << "\n";
   if (!loopback) {
     err << "warning: listening on " << options.address

@@ -57,14 +57,17 @@ class Server {
   Engine& engine() { return *engine_; }
   Store& store() { return *store_; }
   HttpServer& http() { return *http_; }
-  workcell::Workcell& cell() { return *cell_; }
+  /// The cell's name and its description (the engine owns the cell: a scene reset makes it anew).
+  const std::string& name() const { return name_; }
+  const std::string& description() const { return description_; }
   /// Stops serving and ticking (the active run is stopped; its operations cancelled).
   void stop();
 
  private:
   ServeOptions options_;
   std::string token_;
-  std::unique_ptr<workcell::Workcell> cell_;
+  std::string name_;
+  std::string description_;
   std::unique_ptr<Store> store_;
   std::unique_ptr<Engine> engine_;
   std::unique_ptr<Api> api_;

@@ -132,6 +132,9 @@ CREATE TABLE IF NOT EXISTS transitions (
   t REAL NOT NULL, uid INTEGER NOT NULL, from_status TEXT NOT NULL, to_status TEXT NOT NULL,
   reason TEXT NOT NULL DEFAULT '', origin TEXT NOT NULL DEFAULT '', data TEXT NOT NULL DEFAULT '',
   PRIMARY KEY (run, seq));
+CREATE TABLE IF NOT EXISTS run_states (
+  run INTEGER NOT NULL REFERENCES runs(id) ON DELETE CASCADE, seq INTEGER NOT NULL,
+  t REAL NOT NULL, state TEXT NOT NULL, PRIMARY KEY (run, seq));
 )sql";
 
 RunRecord readRun(const Statement& row) {
@@ -148,12 +151,13 @@ RunRecord readRun(const Statement& row) {
   run.failure_reason = row.text(9);
   run.transitions = static_cast<std::uint64_t>(row.integer(10));
   run.truncated = row.integer(11) != 0;
+  run.workcell = row.text(12);
   return run;
 }
 
 constexpr const char* kRunColumns =
     "id, plan, version, xml, started_at, result, ended_at, clock_seconds, failure_path, failure_reason, "
-    "transitions, truncated";
+    "transitions, truncated, workcell";
 
 }  // namespace
 
@@ -175,6 +179,7 @@ Store::Store(const std::filesystem::path& file) : file_(file) {
     exec("PRAGMA synchronous=FULL");
     exec("PRAGMA foreign_keys=ON");
     exec(kSchema);
+    addRunWorkcellColumn();
     exec("UPDATE runs SET result = 'INTERRUPTED' WHERE result = ''");
   } catch (...) {
     sqlite3_close(db_);
@@ -184,6 +189,15 @@ Store::Store(const std::filesystem::path& file) : file_(file) {
 }
 
 Store::~Store() { sqlite3_close(db_); }
+
+void Store::addRunWorkcellColumn() {
+  // Stores made before runs named their cell get the column (empty for their old runs).
+  Statement columns(db_, "SELECT COUNT(*) FROM pragma_table_info('runs') WHERE name = 'workcell'");
+  columns.step();
+  if (columns.integer(0) == 0) {
+    exec("ALTER TABLE runs ADD COLUMN workcell TEXT NOT NULL DEFAULT ''");
+  }
+}
 
 void Store::exec(const char* sql) const {
   char* error = nullptr;
@@ -265,9 +279,9 @@ bool Store::remove(DocumentKind kind, const std::string& name) {
 void Store::beginRun(const RunRecord& record, const std::vector<RunNode>& nodes) {
   const std::lock_guard lock(mutex_);
   Transaction transaction(db_);
-  Statement insert(db_, "INSERT INTO runs (id, plan, version, xml, started_at) VALUES (?, ?, ?, ?, ?)");
+  Statement insert(db_, "INSERT INTO runs (id, plan, version, xml, started_at, workcell) VALUES (?, ?, ?, ?, ?, ?)");
   insert.bind(1, record.id).bind(2, record.plan).bind(3, record.version).bind(4, record.xml);
-  insert.bind(5, record.started_at).run();
+  insert.bind(5, record.started_at).bind(6, record.workcell).run();
   Statement node(db_, "INSERT INTO run_nodes (run, uid, parent, id, name, path) VALUES (?, ?, ?, ?, ?, ?)");
   for (const RunNode& n : nodes) {
     node.reset();
@@ -295,6 +309,35 @@ void Store::appendTransitions(std::int64_t run, const std::vector<TransitionReco
     insert.bind(5, t.from).bind(6, t.to).bind(7, t.reason).bind(8, t.origin).bind(9, t.data).run();
   }
   transaction.commit();
+}
+
+void Store::appendStates(std::int64_t run, const std::vector<StateRecord>& states) {
+  if (states.empty()) {
+    return;
+  }
+  const std::lock_guard lock(mutex_);
+  Transaction transaction(db_);
+  Statement next(db_, "SELECT COALESCE(MAX(seq), 0) FROM run_states WHERE run = ?");
+  next.bind(1, run);
+  next.step();
+  std::int64_t seq = next.integer(0);
+  Statement insert(db_, "INSERT INTO run_states (run, seq, t, state) VALUES (?, ?, ?, ?)");
+  for (const StateRecord& state : states) {
+    insert.reset();
+    insert.bind(1, run).bind(2, ++seq).bind(3, state.t).bind(4, state.state).run();
+  }
+  transaction.commit();
+}
+
+std::vector<StateRecord> Store::runStates(std::int64_t run) const {
+  const std::lock_guard lock(mutex_);
+  Statement query(db_, "SELECT t, state FROM run_states WHERE run = ? ORDER BY seq");
+  query.bind(1, run);
+  std::vector<StateRecord> out;
+  while (query.step()) {
+    out.push_back({query.real(0), query.text(1)});
+  }
+  return out;
 }
 
 void Store::endRun(const RunRecord& record) {

@@ -57,6 +57,8 @@ struct RunNode {
 
 struct RunRecord {
   std::int64_t id = 0;
+  /// The cell it ran on (`--workcell`), empty for runs logged before cells were recorded.
+  std::string workcell;
   /// The plan's name and version when it was saved, else empty / 0.
   std::string plan;
   int version = 0;
@@ -82,6 +84,13 @@ struct TransitionRecord {
   std::string reason;  // on FAILURE
   std::string origin;  // on FAILURE: path of the node where it arose
   std::string data;    // JSON text of an operation's result data, or empty
+};
+
+/// A snapshot of the cell during a run (the stream's state message, without the waypoints and
+/// frames), for replaying the arm, the gripper and the parts.
+struct StateRecord {
+  double t = 0;       // clock seconds since the run started
+  std::string state;  // JSON text
 };
 
 struct RunLog {
@@ -133,6 +142,10 @@ class Store {
   void beginRun(const RunRecord& record, const std::vector<RunNode>& nodes);
   /// Appends transitions of a run in one transaction.
   void appendTransitions(std::int64_t run, const std::vector<TransitionRecord>& transitions);
+  /// Appends snapshots of the cell during a run in one transaction.
+  void appendStates(std::int64_t run, const std::vector<StateRecord>& states);
+  /// A run's snapshots, oldest first.
+  std::vector<StateRecord> runStates(std::int64_t run) const;
   /// Records how a run ended (result, times, failure, counts).
   void endRun(const RunRecord& record);
   /// The newest runs first.
@@ -149,6 +162,7 @@ class Store {
 
  private:
   void exec(const char* sql) const;
+  void addRunWorkcellColumn();
   std::filesystem::path file_;
   sqlite3* db_ = nullptr;
   mutable std::mutex mutex_;

@@ -1,5 +1,7 @@
 #include "workcell/sim_workcell.h"
 
+#include <fstream>
+#include <iterator>
 #include <limits>
 
 #include "arm/arm_component.h"
@@ -12,6 +14,7 @@
 #include "perception/perception_component.h"
 #include "perception/pipeline.h"
 #include "planning/collision_world.h"
+#include "planning/robot_model.h"
 #include "predicator/pattern.h"
 #include "predicator/predicator.h"
 #include "sim/arm_driver.h"
@@ -240,6 +243,61 @@ class SimWorkcell final : public Workcell {
                          [&arg](const world::ObjectClass& c) { return c.name == arg; }) ||
              components().world().symbol(arg) != nullptr;
     });
+  }
+
+  nlohmann::json robotDrawing() const override {
+    const auto text = [](const std::filesystem::path& file) {
+      std::ifstream in(file);
+      if (!in) {
+        throw std::runtime_error("cannot read '" + file.string() + "'");
+      }
+      return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    const std::filesystem::path gripper_urdf = dataRoot() / gripper_model_.urdf;
+    nlohmann::json joints = nlohmann::json::array();
+    for (int j = 0; j < robot_description_.jointCount(); ++j) {
+      joints.push_back(
+          {{"name", robot_description_.joint_names[j]},
+           {"label", j < static_cast<int>(robot_description_.joint_labels.size()) ? robot_description_.joint_labels[j]
+                                                                                  : std::string()},
+           {"lower", robot_description_.limits.min_position[j]},
+           {"upper", robot_description_.limits.max_position[j]}});
+    }
+    nlohmann::json gripper = {{"key", gripper_model_.key}};
+    if (adaptive_) {
+      gripper["kind"] = "adaptive";
+      std::ifstream in(gripper::gripperDescriptionFile(gripper_model_.adaptive));
+      gripper["description"] = nlohmann::json::parse(in);
+      gripper["finger_links"] = {gripper_model_.finger_link};
+    } else {
+      gripper["kind"] = "parallel";
+      gripper["finger_links"] = gripper_model_.links;
+      if (gripper_model_.fingers) {
+        gripper["max_opening"] = gripper_model_.fingers->max_opening;
+        nlohmann::json boxes = nlohmann::json::array();
+        for (const gripper::FingerBox& box : gripper_model_.fingers->closed) {
+          boxes.push_back({{"centre", {box.centre.x(), box.centre.y(), box.centre.z()}},
+                           {"size", {box.size.x(), box.size.y(), box.size.z()}}});
+        }
+        gripper["finger_boxes"] = std::move(boxes);
+      }
+    }
+    const Eigen::Quaterniond q(cell_.robot_base.linear());
+    const Eigen::Vector3d& p = cell_.robot_base.translation();
+    return {{"urdf",
+             planning::mountUrdf(text(robot_description_.urdf), text(gripper_urdf), robot_description_.urdf_tool_link,
+                                 robot_description_.urdf.string() + "' + '" + gripper_urdf.string())},
+            {"name", robot_description_.name},
+            {"label", robot_description_.label},
+            {"base_link", robot_description_.urdf_base_link},
+            {"flange_link", robot_description_.urdf_tool_link},
+            {"tcp_link", gripper_model_.tcp_link},
+            {"base_in_world", {{"p", {p.x(), p.y(), p.z()}}, {"q", {q.x(), q.y(), q.z(), q.w()}}}},
+            {"joints", std::move(joints)},
+            {"gripper", std::move(gripper)},
+            {"table",
+             {{"centre", {cell_.table_centre.x(), cell_.table_centre.y(), cell_.table_centre.z()}},
+              {"size", {cell_.table_size.x(), cell_.table_size.y(), cell_.table_size.z()}}}}};
   }
 
   std::string name() const override { return cell_.name; }

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -83,6 +84,15 @@ class Workcell {
   /// The simulation behind a simulated cell (for tests, pictures and the trial judge, never
   /// for plans), or nullptr.
   virtual sim::Simulation* simulation() { return nullptr; }
+  /// The robot as the editor draws it, from the description the simulator and the planner
+  /// use, or null for a cell without a robot: `urdf` (the arm's URDF with the gripper's mounted
+  /// on its flange: the planner's model), `base_link`, `flange_link`, `tcp_link`,
+  /// `base_in_world` {p, q [x, y, z, w]}, `joints` [{name, label, lower, upper}] (rad),
+  /// `gripper` {key, kind ("parallel": `max_opening`, `finger_boxes` of the +y finger closed, in
+  /// the flange frame; "adaptive": `description`, the gripper's description file),
+  /// `finger_links` (drawn from the gripper's reading, not from the URDF)}, and the `table`
+  /// {centre, size} it stands by (m).
+  virtual nlohmann::json robotDrawing() const { return nullptr; }
 
  protected:
   explicit Workcell(std::unique_ptr<Clock> clock);

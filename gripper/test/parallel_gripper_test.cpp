@@ -169,6 +169,33 @@ TEST_F(GripperTest, OnlyPinchModeIsSupported) {
   EXPECT_TRUE(holds("gripper_mode", pinch));
 }
 
+// Plan validation (the editor's Check, costar run) refuses the modes a 2-finger gripper lacks
+// before anything runs, with the same reason the operation gives.
+TEST_F(GripperTest, ModesOtherThanPinchFailCheck) {
+  const auto problem = [&](const std::string& operation, component::ParamMap params = {}) {
+    const component::OperationSpec* spec = gripper.description().operation(operation);
+    return spec->check ? spec->check(params) : std::string();
+  };
+  for (const char* mode : {"BasicMode", "WideMode", "ScissorMode"}) {
+    EXPECT_NE(problem(mode).find("a parallel 2-finger gripper has only Pinch mode"), std::string::npos) << mode;
+  }
+  EXPECT_EQ(problem("PinchMode"), "");
+  EXPECT_EQ(problem("SetMode", {{"mode", component::Value(std::string("pinch"))}}), "");
+  EXPECT_NE(problem("SetMode", {{"mode", component::Value(std::string("scissor"))}}), "");
+}
+
+// The fingers' reading is a symbol: the editor draws the fingers from it.
+TEST_F(GripperTest, TheReportCarriesTheFingersOpening) {
+  run("Close", {{"speed", component::Value(0.15)}});
+  world::WorldState world;
+  world.update("gripper", gripper.report());
+  const world::Symbol* fingers = world.symbol("gripper_fingers");
+  ASSERT_NE(fingers, nullptr);
+  ASSERT_NE(fingers->joints(), nullptr);
+  EXPECT_EQ(fingers->joints()->joint_names, std::vector<std::string>{"opening"});
+  EXPECT_NEAR(fingers->joints()->positions.at(0), 0.0, 1e-3);
+}
+
 TEST_F(GripperTest, FingersThatNeverSettleFailAfterTheTimeout) {
   fingers.jammed = true;
   const OperationResult result = run("Close");

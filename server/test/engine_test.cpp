@@ -26,12 +26,17 @@ constexpr const char* kToken = "test-token-0123456789";
 /// A workcell, an in-memory store, the engine and the API.
 class Harness {
  public:
-  explicit Harness(workcell::WorkcellOptions options, double pace = 0.0, ApiOptions api_options = {}) {
+  /// `resettable`: the engine can build the cell again ("Reset scene"), as `costar serve` does.
+  explicit Harness(workcell::WorkcellOptions options, double pace = 0.0, ApiOptions api_options = {},
+                   bool resettable = false) {
     options.memory_only = true;
     cell_ = workcell::makeWorkcell(options);
     EngineOptions engine_options;
     engine_options.pace = pace;
     engine_options.grasp_defaults = dataRoot() / "data/grasps.json";
+    if (resettable) {
+      engine_options.make_cell = [options] { return workcell::makeWorkcell(options); };
+    }
     engine_ = std::make_unique<Engine>(*cell_, &store_, engine_options);
     api_options.token = kToken;
     api_ = std::make_unique<Api>(*engine_, store_, api_options);
@@ -124,7 +129,12 @@ TEST(Api, PaletteListsEveryNodeTypeWithItsCategory) {
 TEST(Api, ChangesNeedTheToken) {
   Harness h(testCell());
   const json body = {{"plan", plan(node("AlwaysSuccess"))}};
-  EXPECT_EQ(h.call("PUT", "/api/plans/p", body, false).status, 401);
+  const HttpResponse refused = h.call("PUT", "/api/plans/p", body, false);
+  EXPECT_EQ(refused.status, 401);
+  // In a technician's words, not the header's.
+  EXPECT_EQ(json::parse(refused.body)["error"].get<std::string>().rfind("sign in to change plans or move the robot", 0),
+            0u)
+      << refused.body;
   EXPECT_EQ(h.call("POST", "/api/runs", body, false).status, 401);
   EXPECT_EQ(h.call("POST", "/api/operations", {{"node", "TestLog"}}, false).status, 401);
   EXPECT_EQ(h.call("POST", "/api/control", {{"action", "stop"}}, false).status, 401);
@@ -184,6 +194,10 @@ TEST(Api, RefusesBadRequestsWithAMessage) {
          "did you mean 'Sequence'");
   const HttpResponse unknown = h.call("PUT", "/api/plans/p", {{"plan", plan(node("Sequence", {}, {node("Fly")}))}});
   ASSERT_EQ(unknown.status, 422);
+  // The message names the plan, not a file the user never saw.
+  const std::string message = json::parse(unknown.body)["error"];
+  EXPECT_EQ(message.rfind("plan 'p' has 1 problem: ", 0), 0u) << message;
+  EXPECT_EQ(message.find(".xml"), std::string::npos) << message;
   EXPECT_EQ(json::parse(unknown.body)["diagnostics"][0]["node"]["path"], json({0}));
   expect(422, h.call("PUT", "/api/plans/p", {{"plan", plan(node("TestLog"))}}), "message");  // missing parameter
   expect(422, h.call("PUT", "/api/plans/p", {{"plan", plan(node("TestAction", {{"polls", "many"}}))}}), "polls");
@@ -333,6 +347,75 @@ TEST(Engine, PausedRunsTickOnlyWhenStepped) {
 
   EXPECT_EQ(h.call("POST", "/api/control", {{"action", "resume"}}).status, 200);
   EXPECT_EQ(h.waitForRun(id)["result"], "SUCCESS");
+}
+
+TEST(Engine, PausingHoldsTheClockAndAStepLetsOneTickPeriodPass) {
+  Harness h(testCell(), 0.0);  // unpaced: a running clock would race ahead while paused
+  const HttpResponse started =
+      h.call("POST", "/api/runs", {{"plan", plan(node("TestAction", {{"polls", "1000000"}}))}, {"paused", true}});
+  ASSERT_EQ(started.status, 202) << started.body;
+  h.waitTicks(5);
+  const double t0 = h.engine().state()["t"];
+  h.waitTicks(50);  // 50 held periods: the clock stands still
+  EXPECT_DOUBLE_EQ(h.engine().state()["t"].get<double>(), t0);
+  EXPECT_EQ(h.engine().state()["mode"], "paused");
+  EXPECT_EQ(h.call("POST", "/api/control", {{"action", "step"}}).status, 200);
+  h.waitTicks(20);
+  const double t1 = h.engine().state()["t"];
+  EXPECT_NEAR(t1 - t0, 0.01, 1e-9);  // one tick period (10 ms) and no more
+  h.waitTicks(20);
+  EXPECT_DOUBLE_EQ(h.engine().state()["t"].get<double>(), t1);
+  EXPECT_EQ(h.call("POST", "/api/control", {{"action", "stop"}}).status, 200);
+}
+
+// Any page (a reload, a second browser) learns the running plan from the stream's hello: which
+// plan, its version, its cell and the plan itself, whatever the page had open.
+TEST(Engine, TheHelloCarriesTheRunningPlan) {
+  Harness h(testCell(), 1.0);
+  const json endless = plan(node("Repeat", {{"num_cycles", "-1"}}, {node("TestAction", {{"polls", "3"}})}));
+  ASSERT_EQ(h.call("PUT", "/api/plans/forever", {{"plan", endless}}).status, 201);
+  const HttpResponse started = h.call("POST", "/api/runs", {{"name", "forever"}});
+  ASSERT_EQ(started.status, 202) << started.body;
+  while (h.engine().state()["mode"] != "running") {  // the next snapshot
+    h.waitTicks(1);
+  }
+  const json hello = json::parse(h.engine().helloMessage());
+  const json& run = hello["run"];
+  EXPECT_TRUE(run["active"].get<bool>());
+  EXPECT_EQ(run["plan"], "forever");
+  EXPECT_EQ(run["version"], 1);
+  EXPECT_EQ(run["workcell"], "test");
+  EXPECT_EQ(run["plan_json"]["trees"][0]["root"]["id"], "Repeat");
+  EXPECT_EQ(hello["state"]["mode"], "running");
+  EXPECT_EQ(h.call("POST", "/api/control", {{"action", "stop"}}).status, 200);
+  EXPECT_EQ(h.waitForRun(run["id"])["result"], "STOPPED");
+}
+
+// A plan run's log keeps snapshots of the cell (replay draws the arm and the parts from them)
+// and names the cell it ran on.
+TEST(Engine, TheRunLogKeepsSnapshotsOfTheCellAndItsName) {
+  Harness h(testCell(), 0.0);
+  const HttpResponse started = h.call("POST", "/api/runs", {{"plan", plan(node("TestAction", {{"polls", "120"}}))}});
+  ASSERT_EQ(started.status, 202) << started.body;
+  const std::int64_t id = json::parse(started.body)["run"];
+  EXPECT_EQ(h.waitForRun(id)["result"], "SUCCESS");
+  json states;
+  for (int attempt = 0; attempt < 200; ++attempt) {  // the log writer writes every 200 ms
+    states = h.get("/api/runs/" + std::to_string(id) + "/states")["states"];
+    if (!h.store().runs().empty() && !h.store().runs().front().result.empty() && states.size() >= 3) {
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  // 1.2 s of clock time at 5 snapshots a second, the first and the last: 7.
+  ASSERT_GE(states.size(), 6u) << states.dump();
+  for (std::size_t i = 1; i < states.size(); ++i) {
+    EXPECT_GE(states[i]["t"].get<double>(), states[i - 1]["t"].get<double>());
+  }
+  EXPECT_TRUE(states[0]["state"].contains("objects"));
+  EXPECT_FALSE(states[0]["state"].contains("waypoints"));
+  EXPECT_EQ(h.get("/api/runs")[0]["workcell"], "test");
+  EXPECT_EQ(h.call("GET", "/api/runs/999/states").status, 404);
 }
 
 TEST(Engine, SingleOperationsRunAndAreNotLogged) {
@@ -505,6 +588,136 @@ TEST(Ur5Cell, TheStateCarriesEachPartsSeenColour) {
     }
   }
   EXPECT_EQ(nearest, "red") << seen.transpose();
+}
+
+// Stepping through a SmartGrasp ends as a normal run does: while paused the simulated cell
+// stands still, so no time limit (the fingers settling, the motion) runs out between steps.
+TEST(Ur5Cell, SteppingThroughASmartGraspSucceeds) {
+  workcell::WorkcellOptions options = blindCell();
+  options.test_oracle_perception = true;  // the part's pose without a detection
+  Harness h(options, 0.0);
+  const json p = plan(node("Sequence", {}, {node("Open"), node("SmartGrasp", {{"object_class", "node"}})}));
+  const HttpResponse started = h.call("POST", "/api/runs", {{"plan", p}, {"paused", true}});
+  ASSERT_EQ(started.status, 202) << started.body;
+  const std::int64_t id = json::parse(started.body)["run"];
+  int steps = 0;
+  const double t0 = h.engine().state()["t"];
+  while ((*h.engine().runStatus(id))["active"].get<bool>() && steps < 20000) {
+    h.call("POST", "/api/control", {{"action", "step"}});
+    ++steps;
+    // Wall time between steps, as a person clicking leaves, now and then long: a clock that
+    // ran on while paused (unpaced here: tens of simulated seconds) would pass every time limit
+    // of an operation under way (the fingers settling: 3 s).
+    std::this_thread::sleep_for(std::chrono::milliseconds(steps % 20 == 0 ? 300 : 1));
+  }
+  const json run = h.waitForRun(id);
+  EXPECT_EQ(run["result"], "SUCCESS") << run.dump();
+  EXPECT_GT(steps, 50);
+  // One tick period of simulated time per step, however long the waits between them.
+  EXPECT_NEAR(h.engine().state()["t"].get<double>() - t0, 0.01 * steps, 0.011) << steps << " steps";
+  EXPECT_TRUE(h.get("/api/state")["gripper"]["holding"].get<bool>());
+}
+
+// Check knows the cell: waypoints (a renamed one is flagged, one the plan teaches first is not),
+// the gripper's modes (a 2-finger gripper has only Pinch), the object classes.
+TEST(Ur5Cell, CheckValidatesAgainstTheCell) {
+  Harness h(blindCell());
+  const auto check = [&](const std::string& body) {
+    const std::string xml =
+        R"(<root BTCPP_format="4"><BehaviorTree ID="main"><Sequence>)" + body + R"(</Sequence></BehaviorTree></root>)";
+    const HttpResponse response = h.call("POST", "/api/validate", {{"xml", xml}, {"name", "shift_plan"}});
+    EXPECT_EQ(response.status, 200) << response.body;
+    return json::parse(response.body);
+  };
+  json result = check(R"(<Open/><Move waypoint="over_left"/>)");
+  ASSERT_FALSE(result["valid"]) << result.dump();
+  const std::string message = result["diagnostics"][0]["message"];
+  EXPECT_NE(message.find("no waypoint 'over_left' in this cell now"), std::string::npos) << message;
+  EXPECT_NE(message.find("above_pick"), std::string::npos) << message;  // what it has
+  EXPECT_EQ(result["diagnostics"][0]["node"]["path"], json::array({1}));
+  EXPECT_EQ(result["diagnostics"][0]["where"].get<std::string>().rfind("shift_plan:", 0), 0u);
+  EXPECT_TRUE(check(R"(<Move waypoint="above_pick"/>)")["valid"]);
+  EXPECT_TRUE(check(R"(<Teach waypoint="here"/><Move waypoint="here"/>)")["valid"]);  // taught first
+
+  result = check(R"(<Open/><ScissorMode/>)");
+  ASSERT_FALSE(result["valid"]) << result.dump();
+  EXPECT_NE(result["diagnostics"][0]["message"].get<std::string>().find("has only Pinch mode"), std::string::npos)
+      << result.dump();
+  EXPECT_FALSE(check(R"(<SetMode mode="wide"/>)")["valid"]);
+  EXPECT_TRUE(check(R"(<PinchMode/><SetMode mode="pinch"/>)")["valid"]);
+
+  result = check(R"(<SmartGrasp object_class="gear"/>)");
+  EXPECT_FALSE(result["valid"]) << result.dump();
+
+  // Saving it is not refused (the waypoint may be taught later); running it is, at once,
+  // naming the plan and the problem.
+  EXPECT_EQ(
+      h.call("PUT", "/api/plans/later",
+             {{"xml",
+               R"(<root BTCPP_format="4"><BehaviorTree ID="main"><Move waypoint="over_left"/></BehaviorTree></root>)"}})
+          .status,
+      201);
+  const HttpResponse run = h.call(
+      "POST", "/api/runs",
+      {{"xml",
+        R"(<root BTCPP_format="4"><BehaviorTree ID="main"><Move waypoint="over_left"/></BehaviorTree></root>)"}});
+  EXPECT_EQ(run.status, 422) << run.body;
+  EXPECT_EQ(json::parse(run.body)["error"].get<std::string>().rfind("this plan has 1 problem: Move: waypoint:", 0), 0u)
+      << run.body;
+}
+
+// GET /api/robot: the robot as the planner models it (the arm's URDF with the gripper's on its
+// flange), where it stands, its joints, its gripper; the state carries the fingers' reading.
+TEST(Ur5Cell, TheRobotIsDescribedByThePlannersUrdf) {
+  Harness h(blindCell());
+  const json robot = h.get("/api/robot");
+  EXPECT_EQ(robot["joints"].size(), 6u);
+  EXPECT_EQ(robot["joints"][0]["name"], "shoulder_pan_joint");
+  EXPECT_EQ(robot["flange_link"], "tool0");
+  EXPECT_EQ(robot["tcp_link"], "tcp");
+  const std::string urdf = robot["urdf"];
+  EXPECT_NE(urdf.find("<link name=\"tcp\""), std::string::npos);
+  EXPECT_NE(urdf.find("<joint name=\"tool_centre_point\""), std::string::npos);
+  EXPECT_EQ(robot["gripper"]["kind"], "parallel");
+  EXPECT_EQ(robot["gripper"]["finger_boxes"].size(), 2u);
+  EXPECT_DOUBLE_EQ(robot["base_in_world"]["q"][2].get<double>(), 1.0);  // turned half a turn about z
+  const json gripper = h.get("/api/state")["gripper"];
+  ASSERT_TRUE(gripper.contains("reading")) << gripper.dump();
+  EXPECT_EQ(gripper["reading"]["names"], json::array({"opening"}));
+  EXPECT_GT(gripper["reading"]["positions"][0].get<double>(), 0.0);
+}
+
+// Reset scene builds the cell again from its scene file and seed: a part that was moved is
+// back, the arm at home; refused while something runs.
+TEST(Ur5Cell, ResetSceneBuildsTheSceneAgain) {
+  Harness h(blindCell(), 0.0, {.test_endpoints = true}, /*resettable=*/true);
+  const json before = h.get("/api/test/ground_truth");
+  const json p =
+      plan(node("Sequence", {},
+                {node("Open"), node("Move", {{"waypoint", "above_pick"}}), node("Move", {{"waypoint", "pick"}}),
+                 node("Close"), node("Move", {{"waypoint", "above_pick"}})}));
+  const HttpResponse started = h.call("POST", "/api/runs", {{"plan", p}});
+  ASSERT_EQ(started.status, 202) << started.body;
+  EXPECT_EQ(h.call("POST", "/api/scene/reset").status, 409);  // not while it runs
+  ASSERT_EQ(h.waitForRun(json::parse(started.body)["run"])["result"], "SUCCESS");
+  const json lifted = h.get("/api/test/ground_truth");
+  ASSERT_GT(lifted["parts"][0]["p"][2].get<double>() - before["parts"][0]["p"][2].get<double>(), 0.08);
+
+  const HttpResponse reset = h.call("POST", "/api/scene/reset");
+  ASSERT_EQ(reset.status, 200) << reset.body;
+  const json after = h.get("/api/test/ground_truth");
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(after["parts"][0]["p"][i].get<double>(), before["parts"][0]["p"][i].get<double>(), 1e-3);
+    EXPECT_NEAR(after["tcp"]["p"][i].get<double>(), before["tcp"]["p"][i].get<double>(), 1e-3);
+  }
+  EXPECT_FALSE(h.get("/api/state")["gripper"]["holding"].get<bool>());
+  // The cell works after the reset.
+  const HttpResponse again = h.call("POST", "/api/operations", {{"node", "Home"}});
+  ASSERT_EQ(again.status, 202) << again.body;
+  EXPECT_EQ(h.waitForRun(json::parse(again.body)["run"])["result"], "SUCCESS");
+  // A cell made without a way to make it again cannot reset.
+  Harness fixed(blindCell());
+  EXPECT_EQ(fixed.call("POST", "/api/scene/reset").status, 404);
 }
 
 TEST(Ur5Cell, GroundTruthIsOnlyForTests) {

@@ -3,6 +3,7 @@
 #include "server/store.h"
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include <filesystem>
 
@@ -144,6 +145,57 @@ TEST_F(StoreTest, RunsLeftOpenByADeadServerAreMarkedInterrupted) {
   }
   Store again(file_);
   EXPECT_EQ(again.run(1)->run.result, "INTERRUPTED");
+}
+
+// Runs name their cell and keep snapshots of it, oldest first.
+TEST_F(StoreTest, RunsKeepTheirCellAndSnapshotsInOrder) {
+  Store store(file_);
+  RunRecord run;
+  run.id = 3;
+  run.workcell = "iiwa-3f-sim";
+  store.beginRun(run, {});
+  store.appendStates(3, {{0.0, R"({"t":0})"}, {0.2, R"({"t":0.2})"}});
+  store.appendStates(3, {{0.4, R"({"t":0.4})"}});
+  const auto states = store.runStates(3);
+  ASSERT_EQ(states.size(), 3u);
+  EXPECT_DOUBLE_EQ(states[2].t, 0.4);
+  EXPECT_EQ(states[1].state, R"({"t":0.2})");
+  EXPECT_TRUE(store.runStates(4).empty());
+  EXPECT_EQ(store.runs()[0].workcell, "iiwa-3f-sim");
+  EXPECT_EQ(store.run(3)->run.workcell, "iiwa-3f-sim");
+}
+
+// A store written before runs named their cell opens with its runs intact (an empty cell name)
+// and logs new runs with theirs.
+TEST_F(StoreTest, AStoreFromBeforeRunsNamedTheirCellGetsTheColumn) {
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file_.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db,
+                           "CREATE TABLE runs (id INTEGER PRIMARY KEY, plan TEXT NOT NULL, version INTEGER NOT NULL, "
+                           "xml TEXT NOT NULL, started_at REAL NOT NULL, result TEXT NOT NULL DEFAULT '', ended_at "
+                           "REAL NOT NULL DEFAULT 0, clock_seconds REAL NOT NULL DEFAULT 0, failure_path TEXT NOT NULL "
+                           "DEFAULT '', failure_reason TEXT NOT NULL DEFAULT '', transitions INTEGER NOT NULL DEFAULT "
+                           "0, truncated INTEGER NOT NULL DEFAULT 0);"
+                           "INSERT INTO runs (id, plan, version, xml, started_at, result) "
+                           "VALUES (1, 'old', 2, '<root/>', 1.0, 'SUCCESS');",
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+  }
+  Store store(file_);
+  const auto old = store.run(1);
+  ASSERT_TRUE(old);
+  EXPECT_EQ(old->run.plan, "old");
+  EXPECT_EQ(old->run.result, "SUCCESS");
+  EXPECT_EQ(old->run.workcell, "");
+  RunRecord next;
+  next.id = 2;
+  next.workcell = "ur5-sim";
+  store.beginRun(next, {});
+  EXPECT_EQ(store.runs()[0].workcell, "ur5-sim");
+  Store again(file_);  // opening it again adds nothing twice
+  EXPECT_EQ(again.runs().size(), 2u);
 }
 
 TEST_F(StoreTest, RefusesAFileItCannotOpen) {

@@ -13,68 +13,16 @@
 // (--docs-screenshot: the finished run at 1600x1000 there, and at 1280x800 beside it as
 // NAME_1280x800.png)
 
-import { spawn, spawnSync } from 'node:child_process';
+import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
-import os from 'node:os';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { chromium } from 'playwright-core';
+import { actionCounter, args, artifacts, costar, groundTruth, launchBrowser, makeLog, openPage, readability, root, startServer, waitForRunEnd } from './lib.mjs';
 
 const MAX_ACTIONS = 30;
-const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
-const args = Object.fromEntries(
-  process.argv.slice(2).reduce((pairs, arg, i, all) => (arg.startsWith('--') ? [...pairs, [arg.slice(2), all[i + 1]]] : pairs), []),
-);
-const costar = path.resolve(args.costar ?? path.join(root, 'build/cli/costar'));
-const artifacts = path.resolve(args.artifacts ?? path.join(root, 'build/test-artifacts'));
-const chromiumPath = args.chromium ?? '/usr/bin/chromium';
-fs.mkdirSync(artifacts, { recursive: true });
-
-const work = fs.mkdtempSync(path.join(os.tmpdir(), 'costar-e2e-'));
-const waypoints = path.join(work, 'waypoints.json');
-fs.copyFileSync(path.join(root, 'examples/ur5/blind_waypoints.json'), waypoints);
-const tokenFile = path.join(work, 'token');
-const scene = path.join(root, 'sim/scenes/assembly.json');
-
+const scene = 'sim/scenes/assembly.json';
+const { log, check } = makeLog('e2e');
 let server;
 let browser;
-const log = (...m) => console.log('e2e:', ...m);
-function check(condition, message) {
-  if (!condition) throw new Error(message);
-  log('ok -', message);
-}
-
-// At the real pace (--pace 1), as a person sees it: the page follows a held part from the live
-// snapshots (20 a second), which at --pace 0 are far apart in simulated time (the tool moves
-// 10 cm between two), too sparse to say where a part was let go.
-async function startServer() {
-  server = spawn(
-    costar,
-    ['serve', '--port', '0', '--scene', scene, '--waypoints', waypoints, '--store', path.join(work, 'editor.sqlite'),
-      '--token-file', tokenFile, '--web-root', path.join(root, 'web/dist'), '--pace', '1', '--test-endpoints'],
-    { stdio: ['ignore', 'pipe', 'pipe'] },
-  );
-  server.stderr.on('data', (d) => process.stderr.write(`serve: ${d}`));
-  return new Promise((resolve, reject) => {
-    let text = '';
-    const timer = setTimeout(() => reject(new Error('costar serve did not start within 60 s')), 60000);
-    server.stdout.on('data', (d) => {
-      text += d;
-      const listening = /listening on (http:\/\/\S+)/.exec(text);
-      if (listening) {
-        clearTimeout(timer);
-        resolve({ url: listening[1], open: /open the editor at (\S+)/.exec(text)?.[1] ?? '' });
-      }
-    });
-    server.on('exit', (code) => reject(new Error(`costar serve exited with ${code}`)));
-  });
-}
-
-async function groundTruth(url, token) {
-  const response = await fetch(`${url}api/test/ground_truth`, { headers: { Authorization: `Bearer ${token}` } });
-  if (!response.ok) throw new Error(`ground truth: ${response.status}`);
-  return response.json();
-}
 
 // The judge of `costar trials --judge assembly` (trials/judge.cpp), on the simulator's true state.
 const NODE_HALF = 0.025;
@@ -104,39 +52,22 @@ function wholeInPane(nodes) {
 async function main() {
   check(fs.existsSync(costar), `the costar executable exists (${costar})`);
   check(fs.existsSync(path.join(root, 'web/dist/index.html')), 'the page is built (web/dist)');
-  const { url, open } = await startServer();
-  const token = fs.readFileSync(tokenFile, 'utf8').trim();
+  // At the real pace (--pace 1), as a person sees it: the page follows a held part from the
+  // live snapshots (20 a second), which at --pace 0 are far apart in simulated time (the tool
+  // moves 10 cm between two), too sparse to say where a part was let go.
+  server = await startServer({ scene, waypoints: 'examples/ur5/blind_waypoints.json', pace: 1 });
+  const { url, open, token } = server;
   check(open === `${url}#token=${token}`, `costar serve --token-file prints the address with the token (${open.replace(token, '…')})`);
 
-  browser = await chromium.launch({
-    executablePath: chromiumPath,
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync',
-      '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-  });
-  const context = await browser.newContext({ viewport: { width: 1600, height: 1000 } });
-  const page = await context.newPage();
+  browser = await launchBrowser();
   const pageErrors = [];
-  page.on('pageerror', (e) => pageErrors.push(e.message));
-  await page.goto(open);
-  await page.waitForSelector('.connection.on', { timeout: 30000 });
+  const { context, page } = await openPage(browser, open, pageErrors);
   await page.waitForSelector('[data-node-type="SmartRelease"].palette-item');
   check((await page.$('[role="dialog"][aria-label="Sign in"]')) === null, 'the printed address signs in: no sign-in box');
 
   // --- build the structure assembly: every UI action is counted ---------------------------
-  let actions = 0;
-  const act = async (what, fn) => {
-    actions += 1;
-    await fn();
-    log(`action ${actions}: ${what}`);
-  };
-  const palette = (type) => act(`click ${type} in the operations`, () => page.click(`.palette-item[data-node-type="${type}"]`));
-  const choose = (port, value) => act(`choose ${port} = ${value}`, () => page.selectOption(`#port-${port}`, value));
-  const condition = (name) => act(`add condition ${name}(part, table_center)`, () => page.selectOption('select[aria-label="add condition"]', name));
-  const node = (type, n) => page.locator(`.tree-node[data-node-type="${type}"]`).nth(n);
-  const clickNode = (type, n, modifiers) =>
-    act(`${modifiers ? 'shift+' : ''}click ${type} #${n + 1} in the tree`, () => node(type, n).click({ modifiers }));
-  const key = (combo) => act(`press ${combo}`, () => page.keyboard.press(combo));
+  const counter = actionCounter(page, log);
+  const { act, palette, choose, condition, node, clickNode, key } = counter;
 
   // The new plan's root Sequence is selected: each operation clicked goes after the last one.
   await palette('Open');
@@ -185,19 +116,13 @@ async function main() {
   await act('click Save', () => page.click('button:has-text("Save")'));
   await page.waitForSelector('text=Saved assemble_structure version 1', { timeout: 15000 });
   await act('click Run', () => page.click('button:has-text("Run")'));
+  const actions = counter.actions;
   check(actions <= MAX_ACTIONS, `the whole task took ${actions} UI actions (at most ${MAX_ACTIONS}), save and run included`);
+  fs.writeFileSync(path.join(artifacts, 'actions_assembly.txt'), `${actions}\n`);
 
-  let sawRunning = false;
-  const deadline = Date.now() + 240000;
-  while (Date.now() < deadline) {
-    if (await page.$('.tree-node[data-running="true"]')) sawRunning = true;
-    if (await page.getAttribute('.run-label', 'data-run-result')) break;
-    await page.waitForTimeout(100);
-  }
-  const result = await page.getAttribute('.run-label', 'data-run-result');
-  const label = await page.textContent('.run-label');
+  const { result, label, sawRunning } = await waitForRunEnd(page);
   check(result === 'SUCCESS', `the run ended with ${result}: ${label}`);
-  check(/^Run #1 /.test(label ?? ''), `plan runs are numbered by plan runs only: "${label}"`);
+  check(/^Run #1 \(assemble_structure v1\) on ur5-sim: SUCCESS/.test(label ?? ''), `plan runs are numbered by plan runs only, and name their plan and cell: "${label}"`);
   check(sawRunning, 'the running node was highlighted while it ran');
   const statuses = await page.$$eval('.tree-node', (nodes) => nodes.map((n) => n.getAttribute('data-status')));
   check(statuses.every((s) => s === 'SUCCESS'), `every node is green (SUCCESS): ${statuses.join(', ')}`);
@@ -244,7 +169,15 @@ async function main() {
   await page.screenshot({ path: path.join(artifacts, 'editor_run_1280x800.png') });
   if (args['docs-screenshot']) fs.copyFileSync(path.join(artifacts, 'editor_run_1280x800.png'), path.resolve(args['docs-screenshot']).replace(/\.png$/, '_1280x800.png'));
   const visible = await page.$$eval('.tree-node', wholeInPane);
-  check(visible >= 12, `at 1280x800 the tree shows ${visible} of 15 nodes whole`);
+  const readable = await page.evaluate(readability);
+  log(`at 1280x800: ${visible} of 15 boxes whole; smallest text in the tree ${readable.smallest.toFixed(2)} px (${readable.smallestWhat}) at zoom ${readable.zoom}`);
+  fs.writeFileSync(path.join(artifacts, 'readability_1280x800.json'), JSON.stringify({ visible, ...readable }, null, 2));
+  check(readable.smallest >= 11, `at 1280x800 the tree's smallest text is ${readable.smallest.toFixed(2)} px (at least 11)`);
+  check(readable.problems.length === 0, `at 1280x800 no element overflows its pane or clips its text${readable.problems.length ? ': ' + readable.problems.join('; ') : ''}`);
+  const menuHeight = await page.$eval('.menu', (m) => m.getBoundingClientRect().height);
+  const buttonHeight = await page.$eval('.menu button', (b) => b.getBoundingClientRect().height);
+  check(menuHeight < 2 * buttonHeight, `the menu bar is one row at 1280x800 (${menuHeight} px high, buttons ${buttonHeight} px)`);
+  check(visible >= 9, `at 1280x800 the tree shows ${visible} of 15 nodes whole at a readable zoom (the rest a scroll away)`);
 
   // Undo, redo, keyboard help.
   await page.keyboard.press('?');
@@ -257,8 +190,8 @@ async function main() {
   await page.waitForTimeout(600);
   await page.screenshot({ path: path.join(artifacts, 'editor_run_1280x800_larger_tree.png') });
   const whole = await page.$$eval('.tree-node', wholeInPane);
-  const zoom = await page.$eval('.react-flow__viewport', (v) => Number(/scale\(([\d.]+)\)/.exec(v.style.transform)?.[1]));
-  check(whole === 15 && zoom >= 0.75, `with the larger tree (M) at 1280x800 all ${whole} of 15 nodes show whole, at zoom ${zoom.toFixed(2)}`);
+  const large = await page.evaluate(readability);
+  check(whole === 15 && large.smallest >= 11, `with the larger tree (M) at 1280x800 all ${whole} of 15 nodes show whole, smallest text ${large.smallest.toFixed(2)} px`);
   await node('Home', 3).click();
   await page.keyboard.press('Delete');
   check((await page.$$('.tree-node')).length === 14, 'Delete removes the selected node');
@@ -279,12 +212,35 @@ async function main() {
     await page.fill(slider, String(index));
     return page.$$eval('.tree-node', (nodes) => nodes.map((n) => n.getAttribute('data-status')));
   };
+  const cellAt = async () => ({
+    objects: await page.$$eval('.objects-table tbody tr', (rows) => rows.length),
+    tool: await page.getAttribute('.view3d-canvas', 'data-drawn-tool'),
+    label: await page.textContent('.view3d-replay').catch(() => ''),
+  });
   const atStart = await statusesAt(0);
+  await page.waitForTimeout(300);
+  const cellAtStart = await cellAt();
+  // The arm as replayed at eight points of the run: it moves (it is home at the start and at
+  // the end, and at each Home in between).
+  const tools = new Set();
+  for (let k = 1; k < 8; k++) {
+    await statusesAt(Math.floor((k * total) / 8));
+    await page.waitForTimeout(150);
+    tools.add((await cellAt()).tool);
+  }
   const atMiddle = await statusesAt(Math.floor(total / 2));
   const atEnd = await statusesAt(total);
+  await page.waitForTimeout(300);
+  const cellAtEnd = await cellAt();
   check(total > 20 && atStart.every((s) => s === 'IDLE'), `replay of run #${runId} starts with every node idle (${total} transitions)`);
   check(atMiddle.includes('SUCCESS') && !atMiddle.every((s) => s === 'SUCCESS'), 'half way some nodes are done');
   check(atEnd.every((s) => s === 'SUCCESS'), 'at the end of the replay every node is green');
+  const parts = second.parts.length;
+  tools.delete(cellAtStart.tool);
+  check(
+    cellAtStart.objects === 0 && cellAtEnd.objects === parts && tools.size >= 3 && /replay/.test(cellAtEnd.label ?? ''),
+    `the replay drives the Objects pane and the 3D view from the run's log: ${cellAtStart.objects} parts at the start, ${cellAtEnd.objects} of ${parts} at the end; the tool drawn at ${tools.size} other places of 7 along the run ("${cellAtEnd.label}")`,
+  );
   await page.click('button:text-is("Back to editing")');
 
   // Reloaded, a new plan shows no status of the plan that ran.
@@ -312,10 +268,10 @@ async function main() {
 
   // The saved plan is the file the CLI runs.
   const xml = await (await fetch(`${url}api/plans/assemble_structure/xml`)).text();
-  const file = path.join(work, 'assemble_structure.xml');
+  const file = path.join(server.work, 'assemble_structure.xml');
   fs.writeFileSync(file, xml);
   fs.copyFileSync(file, path.join(artifacts, 'assemble_structure.xml'));
-  const cli = spawnSync(costar, ['run', file, '--scene', scene, '--waypoints', waypoints, '-q'], { encoding: 'utf8' });
+  const cli = spawnSync(costar, ['run', file, '--scene', path.join(root, scene), '--waypoints', server.waypointFile, '-q'], { encoding: 'utf8' });
   check(cli.status === 0, `costar run on the saved plan succeeds: ${cli.stdout.trim()} ${cli.stderr.trim()}`);
 
   check(pageErrors.length === 0, `no errors in the page${pageErrors.length ? ': ' + pageErrors.join('; ') : ''}`);
@@ -336,7 +292,6 @@ try {
   }
 } finally {
   await browser?.close();
-  server?.kill('SIGTERM');
-  fs.rmSync(work, { recursive: true, force: true });
+  server?.stop();
 }
 process.exit(failed ? 1 : 0);

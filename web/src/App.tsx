@@ -1,15 +1,35 @@
-// The task editor (the paper's Fig. 5): 1 objects and SmartMove candidates, 2 the cell in 3D,
-// 3 waypoints, 4 the tree workspace, 5 customise the selected operation, 6 the operations,
-// 7 live execution and replay, 8 the menu of quick actions.
+// The task editor (the paper's Fig. 5) and the cell's control panel: 1 objects and SmartMove
+// candidates, 2 the cell in 3D, 3 waypoints and jogging, 4 the tree workspace, 5 customise the
+// selected operation, 6 the operations, 7 live execution and replay, 8 the menu.
+//
+// What the cell does is the cell's, not the page's: the active run (whoever started it, before
+// or after a reload) is shown and can be paused, stepped and stopped from any signed-in page;
+// every control the cell would refuse is disabled and says why (model/controls.ts). Lists,
+// Check and the nodes' badges follow what the cell knows now and the plan as it is now.
 
 import { useCallback, useEffect, useMemo, useRef, useState } from 'react';
-import { Api, ApiError, CellState, Choices, Diagnostic, Info, NodeInfo, RunInfo, RunLog } from './api';
+import { Api, ApiError, CellState, Choices, Diagnostic, Info, NodeInfo, RunInfo, RunLog, StoredRun } from './api';
 import { Stream, StreamMessage } from './stream';
 import { readToken, storeToken, tokenFromHash } from './token';
 import * as T from './model/tree';
 import { EditorPlan } from './model/tree';
 import { canRedo, canUndo, History, push, redo, replace, startHistory, undo } from './model/history';
-import { mapRun, mergeStatuses, NodeRef, NodeStatus, statusesAt, statusesByKey } from './model/status';
+import {
+  MappedRef,
+  mapRun,
+  mapRunOnto,
+  mergeStatuses,
+  NodeRef,
+  NodeStatus,
+  runningNode,
+  statusesAt,
+  statusesByKey,
+  unchangedStatusesByKey,
+} from './model/status';
+import { controlRefusal, motionRefusal, resetRefusal, runRefusal, saveRefusal } from './model/controls';
+import { fixFor, renameWaypoint, waypointUses } from './model/fixes';
+import type { DiffEntry } from './model/diff';
+import type { RobotDescription } from './model/robot';
 import { Palette } from './components/Palette';
 import { Orientation, SelectMode, TreeCanvas } from './components/TreeCanvas';
 import { HelpOverlay } from './components/HelpOverlay';
@@ -19,12 +39,13 @@ import { candidatesOf, ObjectsPane } from './components/ObjectsPane';
 import { Waypoints } from './components/Waypoints';
 import { View3D } from './components/View3D';
 import { Replay } from './components/Replay';
+import { PlanBrowser } from './components/PlanBrowser';
 import { Believed, believe, emptyBelief } from './model/belief';
 
-interface LiveRun {
+/** The cell's current (or last) plan run, as the stream tells it. */
+interface CellRun {
   run: RunInfo;
   statuses: Map<number, NodeStatus>;
-  mapping: Map<number, NodeRef>;
 }
 
 interface OperationState {
@@ -40,9 +61,17 @@ interface ReplayState {
   plan: EditorPlan;
   mapping: Map<number, NodeRef>;
   index: number;
+  /** The cell's snapshots during the run (clock seconds since its start). */
+  states: { t: number; state: CellState }[];
 }
 
+/** The last thing done from this page (one at a time: the status line shows only it). */
 type Message = { text: string; kind: 'info' | 'error' } | null;
+
+interface Offer {
+  label: string;
+  apply: () => void;
+}
 
 /**
  * The menu's quick actions (pane 8): each runs one operation of the workcell outside a plan.
@@ -61,14 +90,22 @@ function quickActions(info: Info | null): { label: string; node: string; title: 
 
 const NAME_PATTERN = /^[A-Za-z0-9][A-Za-z0-9_-]{0,63}$/;
 
+/** A node of a run as people read it: type and name. */
+function nodeLabel(node: { id: string; name: string } | undefined) {
+  return node ? `${node.id}${node.name ? ` “${node.name}”` : ''}` : '';
+}
+
 export function App() {
   const [token, setToken] = useState(readToken);
   const api = useMemo(() => new Api(token), [token]);
   const [info, setInfo] = useState<Info | null>(null);
   const [nodes, setNodes] = useState<NodeInfo[]>([]);
   const [choices, setChoices] = useState<Choices | null>(null);
+  const [robot, setRobot] = useState<RobotDescription | null>(null);
   const [cell, setCell] = useState<CellState | null>(null);
   const [connected, setConnected] = useState(false);
+  // The server refused the token (401, or the stream's auth answer).
+  const [tokenRefused, setTokenRefused] = useState(false);
 
   const planNameRef = useRef('');
   const [history, setHistory] = useState<History<EditorPlan>>(() => startHistory(T.emptyPlan()));
@@ -84,30 +121,43 @@ export function App() {
   const [clipboard, setClipboard] = useState<T.EditorNode[]>([]);
   const [orientation, setOrientation] = useState<Orientation>('LR');
   const [help, setHelp] = useState(false);
+  const [browsing, setBrowsing] = useState(false);
   // The larger tree (M): the cell, the waypoints and the runs fold away.
   const [large, setLarge] = useState(false);
   const [fitRequest, setFitRequest] = useState(0);
   // Sign-in: 'missing' without a token, 'wrong' when the server refused it.
   const [signIn, setSignIn] = useState<'missing' | 'wrong' | null>(() => (readToken() ? null : 'missing'));
-  // Plan runs started from this page: their statuses are painted on this plan.
-  const startedHere = useRef(new Set<number>());
-  const endedRuns = useRef(new Set<number>());
   const [planName, setPlanNameState] = useState('');
   const setPlanName = (name: string) => {
     planNameRef.current = name;
     setPlanNameState(name);
   };
   const [saved, setSaved] = useState<{ name: string; plan: EditorPlan; version: number } | null>(null);
-  const [savedPlans, setSavedPlans] = useState<{ name: string; latest_version: number }[]>([]);
   const [savedSubtrees, setSavedSubtrees] = useState<{ name: string }[]>([]);
   const [subtreeChoice, setSubtreeChoice] = useState('');
   const [diagnostics, setDiagnostics] = useState<Diagnostic[]>([]);
   const [message, setMessage] = useState<Message>(null);
+  const [offer, setOffer] = useState<Offer | null>(null);
+  const say = (text: string, kind: 'info' | 'error' = 'info', next: Offer | null = null) => {
+    setMessage({ text, kind });
+    setOffer(next);
+  };
 
-  const [live, setLive] = useState<LiveRun | null>(null);
+  // The cell's run and which of the open plan's nodes it maps onto (null: it is another plan).
+  const [cellRun, setCellRun] = useState<CellRun | null>(null);
+  const cellRunRef = useRef<CellRun | null>(null);
+  cellRunRef.current = cellRun;
+  const [shown, setShown] = useState<{ runId: number; mapping: Map<number, MappedRef> } | null>(null);
   const [operation, setOperation] = useState<OperationState | null>(null);
   const [replay, setReplay] = useState<ReplayState | null>(null);
-  const [runsRefresh, setRunsRefresh] = useState(0);
+  const [comparison, setComparison] = useState<{ label: string; entries: DiffEntry[] } | null>(null);
+  const [runs, setRuns] = useState<StoredRun[]>([]);
+  // Plan runs started from this page (mapped onto the plan open when they started).
+  const startedHere = useRef(new Map<number, EditorPlan>());
+  // Waypoint renames asked for here, by operation id: offered in the open plan when done.
+  const renames = useRef(new Map<number, { from: string; to: string }>());
+  // How operations ended, by id (the stream may tell before the request that started one returns).
+  const ended = useRef(new Map<number, string>());
 
   // The world the system believes (pane 1 lists it, pane 2 draws it): one step for every
   // snapshot as it arrives, not per render, so that a grasp or a release between two renders
@@ -123,75 +173,166 @@ export function App() {
 
   const planRef = useRef(plan);
   planRef.current = plan;
+  const savedRef = useRef(saved);
+  savedRef.current = saved;
   const nodeInfo = useCallback((id: string) => nodes.find((n) => n.id === id), [nodes]);
   const kindOf = useCallback((id: string) => nodeInfo(id)?.kind, [nodeInfo]);
+  const waypointPorts = useCallback(
+    (type: string) => nodeInfo(type)?.ports.filter((p) => p.choices_from === 'waypoint').map((p) => p.name) ?? [],
+    [nodeInfo],
+  );
 
   const fail = (e: unknown) => {
     const error = e as ApiError;
-    if (error.status === 401) setSignIn(token ? 'wrong' : 'missing');
-    setMessage({ text: error.message, kind: 'error' });
+    if (error.status === 401) {
+      setTokenRefused(!!token);
+      setSignIn(token ? 'wrong' : 'missing');
+    }
+    say(error.status === undefined ? `not connected to the cell (${error.message})` : error.message, 'error');
     if (error.diagnostics?.length) setDiagnostics(error.diagnostics);
   };
 
   const refreshLists = useCallback(() => {
     api.choices().then(setChoices, () => undefined);
-    api.plans().then(setSavedPlans, () => undefined);
     api.subtrees().then(setSavedSubtrees, () => undefined);
+    api.runs().then(setRuns, () => undefined);
   }, [api]);
 
+  // --- the open plan and the cell's run ------------------------------------------------------
+  /** Opens a plan in the editor (a fresh history). */
+  const loadPlan = (json: T.PlanJson, name: string, version?: number) => {
+    const next = T.fromPlanJson(json);
+    setHistory(startHistory(next));
+    planRef.current = next;
+    setTreeId(next.mainTree);
+    setSelectedKey(T.findTree(next, next.mainTree)?.root?.key ?? null);
+    setPlanName(name);
+    const savedNow = version ? { name, plan: next, version } : null;
+    setSaved(savedNow);
+    savedRef.current = savedNow;
+    setDiagnostics([]);
+    setReplay(null);
+    setComparison(null);
+    setShown(null);
+    return next;
+  };
+
+  /** Paints the run on the open plan, where its nodes are still what ran. */
+  const showRunOn = (run: RunInfo, open: EditorPlan) => {
+    const ran = run.plan_json ? T.fromPlanJson(run.plan_json) : undefined;
+    setShown({ runId: run.id, mapping: mapRunOnto(open, run.nodes ?? [], ran) });
+  };
+
+  /**
+   * The cell runs (or ran) a plan: show it on the open plan if that is the plan that runs;
+   * on a fresh page (nothing opened, nothing edited), open the plan that runs.
+   */
+  const adoptRun = (run: RunInfo) => {
+    const open = planRef.current;
+    const here = startedHere.current.get(run.id);
+    if (here) {
+      showRunOn(run, here);
+      return;
+    }
+    const pristine = !planNameRef.current && T.countNodes(open) <= 1 && history.past.length === 0;
+    const samePlan = !!run.plan && run.plan === planNameRef.current;
+    if (samePlan) {
+      showRunOn(run, open);
+    } else if (pristine && run.active && run.plan_json) {
+      const next = loadPlan(run.plan_json, run.plan, run.plan ? run.version : undefined);
+      showRunOn(run, next);
+    }
+  };
+
+  /** Opens the plan the cell runs (the status line's Show button). */
+  const showRunningPlan = () => {
+    if (!cellRun?.run.plan_json) return;
+    if (dirty && T.countNodes(plan) > 1 && !confirm('Discard the changes to this plan?')) return;
+    const run = cellRun.run;
+    const next = loadPlan(run.plan_json!, run.plan, run.plan ? run.version : undefined);
+    showRunOn(run, next);
+  };
+
+  /** A rename asked for here ended: offer to take it into the open plan if it names the old waypoint. */
+  const renamed = (id: number) => {
+    const rename = renames.current.get(id);
+    if (!rename || !ended.current.has(id)) return;
+    renames.current.delete(id);
+    if (ended.current.get(id) !== 'SUCCESS') return;
+    const uses = waypointUses(planRef.current, rename.from, waypointPorts);
+    if (uses === 0) return;
+    say(`Waypoint '${rename.from}' is now '${rename.to}': ${uses} node(s) of this plan still name '${rename.from}'.`, 'error', {
+      label: `Rename it in this plan (${uses})`,
+      apply: () => {
+        edit((p) => renameWaypoint(p, rename.from, rename.to, waypointPorts));
+        say(`Renamed '${rename.from}' to '${rename.to}' in this plan (not saved yet).`);
+      },
+    });
+  };
+
   // --- connection --------------------------------------------------------------------------
+  const messageHandler = useRef<(m: StreamMessage) => void>(() => undefined);
+  messageHandler.current = (m: StreamMessage) => {
+    switch (m.type) {
+      case 'hello': {
+        setInfo(m.info);
+        if (m.state) showCell(m.state);
+        const run = m.run;
+        if (run && run.kind === 'plan') {
+          setCellRun({ run, statuses: new Map((run.statuses ?? []).map((s) => [s.uid, s])) });
+          adoptRun(run);
+        } else if (run && run.kind === 'operation' && run.active) {
+          setOperation({ id: run.id, label: run.label, active: true });
+        }
+        break;
+      }
+      case 'state':
+        showCell(m as CellState);
+        break;
+      case 'run_started':
+        if (m.run.kind === 'plan') {
+          setCellRun({ run: m.run, statuses: new Map() });
+          adoptRun(m.run);
+          if (!startedHere.current.has(m.run.id)) say(`Run #${m.run.id} started${m.run.plan ? ` (${m.run.plan} v${m.run.version})` : ''} from another page.`);
+        } else {
+          setOperation({ id: m.run.id, label: m.run.label, active: true });
+        }
+        break;
+      case 'statuses':
+        setCellRun((c) => (c && c.run.id === m.run ? { ...c, statuses: mergeStatuses(c.statuses, m.nodes) } : c));
+        break;
+      case 'auth':
+        setTokenRefused(!m.ok);
+        if (!m.ok) setSignIn('wrong');
+        break;
+      case 'scene_reset':
+        beliefRef.current = emptyBelief();
+        break;
+      case 'run_ended':
+        if (m.run.kind === 'plan') {
+          setCellRun((c) => (c && c.run.id === m.run.id ? { ...c, run: { ...c.run, ...m.run, active: false } } : c));
+          setMessage((msg) => (msg && /^Run #\d+ started/.test(msg.text) ? null : msg));
+          api.runs().then(setRuns, () => undefined);
+        } else {
+          setOperation((o) => (o && o.id === m.run.id ? { ...o, active: false, result: m.run.result, reason: m.run.failure_reason } : o));
+          api.choices().then(setChoices, () => undefined);
+          ended.current.set(m.run.id, m.run.result);
+          renamed(m.run.id);
+        }
+        break;
+      default:
+        break;
+    }
+  };
+
   useEffect(() => {
     api.info().then(setInfo, fail);
     api.nodes().then(setNodes, fail);
+    api.robot().then(setRobot, () => setRobot(null));
     refreshLists();
     const stream = new Stream(token, {
       onConnection: setConnected,
-      onMessage: (m: StreamMessage) => {
-        switch (m.type) {
-          case 'hello':
-            setInfo(m.info);
-            if (m.state) showCell(m.state);
-            // The last run paints this plan only if it is a run of this plan (a reload starts
-            // a new plan: another plan's old FAILURE must not show on it).
-            if (m.run && m.run.kind === 'plan' && m.run.nodes && m.run.plan && m.run.plan === planNameRef.current) {
-              setLive({
-                run: m.run,
-                statuses: new Map((m.run.statuses ?? []).map((s) => [s.uid, s])),
-                mapping: mapRun(planRef.current, m.run.nodes),
-              });
-            }
-            break;
-          case 'state':
-            showCell(m as CellState);
-            break;
-          case 'run_started':
-            if (m.run.kind === 'plan') {
-              setLive({ run: m.run, statuses: new Map(), mapping: mapRun(planRef.current, m.run.nodes ?? []) });
-            } else {
-              setOperation({ id: m.run.id, label: m.run.label, active: true });
-            }
-            break;
-          case 'statuses':
-            setLive((l) => (l && l.run.id === m.run ? { ...l, statuses: mergeStatuses(l.statuses, m.nodes) } : l));
-            break;
-          case 'auth':
-            setSignIn(m.ok ? null : 'wrong');
-            break;
-          case 'run_ended':
-            endedRuns.current.add(m.run.id);
-            // "Run #N started." is over: the status line shows how it ended.
-            setMessage((msg) => (msg && /^Run #\d+ started/.test(msg.text) ? null : msg));
-            setLive((l) => (l && l.run.id === m.run.id ? { ...l, run: { ...l.run, ...m.run, active: false } } : l));
-            setOperation((o) =>
-              o && o.id === m.run.id ? { ...o, active: false, result: m.run.result, reason: m.run.failure_reason } : o,
-            );
-            if (m.run.kind === 'plan') setRunsRefresh((x) => x + 1);
-            else api.choices().then(setChoices, () => undefined);
-            break;
-          default:
-            break;
-        }
-      },
+      onMessage: (m) => messageHandler.current(m),
     });
     return () => stream.close();
     // eslint-disable-next-line react-hooks/exhaustive-deps
@@ -203,6 +344,7 @@ export function App() {
       const fresh = tokenFromHash();
       if (fresh) {
         setToken(fresh);
+        setTokenRefused(false);
         setSignIn(null);
       }
     };
@@ -210,24 +352,40 @@ export function App() {
     return () => window.removeEventListener('hashchange', onHash);
   }, []);
 
+  // --- what the cell would refuse ------------------------------------------------------------
+  const activeRun = cell && cell.mode !== 'idle' && cell.run ? cell.run : cellRun?.run.active ? cellRun.run.id : operation?.active ? operation.id : null;
+  const controls = {
+    connected,
+    signedIn: !!token && !tokenRefused,
+    activeRun,
+    replaying: !!replay,
+  };
+  const refusedRun = runRefusal(controls);
+  const refusedMotion = motionRefusal(controls);
+  const refusedControl = controlRefusal(controls);
+  const refusedSave = saveRefusal(controls);
+  const paused = cell?.mode === 'paused';
+
   // --- editing -------------------------------------------------------------------------------
   const edit = (change: (p: EditorPlan) => EditorPlan, select?: string | null) => {
     try {
-      const next = change(plan);
-      setHistory(push(history, next));
+      const next = change(planRef.current);
+      setHistory((h) => push(h, next));
+      planRef.current = next;
       if (select !== undefined) setSelectedKey(select);
       setMessage(null);
+      setOffer(null);
     } catch (e) {
-      setMessage({ text: (e as Error).message, kind: 'error' });
+      say((e as Error).message, 'error');
     }
   };
 
   // Inserting (the palette, paste): inside the selected node when it takes children, else
   // right after it; the inserted node is selected, so clicking operations one after another
   // builds a sequence in order.
-  const insert = (nodes: T.EditorNode[], at: string | null = selectedKey) => {
-    if (nodes.length === 0) return;
-    edit((p) => T.insertAt(p, treeId, at, nodes, kindOf), nodes[nodes.length - 1].key);
+  const insert = (inserted: T.EditorNode[], at: string | null = selectedKey) => {
+    if (inserted.length === 0) return;
+    edit((p) => T.insertAt(p, treeId, at, inserted, kindOf), inserted[inserted.length - 1].key);
   };
   const addNode = (type: string) => insert([T.makeNode(type)]);
   const selectedNodes = () => {
@@ -236,30 +394,30 @@ export function App() {
     return T.topmostSelected(root, keys);
   };
   const copy = () => {
-    const nodes = selectedNodes();
-    if (nodes.length === 0) return;
-    setClipboard(nodes.map(T.cloneNode));
-    setMessage({ text: `Copied ${nodes.length} node(s) with what is under them: Ctrl+V pastes after the selected node.`, kind: 'info' });
+    const chosen = selectedNodes();
+    if (chosen.length === 0) return;
+    setClipboard(chosen.map(T.cloneNode));
+    say(`Copied ${chosen.length} node(s) with what is under them: Ctrl+V pastes after the selected node.`);
   };
   const cut = () => {
-    const nodes = selectedNodes();
-    if (nodes.length === 0) return;
+    const chosen = selectedNodes();
+    if (chosen.length === 0) return;
     const root = T.findTree(plan, treeId)?.root ?? null;
-    const first = T.locate(root, nodes[0].key);
+    const first = T.locate(root, chosen[0].key);
     const before = first?.parent ? first.parent.children[first.index - 1]?.key ?? first.parent.key : null;
     try {
-      const next = T.removeNodes(plan, treeId, nodes.map((n) => n.key));
-      setClipboard(nodes.map(T.cloneNode));
+      const next = T.removeNodes(plan, treeId, chosen.map((n) => n.key));
+      setClipboard(chosen.map(T.cloneNode));
       setHistory(push(history, next));
       setSelectedKey(before);
-      setMessage({ text: `Cut ${nodes.length} node(s): Ctrl+V pastes them after the selected node.`, kind: 'info' });
+      say(`Cut ${chosen.length} node(s): Ctrl+V pastes them after the selected node.`);
     } catch (e) {
-      setMessage({ text: (e as Error).message, kind: 'error' });
+      say((e as Error).message, 'error');
     }
   };
   const paste = () => {
     if (clipboard.length === 0) {
-      setMessage({ text: 'Nothing to paste: copy (Ctrl+C) or cut (Ctrl+X) nodes first.', kind: 'error' });
+      say('Nothing to paste: copy (Ctrl+C) or cut (Ctrl+X) nodes first.', 'error');
       return;
     }
     // After the last selected node (a copied range stays selected), as fresh copies: the
@@ -268,15 +426,15 @@ export function App() {
     insert(clipboard.map(T.cloneNode), chosen.length ? chosen[chosen.length - 1].key : selectedKey);
   };
   const duplicate = () => {
-    const nodes = selectedNodes();
-    if (nodes.length === 0) return;
+    const chosen = selectedNodes();
+    if (chosen.length === 0) return;
     const root = T.findTree(plan, treeId)?.root ?? null;
-    const last = nodes[nodes.length - 1];
+    const last = chosen[chosen.length - 1];
     if (last.key === root?.key) {
-      setMessage({ text: 'The root cannot be duplicated: select nodes under it.', kind: 'error' });
+      say('The root cannot be duplicated: select nodes under it.', 'error');
       return;
     }
-    const copies = nodes.map(T.cloneNode);
+    const copies = chosen.map(T.cloneNode);
     edit((p) => {
       let next = p;
       let after = last.key;
@@ -288,12 +446,12 @@ export function App() {
     }, copies[copies.length - 1].key);
   };
   const removeSelected = () => {
-    const nodes = selectedNodes();
-    if (nodes.length === 0) return;
+    const chosen = selectedNodes();
+    if (chosen.length === 0) return;
     const root = T.findTree(plan, treeId)?.root ?? null;
-    const first = T.locate(root, nodes[0].key);
+    const first = T.locate(root, chosen[0].key);
     const next = first?.parent ? first.parent.children[first.index - 1]?.key ?? first.parent.key : null;
-    edit((p) => T.removeNodes(p, treeId, nodes.map((n) => n.key)), next);
+    edit((p) => T.removeNodes(p, treeId, chosen.map((n) => n.key)), next);
   };
   const select = (key: string, mode: SelectMode) => {
     const root = T.findTree(replay ? replay.plan : plan, treeId)?.root ?? null;
@@ -312,11 +470,10 @@ export function App() {
     setSelectedKey(key);
   };
 
-  const tree = T.findTree(replay ? replay.plan : plan, treeId) ?? T.findTree(replay ? replay.plan : plan, (replay ? replay.plan : plan).mainTree);
+  const shownPlan = replay ? replay.plan : plan;
+  const tree = T.findTree(shownPlan, treeId) ?? T.findTree(shownPlan, shownPlan.mainTree);
   const selected = tree && selectedKey ? T.locate(tree.root, selectedKey)?.node ?? null : null;
   const dirty = !saved || saved.name !== planName || !T.samePlan(saved.plan, plan);
-  const running = (live?.run.active ?? false) || (operation?.active ?? false);
-  const paused = cell?.mode === 'paused';
 
   useEffect(() => {
     const onKey = (e: KeyboardEvent) => {
@@ -338,15 +495,18 @@ export function App() {
       if (e.key === '?' || e.key === 'F1') setHelp((h) => !h);
       else if (e.key === 'Escape') {
         setHelp(false);
+        setBrowsing(false);
         if (selectedKey) setSelectedKey(selectedKey);
-      } else if (ctrl && key === 'z') setHistory(e.shiftKey ? redo(history) : undo(history));
-      else if (ctrl && key === 'y') setHistory(redo(history));
+      } else if (ctrl && key === 'z' && !replay) setHistory(e.shiftKey ? redo(history) : undo(history));
+      else if (ctrl && key === 'y' && !replay) setHistory(redo(history));
       else if (ctrl && key === 'c') copy();
       else if (ctrl && key === 'x' && !replay) cut();
       else if (ctrl && key === 'v' && !replay) paste();
       else if (ctrl && key === 'd' && !replay) duplicate();
-      else if (ctrl && key === 's') void save();
-      else if (!ctrl && !e.altKey && key === 'f') setFitRequest((n) => n + 1);
+      else if (ctrl && key === 's') {
+        if (refusedSave) say(`Not saved: ${refusedSave}.`, 'error');
+        else void save();
+      } else if (!ctrl && !e.altKey && key === 'f') setFitRequest((n) => n + 1);
       else if (!ctrl && !e.altKey && key === 'm') setLarge((l) => !l);
       else if ((e.key === 'Delete' || e.key === 'Backspace') && selectedKey && !replay) removeSelected();
       else if (e.altKey && selectedKey && !replay && (key === (lr ? 'arrowup' : 'arrowleft') || key === (lr ? 'arrowdown' : 'arrowright')))
@@ -367,7 +527,7 @@ export function App() {
     if (!hasDiagnostics || replay) return;
     const timer = setTimeout(() => {
       try {
-        api.validate(T.toPlanJson(plan)).then((r) => setDiagnostics(r.diagnostics), () => undefined);
+        api.validate(T.toPlanJson(plan), planName || undefined).then((r) => setDiagnostics(r.diagnostics), () => undefined);
       } catch {
         // an empty tree: Check says so when clicked
       }
@@ -377,30 +537,16 @@ export function App() {
   }, [plan, hasDiagnostics]);
 
   // --- files ---------------------------------------------------------------------------------
-  const loadPlan = (json: ReturnType<typeof T.toPlanJson>, name: string, version?: number) => {
-    const next = T.fromPlanJson(json);
-    setHistory(startHistory(next));
-    setTreeId(next.mainTree);
-    setSelectedKey(T.findTree(next, next.mainTree)?.root?.key ?? null);
-    setPlanName(name);
-    setSaved(version ? { name, plan: next, version } : null);
-    setDiagnostics([]);
-    setReplay(null);
-    // Another plan: the statuses of the last run belong to the plan that ran.
-    setLive((l) => (l && l.run.active && l.run.plan === name ? { ...l, mapping: mapRun(next, l.run.nodes ?? []) } : null));
-  };
-
   const save = async (): Promise<{ name: string; version: number } | null> => {
     if (!NAME_PATTERN.test(planName)) {
-      setMessage({ text: 'Give the plan a name: letters, digits, _ and - (it is not a path).', kind: 'error' });
+      say('Give the plan a name: letters, digits, _ and - (it is not a path).', 'error');
       return null;
     }
     try {
       const result = await api.savePlan(planName, T.toPlanJson(plan));
       setSaved({ name: planName, plan, version: result.version });
       setDiagnostics([]);
-      setMessage({ text: `Saved ${result.name} version ${result.version}.`, kind: 'info' });
-      refreshLists();
+      say(`Saved ${result.name} version ${result.version}.`);
       return result;
     } catch (e) {
       fail(e);
@@ -408,10 +554,42 @@ export function App() {
     }
   };
 
+  const check = async () => {
+    try {
+      const result = await api.validate(T.toPlanJson(plan), planName || undefined);
+      setDiagnostics(result.diagnostics);
+      if (result.valid) {
+        say(`${planName ? `Plan '${planName}'` : 'This plan'} is valid for ${info?.workcell ?? 'this cell'}.`);
+        return;
+      }
+      const first = result.diagnostics[0];
+      const count = result.diagnostics.length === 1 ? '1 problem' : `${result.diagnostics.length} problems`;
+      // A cure for the problem, else the offer standing (a rename to take into the plan).
+      say(`${count}: ${first.message}`, 'error', fixOffer(result.diagnostics) ?? offer);
+    } catch (e) {
+      fail(e);
+    }
+  };
+
+  /** The first of Check's problems the editor can cure, as a button. */
+  const fixOffer = (found: Diagnostic[]): Offer | null => {
+    for (const d of found) {
+      if (!d.node) continue;
+      const root = T.findTree(planRef.current, d.node.tree)?.root ?? null;
+      const node = T.nodeAtPath(root, d.node.path);
+      if (!node) continue;
+      const parent = T.locate(root, node.key)?.parent ?? null;
+      const fix = fixFor(d.message, d.node.tree, node, parent);
+      if (fix) return { label: fix.label, apply: () => edit(fix.apply) };
+    }
+    return null;
+  };
+
   const run = async (startPaused = false) => {
     setReplay(null);
     try {
       let started: { run: number };
+      const open = planRef.current;
       if (planName) {
         let version = saved?.version;
         if (dirty) {
@@ -423,8 +601,10 @@ export function App() {
       } else {
         started = await api.runPlan(T.toPlanJson(plan), startPaused);
       }
-      startedHere.current.add(started.run);
-      if (!endedRuns.current.has(started.run)) setMessage({ text: `Run #${started.run} started.`, kind: 'info' });
+      startedHere.current.set(started.run, open);
+      // The stream may have told of the start already: show it on this plan now.
+      if (cellRunRef.current?.run.id === started.run) showRunOn(cellRunRef.current.run, open);
+      say(`Run #${started.run} started${startPaused ? ' paused: Step ticks it once, Resume runs it' : ''}.`);
       setDiagnostics([]);
     } catch (e) {
       fail(e);
@@ -436,16 +616,41 @@ export function App() {
       const started = await api.operation(node, attributes);
       // The stream may have reported its start and end already: keep what it said.
       setOperation((o) => (o && o.id === started.run ? o : { id: started.run, label: node, active: true }));
+      setMessage(null);
+      setOffer(null);
+      return started.run;
+    } catch (e) {
+      fail(e);
+      return null;
+    }
+  };
+
+  const renameWaypointInCell = async (from: string, to: string) => {
+    const id = await runOperation('RenameWaypoint', { waypoint: from, new_name: to });
+    if (id === null) return;
+    renames.current.set(id, { from, to });
+    renamed(id);
+  };
+
+  const control = (action: 'pause' | 'resume' | 'step' | 'stop') =>
+    api.control(action).then(
+      () => setMessage(null),
+      (e) => fail(e),
+    );
+
+  const resetScene = async () => {
+    try {
+      await api.resetScene();
+      beliefRef.current = emptyBelief();
+      say('Scene reset: the parts where the scene puts them, the arm at home. Detect objects to see them.');
     } catch (e) {
       fail(e);
     }
   };
 
-  const control = (action: 'pause' | 'resume' | 'step' | 'stop') => api.control(action).catch(fail);
-
   const exportXml = async () => {
     try {
-      const result = await api.validate(T.toPlanJson(plan));
+      const result = await api.validate(T.toPlanJson(plan), planName || undefined);
       const blob = new Blob([result.xml], { type: 'application/xml' });
       const link = document.createElement('a');
       link.href = URL.createObjectURL(blob);
@@ -464,10 +669,8 @@ export function App() {
       const name = file.name.replace(/\.xml$/i, '').replace(/[^A-Za-z0-9_-]/g, '_').slice(0, 64);
       loadPlan(result.plan, name);
       setDiagnostics(result.diagnostics);
-      setMessage({
-        text: result.valid ? `Imported ${file.name} (not saved yet).` : `Imported ${file.name}: ${result.diagnostics.length} problem(s).`,
-        kind: result.valid ? 'info' : 'error',
-      });
+      if (result.valid) say(`Imported ${file.name} (not saved yet).`);
+      else say(`Imported ${file.name}: ${result.diagnostics.length} problem(s): ${result.diagnostics[0].message}`, 'error', fixOffer(result.diagnostics));
     } catch (e) {
       fail(e);
     }
@@ -479,7 +682,7 @@ export function App() {
     if (!name) return;
     try {
       const result = await api.saveSubtree(name, { main_tree: name, trees: [{ id: name, root: T.nodeToJson(selected) }] });
-      setMessage({ text: `Saved subtree ${name} version ${result.version}.`, kind: 'info' });
+      say(`Saved subtree ${name} version ${result.version}.`);
       refreshLists();
     } catch (e) {
       fail(e);
@@ -502,19 +705,47 @@ export function App() {
     }
   };
 
+  const openReplay = async (log: RunLog) => {
+    if (!log.plan_json) return;
+    const replayPlan = T.fromPlanJson(log.plan_json);
+    let states: { t: number; state: CellState }[] = [];
+    try {
+      // Logged snapshots carry no waypoints or frames (they are not the run's): none drawn.
+      states = (await api.runStates(log.id)).states.map(({ t, state }) => ({
+        t,
+        state: { ...state, waypoints: state.waypoints ?? [], frames: state.frames ?? [], objects: state.objects ?? [], predicates: state.predicates ?? [] },
+      }));
+    } catch {
+      // a run logged before snapshots were kept: the tree replays alone
+    }
+    setReplay({ log, plan: replayPlan, mapping: mapRun(replayPlan, log.nodes), index: log.transition_list.length, states });
+    setTreeId(replayPlan.mainTree);
+    setSelectedKey(null);
+  };
+
   // --- what the panes show ---------------------------------------------------------------------
-  // A run's statuses are painted on this plan when this page started it, or it is a run of
-  // the plan open here (by name); another plan's run only shows in the status line.
-  const liveIsOurs = !!live && (startedHere.current.has(live.run.id) || (!!live.run.plan && live.run.plan === planName));
-  const replayStatuses = useMemo(
-    () => (replay ? statusesAt(replay.log.transition_list, replay.index) : null),
-    [replay],
-  );
+  const replayStatuses = useMemo(() => (replay ? statusesAt(replay.log.transition_list, replay.index) : null), [replay]);
+  const runIsShown = !!cellRun && !!shown && shown.runId === cellRun.run.id;
   const shownStatuses = useMemo(() => {
     if (replay && replayStatuses) return statusesByKey(replayStatuses, replay.mapping, tree?.id ?? treeId);
-    if (live && liveIsOurs) return statusesByKey(live.statuses, live.mapping, tree?.id ?? treeId);
+    if (cellRun && shown && shown.runId === cellRun.run.id) return unchangedStatusesByKey(cellRun.statuses, shown.mapping, plan, tree?.id ?? treeId);
     return new Map<string, NodeStatus>();
-  }, [replay, replayStatuses, live, liveIsOurs, tree, treeId]);
+  }, [replay, replayStatuses, cellRun, shown, plan, tree, treeId]);
+  const runningKey = useMemo(() => {
+    for (const [key, status] of shownStatuses) if (status.status === 'RUNNING') return key;
+    return null;
+  }, [shownStatuses]);
+  const deepestRunningKey = useMemo(() => {
+    // The running leaf: a RUNNING node none of whose children runs.
+    let found: string | null = null;
+    const walk = (node: T.EditorNode | null) => {
+      if (!node) return;
+      if (shownStatuses.get(node.key)?.status === 'RUNNING') found = node.key;
+      node.children.forEach(walk);
+    };
+    if (runningKey) walk(tree?.root ?? null);
+    return found;
+  }, [shownStatuses, runningKey, tree]);
   const problems = useMemo(() => {
     const map = new Map<string, string>();
     for (const d of diagnostics) {
@@ -525,119 +756,156 @@ export function App() {
     }
     return map;
   }, [diagnostics, tree]);
+  const changes = useMemo(() => {
+    if (!comparison || replay) return undefined;
+    const map = new Map<string, 'added' | 'changed'>();
+    for (const entry of comparison.entries) {
+      if (entry.kind !== 'removed' && entry.tree === tree?.id) map.set(entry.key, entry.kind);
+    }
+    return map;
+  }, [comparison, replay, tree]);
+
+  // Replay: the cell as the run's log has it at the replayed moment (and what was believed then).
+  const replayed = useMemo(() => {
+    if (!replay || replay.states.length === 0) return null;
+    const t = replay.index > 0 ? replay.log.transition_list[replay.index - 1]?.t ?? 0 : 0;
+    let belief = emptyBelief();
+    let last: Believed | undefined;
+    let state: CellState | null = null;
+    for (const entry of replay.states) {
+      if (entry.t > t && state) break;
+      last = believe(belief, entry.state);
+      belief = last.belief;
+      state = entry.state;
+    }
+    return state ? { state, believed: last, t } : null;
+  }, [replay]);
+  const viewState = replayed ? replayed.state : cell;
+  const viewBelieved = replayed ? replayed.believed : believed;
+
   const selectedData = selected ? candidatesOf(shownStatuses.get(selected.key)?.data) : null;
-  const waypointChoices = useMemo(() => {
-    const names = new Set([...(choices?.waypoint ?? []), ...(cell?.waypoints.map((w) => w.name) ?? [])]);
-    return choices ? { ...choices, waypoint: [...names].sort() } : null;
+  // What the lists offer: what the cell knows now (the live snapshot), not what it knew when
+  // the page loaded.
+  const liveChoices = useMemo(() => {
+    if (!choices) return null;
+    if (!cell) return choices;
+    const waypoints = cell.waypoints.map((w) => w.name).sort();
+    const frames = new Set(['world', ...cell.frames.map((f) => f.name), ...cell.waypoints.filter((w) => w.kind === 'pose').map((w) => w.name), ...cell.objects.map((o) => o.name)]);
+    return { ...choices, waypoint: waypoints, frame: [...frames].sort((a, b) => (a === 'world' ? -1 : b === 'world' ? 1 : a.localeCompare(b))) };
   }, [choices, cell]);
 
-  const runLabel = live
-    ? `Run #${live.run.id}${live.run.plan ? ` (${live.run.plan}${live.run.version ? ` v${live.run.version}` : ''})` : ''}: ${
-        live.run.active ? (paused ? 'PAUSED' : 'RUNNING') : live.run.result
-      }${live.run.failure_reason ? ` at ${live.run.failure_path}: ${live.run.failure_reason}` : ''}`
-    : 'Nothing has run yet.';
+  const runLabel = (() => {
+    if (cellRun) {
+      const r = cellRun.run;
+      const what = `Run #${r.id}${r.plan ? ` (${r.plan} v${r.version})` : ' (unsaved plan)'}${r.workcell ? ` on ${r.workcell}` : ''}`;
+      if (r.active) {
+        const at = nodeLabel(runningNode(cellRun.statuses, r.nodes ?? []));
+        return `${what}: ${paused ? 'PAUSED' : 'RUNNING'}${at ? ` at ${at}` : ''}`;
+      }
+      return `${what}: ${r.result}${r.failure_reason ? ` at ${r.failure_path}: ${r.failure_reason}` : ''}`;
+    }
+    const last = runs[0];
+    if (last) return `Last run: #${last.id}${last.plan ? ` (${last.plan} v${last.version})` : ''}${last.workcell ? ` on ${last.workcell}` : ''}: ${last.result || 'INTERRUPTED'}`;
+    return 'Nothing has run yet.';
+  })();
+  const lastAction = message
+    ? message
+    : operation
+      ? {
+          text: `${operation.label}: ${operation.active ? 'running…' : operation.result}${operation.reason ? ` — ${operation.reason}` : ''}`,
+          kind: operation.result === 'FAILURE' ? ('error' as const) : ('info' as const),
+        }
+      : null;
+
+  const stepRefusal = activeRun !== null ? refusedControl : refusedRun;
 
   return (
     <div className={`app ${large ? 'tree-large' : ''}`}>
       {/* 8: the menu, with plan files and the run controls (7) */}
       <header className="menu" aria-label="Menu">
         <span className="brand">costar</span>
-        <span className="pane-number">8</span>
         {quickActions(info).map((action) => (
-          <button key={action.label} type="button" disabled={running} title={action.title} onClick={() => runOperation(action.node)}>
+          <button key={action.label} type="button" disabled={refusedMotion !== null} title={refusedMotion ?? action.title} onClick={() => runOperation(action.node)}>
             {action.label}
           </button>
         ))}
+        {info?.simulator && (
+          <button
+            type="button"
+            disabled={resetRefusal(controls) !== null}
+            title={resetRefusal(controls) ?? 'Build the simulated scene again from its file and seed, the arm at home'}
+            onClick={() => confirm('Reset the simulated scene? The parts go back where the scene puts them and the arm goes home.') && resetScene()}
+          >
+            Reset scene
+          </button>
+        )}
         <span className="separator" />
-        <input
-          className="plan-name"
-          aria-label="plan name"
-          placeholder="plan name"
-          value={planName}
-          onChange={(e) => setPlanName(e.target.value)}
-        />
-        <button type="button" onClick={save} disabled={!!replay}>
+        <input className="plan-name" aria-label="plan name" placeholder="plan name" value={planName} onChange={(e) => setPlanName(e.target.value)} />
+        <button type="button" onClick={save} disabled={refusedSave !== null} title={refusedSave ?? 'Save as the next version (Ctrl+S)'}>
           Save{dirty && planName ? ' *' : ''}
         </button>
-        <select
-          aria-label="load plan"
-          value=""
-          onChange={async (e) => {
-            const name = e.target.value;
-            if (!name) return;
-            if (dirty && T.countNodes(plan) > 1 && !confirm('Discard the changes to this plan?')) return;
-            try {
-              const doc = await api.plan(name);
-              loadPlan(doc.plan, doc.name, doc.version);
-              setMessage({ text: `Loaded ${doc.name} version ${doc.version}.`, kind: 'info' });
-            } catch (err) {
-              fail(err);
-            }
-          }}
-          onFocus={refreshLists}
-        >
-          <option value="">Load…</option>
-          {savedPlans.map((p) => (
-            <option key={p.name} value={p.name}>
-              {p.name} (v{p.latest_version})
-            </option>
-          ))}
-        </select>
+        <button type="button" onClick={() => setBrowsing(true)} title="Saved plans: open, compare or restore any version">
+          Plans…
+        </button>
         <button
           type="button"
           onClick={() => {
             if (dirty && T.countNodes(plan) > 1 && !confirm('Discard the changes to this plan?')) return;
             const next = T.emptyPlan();
             setHistory(startHistory(next));
+            planRef.current = next;
             setTreeId(next.mainTree);
             setSelectedKey(next.trees[0].root?.key ?? null);
             setPlanName('');
             setSaved(null);
             setDiagnostics([]);
-            setLive((l) => (l && l.run.active ? l : null));
+            setComparison(null);
+            setShown(null);
+            setMessage(null);
+            setOffer(null);
           }}
         >
           New
         </button>
-        <label className="file-button">
-          Import XML
+        <label className="file-button" title="Open a plan file (BehaviorTree.CPP v4 XML)">
+          Import
           <input type="file" accept=".xml,application/xml" onChange={(e) => e.target.files?.[0] && importXml(e.target.files[0])} />
         </label>
-        <button type="button" onClick={exportXml}>
-          Export XML
+        <button type="button" onClick={exportXml} title="Download the plan file that costar run runs">
+          Export
         </button>
-        <button
-          type="button"
-          onClick={async () => {
-            try {
-              const result = await api.validate(T.toPlanJson(plan));
-              setDiagnostics(result.diagnostics);
-              setMessage(
-                result.valid
-                  ? { text: 'The plan is valid for this workcell.', kind: 'info' }
-                  : { text: `${result.diagnostics.length} problem(s): ${result.diagnostics[0].message}`, kind: 'error' },
-              );
-            } catch (e) {
-              fail(e);
-            }
-          }}
-        >
+        <button type="button" onClick={check} title="Check the plan against this cell: its operations, waypoints, frames, gripper">
           Check
         </button>
         <span className="separator" />
-        <button type="button" className="run" disabled={running || !!replay} onClick={() => run(false)}>
+        <button type="button" className="run" disabled={refusedRun !== null} title={refusedRun ?? 'Run the plan on the cell (saves it first)'} onClick={() => run(false)}>
           ▶ Run
         </button>
-        <button type="button" disabled={!running} onClick={() => control(paused ? 'resume' : 'pause')}>
+        <button
+          type="button"
+          disabled={refusedControl !== null}
+          title={refusedControl ?? (paused ? 'Go on from where it paused' : 'Hold the run: the cell stands still, no time limit runs out')}
+          onClick={() => control(paused ? 'resume' : 'pause')}
+        >
           {paused ? 'Resume' : 'Pause'}
         </button>
-        <button type="button" disabled={!!replay || (running && !live?.run.active)} onClick={() => (running ? control('step') : run(true))}>
+        <button
+          type="button"
+          disabled={stepRefusal !== null}
+          title={stepRefusal ?? (activeRun !== null ? 'Tick the paused run once' : 'Start the plan paused, ticked one step')}
+          onClick={() => (activeRun !== null ? control('step') : run(true))}
+        >
           Step
         </button>
-        <button type="button" className="stop" disabled={!running} onClick={() => control('stop')}>
+        <button type="button" className="stop" disabled={refusedControl !== null} title={refusedControl ?? 'Stop the run: the arm decelerates and stops'} onClick={() => control('stop')}>
           ■ Stop
         </button>
-        <span className={`connection ${connected ? 'on' : 'off'}`}>{connected ? info?.workcell ?? 'connected' : 'disconnected'}</span>
+        <span
+          className={`connection ${connected ? (controls.signedIn ? 'on' : 'look') : 'off'}`}
+          title={connected ? (controls.signedIn ? 'connected and signed in' : 'connected, looking only: sign in to change plans or move the robot') : 'not connected to the cell'}
+        >
+          {connected ? `${info?.workcell ?? 'connected'}${controls.signedIn ? '' : ' (look only)'}` : 'not connected'}
+        </span>
       </header>
 
       {signIn && (
@@ -646,32 +914,90 @@ export function App() {
           onToken={(t) => {
             storeToken(t);
             setToken(t);
+            setTokenRefused(false);
             setSignIn(null);
           }}
           onDismiss={() => setSignIn(null)}
         />
       )}
       {help && <HelpOverlay onClose={() => setHelp(false)} />}
-      <div className={`status-line ${message?.kind ?? ''}`} role="status">
-        <span className="run-label" data-run-result={live && !live.run.active ? live.run.result : ''}>
+      {browsing && (
+        <PlanBrowser
+          api={api}
+          open={plan}
+          openName={planName}
+          saveRefusal={refusedSave}
+          onOpen={(json, name, version) => {
+            if (dirty && T.countNodes(plan) > 1 && !confirm('Discard the changes to this plan?')) return;
+            loadPlan(json, name, version);
+            setBrowsing(false);
+            say(`Opened ${name} version ${version}.`);
+          }}
+          onCompare={(label, entries) => {
+            setComparison({ label, entries });
+            setBrowsing(false);
+          }}
+          onRestore={(name, version, newVersion) => {
+            setBrowsing(false);
+            void api.plan(name, newVersion).then((doc) => {
+              loadPlan(doc.plan, doc.name, doc.version);
+              say(`Restored ${name} version ${version} as version ${newVersion}.`);
+            }, fail);
+          }}
+          onClose={() => setBrowsing(false)}
+          onError={fail}
+        />
+      )}
+      <div className={`status-line ${lastAction?.kind ?? ''}`} role="status">
+        <span className="run-label" data-run-result={cellRun && !cellRun.run.active ? cellRun.run.result : ''} data-run-active={cellRun?.run.active ? 'true' : 'false'}>
           {runLabel}
         </span>
-        {operation && (
-          <span className="operation" data-operation-result={operation.result ?? ''}>
-            {operation.label}: {operation.active ? 'running…' : operation.result}
-            {operation.reason ? ` — ${operation.reason}` : ''}
+        {cellRun && cellRun.run.plan_json && !runIsShown && !replay && (
+          <button type="button" className="small" onClick={showRunningPlan} title="Open the plan of this run in the editor">
+            Show it
+          </button>
+        )}
+        {lastAction && (
+          <span className="message" data-kind={lastAction.kind}>
+            {lastAction.text}
           </span>
         )}
-        {message && <span className="message">{message.text}</span>}
+        {offer && (
+          <button
+            type="button"
+            className="small offer"
+            onClick={() => {
+              offer.apply();
+            }}
+          >
+            {offer.label}
+          </button>
+        )}
       </div>
 
-      <Palette nodes={nodes} disabled={!!replay} onAdd={addNode} />
+      <Palette nodes={nodes} disabledReason={replay ? 'replaying a run: Back to editing first' : null} onAdd={addNode} />
 
       {/* 4: the workspace (and 7: live status on each node) */}
       <section className="pane workspace" aria-label="Behavior tree">
         <h2>
           <span className="pane-number">4</span> Behavior tree
+          {planName && !replay && (
+            <span className="plan-title">
+              {planName}
+              {saved ? ` v${saved.version}` : ''}
+              {dirty ? ' (changed)' : ''}
+            </span>
+          )}
           {replay && <span className="replaying">replaying run #{replay.log.id} (read only)</span>}
+          {comparison && !replay && (
+            <span className="comparing">
+              comparing: {comparison.label}
+              {comparison.entries.some((e) => e.kind === 'removed') && ` · removed: ${comparison.entries.filter((e) => e.kind === 'removed').map((e) => e.path.split(' › ').pop()).join(', ')}`}
+              <button type="button" className="small" onClick={() => setComparison(null)}>
+                Stop comparing
+              </button>
+            </span>
+          )}
         </h2>
         <div className="toolbar">
           <button type="button" disabled={!!replay || !selectedKey} onClick={copy} title="Copy the selected nodes and what is under them (Ctrl+C)">
@@ -686,20 +1012,10 @@ export function App() {
           <button type="button" disabled={!!replay || !selectedKey} onClick={duplicate} title="Duplicate right after (Ctrl+D)">
             Duplicate
           </button>
-          <button
-            type="button"
-            disabled={!!replay || !selectedKey}
-            title="Move before the previous sibling (Alt+↑)"
-            onClick={() => selectedKey && edit((p) => T.shiftNode(p, treeId, selectedKey, -1))}
-          >
+          <button type="button" disabled={!!replay || !selectedKey} title="Move before the previous sibling (Alt+↑)" onClick={() => selectedKey && edit((p) => T.shiftNode(p, treeId, selectedKey, -1))}>
             ↑
           </button>
-          <button
-            type="button"
-            disabled={!!replay || !selectedKey}
-            title="Move after the next sibling (Alt+↓)"
-            onClick={() => selectedKey && edit((p) => T.shiftNode(p, treeId, selectedKey, 1))}
-          >
+          <button type="button" disabled={!!replay || !selectedKey} title="Move after the next sibling (Alt+↓)" onClick={() => selectedKey && edit((p) => T.shiftNode(p, treeId, selectedKey, 1))}>
             ↓
           </button>
           <button type="button" disabled={!!replay || !selectedKey} onClick={removeSelected} title="Delete the selected nodes (Delete)">
@@ -737,11 +1053,11 @@ export function App() {
             ?
           </button>
           <span className="separator" />
-          <button type="button" disabled={!selected || !!replay} onClick={saveSubtree}>
+          <button type="button" disabled={!selected || refusedSave !== null} title={refusedSave ?? 'Save the selected node and what is under it by name'} onClick={saveSubtree}>
             Save subtree
           </button>
           <select aria-label="saved subtree" value={subtreeChoice} onChange={(e) => setSubtreeChoice(e.target.value)} onFocus={refreshLists}>
-            <option value="">saved subtrees…</option>
+            <option value="">subtrees…</option>
             {savedSubtrees.map((s) => (
               <option key={s.name} value={s.name}>
                 {s.name}
@@ -759,23 +1075,23 @@ export function App() {
             </>
           )}
         </div>
-        {(replay ? replay.plan : plan).trees.length > 1 && (
-        <div className="tabs">
-          {(replay ? replay.plan : plan).trees.map((t) => (
-            <button
-              type="button"
-              key={t.id}
-              className={t.id === tree?.id ? 'tab active' : 'tab'}
-              onClick={() => {
-                setTreeId(t.id);
-                setSelectedKey(t.root?.key ?? null);
-              }}
-            >
-              {t.id}
-              {t.id === (replay ? replay.plan : plan).mainTree ? ' (main)' : ''}
-            </button>
-          ))}
-        </div>
+        {shownPlan.trees.length > 1 && (
+          <div className="tabs">
+            {shownPlan.trees.map((t) => (
+              <button
+                type="button"
+                key={t.id}
+                className={t.id === tree?.id ? 'tab active' : 'tab'}
+                onClick={() => {
+                  setTreeId(t.id);
+                  setSelectedKey(t.root?.key ?? null);
+                }}
+              >
+                {t.id}
+                {t.id === shownPlan.mainTree ? ' (main)' : ''}
+              </button>
+            ))}
+          </div>
         )}
         <div className="tree-canvas" aria-label="tree canvas">
           <TreeCanvas
@@ -787,6 +1103,9 @@ export function App() {
             problems={problems}
             readOnly={!!replay}
             orientation={orientation}
+            paused={!replay && paused}
+            runningKey={deepestRunningKey}
+            changes={changes}
             fitRequest={fitRequest}
             onSelect={select}
             onToggle={(key) => setHistory(replace(history, T.toggleCollapsed(plan, treeId, key)))}
@@ -810,7 +1129,7 @@ export function App() {
       <NodeEditor
         node={selected}
         info={selected ? nodeInfo(selected.id) : undefined}
-        choices={waypointChoices}
+        choices={liveChoices}
         objects={cell?.objects.map((o) => o.name) ?? []}
         trees={plan.trees.map((t) => t.id).filter((id) => id !== treeId)}
         readOnly={!!replay}
@@ -819,28 +1138,32 @@ export function App() {
           edit((p) => (clear ?? []).reduce((q, other) => T.setAttribute(q, treeId, selectedKey, other, undefined), T.setAttribute(p, treeId, selectedKey, name, value)))
         }
       />
-      <ObjectsPane state={cell} selectedType={selected?.id ?? null} data={selectedData} shapes={choices?.object_shape} believed={believed} />
+      <ObjectsPane state={viewState} selectedType={selected?.id ?? null} data={selectedData} shapes={choices?.object_shape} believed={viewBelieved} />
       <View3D
-        state={cell}
+        state={viewState}
         candidates={selectedData?.candidates ?? []}
         selectedWaypoint={selected ? T.attribute(selected, 'waypoint') ?? null : null}
         api={api}
         pointCloudAvailable={info?.features.pointcloud ?? false}
         shapes={choices?.object_shape}
-        believed={believed}
+        believed={viewBelieved}
+        robot={robot}
+        replayLabel={replay ? (replayed ? `run #${replay.log.id} at t = ${replayed.t.toFixed(1)} s (replay)` : `run #${replay.log.id}: no snapshots logged (the cell now)`) : undefined}
       />
-      <Waypoints state={cell} choices={choices} busy={running} run={runOperation} />
+      <Waypoints
+        state={cell}
+        frames={liveChoices?.frame ?? ['world']}
+        robot={robot}
+        refusal={refusedMotion}
+        run={runOperation}
+        rename={renameWaypointInCell}
+      />
       <Replay
         api={api}
+        runs={runs}
         replay={replay ? { log: replay.log, index: replay.index } : null}
-        refreshKey={runsRefresh}
-        onOpen={(log) => {
-          if (!log.plan_json) return;
-          const replayPlan = T.fromPlanJson(log.plan_json);
-          setReplay({ log, plan: replayPlan, mapping: mapRun(replayPlan, log.nodes), index: log.transition_list.length });
-          setTreeId(replayPlan.mainTree);
-          setSelectedKey(null);
-        }}
+        onRefresh={() => api.runs().then(setRuns, () => undefined)}
+        onOpen={openReplay}
         onIndex={(index) => setReplay((r) => (r ? { ...r, index } : r))}
         onClose={() => {
           setReplay(null);

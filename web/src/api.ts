@@ -2,6 +2,7 @@
 
 import type { PlanJson } from './model/tree';
 import type { NodeStatus, RunNode, Transition } from './model/status';
+import type { FingerReading, RobotDescription } from './model/robot';
 
 export interface PortInfo {
   name: string;
@@ -62,7 +63,8 @@ export interface CellState {
   run: number;
   mode: 'idle' | 'running' | 'paused';
   arm: { joints?: number[]; endpoint?: Pose; moving?: boolean };
-  gripper: { open: boolean; closed: boolean; holding: boolean; mode?: string };
+  /** reading: the gripper_fingers symbol (2 fingers: their opening, m; 3 fingers: each one's position, 0 open .. 1 closed). */
+  gripper: { open: boolean; closed: boolean; holding: boolean; mode?: string; reading?: FingerReading };
   /** color: the mean RGB ([0, 1]) DetectObjects saw on the part, when it reported one. */
   objects: (Pose & { name: string; class: string; color?: [number, number, number] })[];
   waypoints: (Partial<Pose> & { name: string; kind: 'pose' | 'joints'; frame?: string })[];
@@ -76,7 +78,12 @@ export interface RunInfo {
   plan: string;
   version: number;
   label: string;
+  /** The cell it runs on. */
+  workcell?: string;
   active: boolean;
+  paused?: boolean;
+  /** A plan run's plan (the editor's JSON): any page can show what runs. */
+  plan_json?: PlanJson;
   result: string;
   failure_path?: string;
   failure_reason?: string;
@@ -90,6 +97,7 @@ export interface StoredRun {
   id: number;
   plan: string;
   version: number;
+  workcell?: string;
   started_at: number;
   result: string;
   clock_seconds: number;
@@ -151,7 +159,7 @@ export class Api {
   state = () => this.request<CellState>('GET', '/api/state');
   plans = () => this.request<{ name: string; latest_version: number; versions: number }[]>('GET', '/api/plans');
   plan = (name: string, version?: number) =>
-    this.request<{ name: string; version: number; xml: string; plan: PlanJson }>(
+    this.request<{ name: string; version: number; saved_at: number; xml: string; plan: PlanJson }>(
       'GET',
       `/api/plans/${encodeURIComponent(name)}${version ? `?version=${version}` : ''}`,
     );
@@ -165,8 +173,8 @@ export class Api {
     this.request<{ name: string; version: number; plan: PlanJson }>('GET', `/api/subtrees/${encodeURIComponent(name)}`);
   saveSubtree = (name: string, plan: PlanJson) =>
     this.request<{ name: string; version: number }>('PUT', `/api/subtrees/${encodeURIComponent(name)}`, { plan });
-  validate = (plan: PlanJson) =>
-    this.request<{ valid: boolean; diagnostics: Diagnostic[]; xml: string }>('POST', '/api/validate', { plan });
+  validate = (plan: PlanJson, name?: string) =>
+    this.request<{ valid: boolean; diagnostics: Diagnostic[]; xml: string }>('POST', '/api/validate', name ? { plan, name } : { plan });
   convertXml = (xml: string) =>
     this.request<{ valid: boolean; diagnostics: Diagnostic[]; xml: string; plan: PlanJson }>('POST', '/api/validate', {
       xml,
@@ -192,6 +200,11 @@ export class Api {
     }
     return log;
   };
+  versions = (name: string) =>
+    this.request<{ version: number; saved_at: number }[]>('GET', `/api/plans/${encodeURIComponent(name)}/versions`);
+  robot = () => this.request<RobotDescription>('GET', '/api/robot');
+  resetScene = () => this.request<{ reset: boolean }>('POST', '/api/scene/reset');
+  runStates = (id: number) => this.request<{ run: number; states: { t: number; state: CellState }[] }>('GET', `/api/runs/${id}/states`);
   pointCloud = (max = 20000) =>
     this.request<{ points: number[]; colors: number[]; t?: number }>('GET', `/api/pointcloud?max=${max}`);
 }

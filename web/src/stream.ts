@@ -11,6 +11,7 @@ export type StreamMessage =
   | { type: 'statuses'; run: number; nodes: NodeStatus[] }
   | { type: 'run_ended'; run: RunInfo }
   | { type: 'auth'; ok: boolean }
+  | { type: 'scene_reset'; t: number }
   | { type: 'control'; action: string; ok: boolean }
   | { type: 'error'; error: string };
 

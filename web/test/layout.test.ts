@@ -36,17 +36,23 @@ describe('the tree in its pane', () => {
 
   // Pane sizes measured in Chromium: the canvas at 1600x1000, at 1280x800, and at 1280x800 with
   // the larger tree (M).
+  it('never zooms a first view out below where its smallest text (11 px) reads at 11 px', () => {
+    expect(MIN_FIT_ZOOM).toBe(1);
+  });
+
   it('shows the whole structure assembly at 1600x1000, readable', () => {
     const view = wholeInView(assembly(), 1048, 558);
     expect(view.shown).toBe(15);
-    expect(view.zoom).toBeGreaterThanOrEqual(MIN_FIT_ZOOM);
+    expect(view.zoom).toBe(1);
   });
 
-  it('at 1280x800 shows most of it, and all of it with the larger tree', () => {
-    expect(wholeInView(assembly(), 796, 463).shown).toBeGreaterThanOrEqual(12);
+  it('at 1280x800 shows most of it readable, and all of it with the larger tree', () => {
+    const view = wholeInView(assembly(), 796, 463);
+    expect(view.zoom).toBe(1);
+    expect(view.shown).toBeGreaterThanOrEqual(11);
     const large = wholeInView(assembly(), 796, 638);
     expect(large.shown).toBe(15);
-    expect(large.zoom).toBeGreaterThan(0.9);
+    expect(large.zoom).toBe(1);
   });
 
   it('starts a tree too big to show readable at its top left, never below the minimum zoom', () => {

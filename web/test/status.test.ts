@@ -1,6 +1,18 @@
 import { describe, expect, it } from 'vitest';
 import * as T from '../src/model/tree';
-import { applyTransition, mapRun, mergeStatuses, NodeStatus, RunNode, statusesAt, statusesByKey, Transition } from '../src/model/status';
+import {
+  applyTransition,
+  mapRun,
+  mapRunOnto,
+  mergeStatuses,
+  NodeStatus,
+  RunNode,
+  runningNode,
+  statusesAt,
+  statusesByKey,
+  Transition,
+  unchangedStatusesByKey,
+} from '../src/model/status';
 
 // A plan with a SubTree: main = Sequence(Open, SubTree grasp, Move); grasp = Fallback(Close, Open).
 const plan = T.fromPlanJson({
@@ -90,5 +102,47 @@ describe('statuses', () => {
     const merged = mergeStatuses(statuses, [{ uid: 6, status: 'SUCCESS', last: 'SUCCESS' }]);
     expect(merged.get(6)?.last).toBe('SUCCESS');
     expect(statuses.has(6)).toBe(false);
+  });
+});
+
+describe("the cell's run on the plan open in the editor", () => {
+  const all = (status: NodeStatus['status']) => new Map(runNodes.map((n) => [n.uid, { uid: n.uid, status, last: status } as NodeStatus]));
+
+  it('clears the badge of a node edited since the run (and of its parent when a child is added), not the others', () => {
+    const mapping = mapRunOnto(plan, runNodes, plan);
+    const main = T.findTree(plan, 'main')!.root!;
+    const before = unchangedStatusesByKey(all('SUCCESS'), mapping, plan, 'main');
+    expect(before.size).toBe(4); // Sequence, Open, SubTree, Move
+    const moved = T.setAttribute(plan, 'main', main.children[2].key, 'waypoint', 'above_pick');
+    const after = unchangedStatusesByKey(all('SUCCESS'), mapping, moved, 'main');
+    expect(after.has(main.children[2].key)).toBe(false);
+    expect(after.has(main.children[0].key)).toBe(true);
+    expect(after.has(main.key)).toBe(true);
+    const added = T.addChild(plan, 'main', main.key, T.makeNode('Home'), () => 'Control');
+    const withChild = unchangedStatusesByKey(all('SUCCESS'), mapping, added, 'main');
+    expect(withChild.has(main.key)).toBe(false);
+    expect(withChild.has(main.children[1].key)).toBe(true);
+  });
+
+  it("maps only the nodes that are still what ran (the run's own plan says what that was)", () => {
+    const main = T.findTree(plan, 'main')!.root!;
+    // The plan open here has Move with a waypoint the run did not have.
+    const open = T.setAttribute(plan, 'main', main.children[2].key, 'waypoint', 'pick');
+    const mapping = mapRunOnto(open, runNodes, plan);
+    expect(mapping.has(6)).toBe(false);
+    expect(mapping.has(1)).toBe(true);
+    expect(mapping.get(5)?.tree).toBe('grasp');
+  });
+
+  it('names the node that runs now: the deepest one RUNNING', () => {
+    const statuses = new Map<number, NodeStatus>([
+      [0, { uid: 0, status: 'RUNNING', last: 'RUNNING' }],
+      [2, { uid: 2, status: 'RUNNING', last: 'RUNNING' }],
+      [3, { uid: 3, status: 'RUNNING', last: 'RUNNING' }],
+      [4, { uid: 4, status: 'RUNNING', last: 'RUNNING' }],
+      [1, { uid: 1, status: 'SUCCESS', last: 'SUCCESS' }],
+    ]);
+    expect(runningNode(statuses, runNodes)?.uid).toBe(4);
+    expect(runningNode(new Map(), runNodes)).toBeUndefined();
   });
 });

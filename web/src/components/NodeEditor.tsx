@@ -4,6 +4,7 @@
 import type { Choices, NodeInfo, PortInfo } from '../api';
 import type { EditorNode } from '../model/tree';
 import { formatPredicates, parsePredicates, PredicateTerm } from '../model/predicates';
+import { formatPoseText, parsePoseText, POSE_FIELDS, PoseFields } from '../model/poseText';
 
 interface Props {
   node: EditorNode | null;
@@ -29,21 +30,66 @@ function Select(props: {
   onChange: (value: string | undefined) => void;
 }) {
   const options = [...props.options];
-  if (props.current !== undefined && !options.includes(props.current)) options.unshift(props.current);
+  // A value the cell does not offer now (a waypoint renamed, a part no longer seen) stays shown,
+  // marked, until it is changed: Check flags it.
+  const unknown = props.current !== undefined && props.current !== '' && !options.includes(props.current);
+  if (unknown) options.unshift(props.current!);
   return (
     <select
       id={props.id}
       value={props.current ?? ''}
       disabled={props.disabled}
+      className={unknown ? 'unknown-choice' : undefined}
+      title={unknown ? `'${props.current}' is not in the cell now` : undefined}
       onChange={(e) => props.onChange(e.target.value === '' ? undefined : e.target.value)}
     >
       <option value="">{props.placeholder}</option>
       {options.map((option) => (
         <option key={option} value={option}>
-          {option === '' ? '(none)' : option}
+          {option === '' ? '(none)' : unknown && option === props.current ? `${option} (not in the cell now)` : option}
         </option>
       ))}
     </select>
+  );
+}
+
+/** A pose or an offset as labelled fields: x, y, z in millimetres, roll, pitch, yaw in degrees. */
+function PoseInput(props: { id: string; text: string | undefined; disabled: boolean; onChange: (value: string | undefined) => void }) {
+  const fields = parsePoseText(props.text);
+  if (!fields) {
+    return (
+      <div id={props.id} className="pose-fields">
+        <span className="reason">'{props.text}' is not a pose (x;y;z or x;y;z;roll;pitch;yaw, m and degrees)</span>
+        <button type="button" disabled={props.disabled} onClick={() => props.onChange(undefined)}>
+          Clear
+        </button>
+      </div>
+    );
+  }
+  const set = (key: keyof PoseFields, value: string) => {
+    const number = Number(value);
+    if (value.trim() === '' || !Number.isFinite(number)) return;
+    props.onChange(formatPoseText({ ...fields, [key]: number }));
+  };
+  return (
+    <div id={props.id} className="pose-fields" role="group" aria-label="pose">
+      {POSE_FIELDS.map(({ key, label, unit }) => (
+        <label key={key} className="pose-field">
+          <span>
+            {label} <span className="unit">{unit}</span>
+          </span>
+          <input
+            type="number"
+            step={unit === 'mm' ? 1 : 5}
+            aria-label={`${label} (${unit === 'mm' ? 'millimetres' : 'degrees'})`}
+            data-pose-field={key}
+            value={Number(fields[key].toFixed(unit === 'mm' ? 1 : 3))}
+            disabled={props.disabled}
+            onChange={(e) => set(key, e.target.value)}
+          />
+        </label>
+      ))}
+    </div>
   );
 }
 
@@ -252,11 +298,14 @@ export function NodeEditor({ node, info, choices, objects, trees, readOnly, onCh
         />
       );
     }
+    if (port.type === 'costar::Pose') {
+      return <PoseInput id={id} text={current} disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;
+    }
     return (
       <input
         id={id}
         type="text"
-        placeholder={port.type === 'costar::Pose' ? 'x;y;z;roll;pitch;yaw (m, degrees)' : placeholder}
+        placeholder={placeholder}
         value={current ?? ''}
         disabled={readOnly}
         onChange={(e) => onChange(port.name, e.target.value === '' ? undefined : e.target.value)}

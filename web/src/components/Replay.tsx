@@ -1,25 +1,24 @@
-// Replay: pick a past run (the store's run log) and scrub through its status transitions.
+// Replay: pick a past run (the store's run log, each run labelled with its cell) and scrub
+// through its status transitions; the 3D view and the Objects pane show the cell as the run's
+// log has it at that moment.
 
 import { useEffect, useState } from 'react';
 import type { Api, RunLog, StoredRun } from '../api';
 
 interface Props {
   api: Api;
+  /** The run log, newest first. */
+  runs: StoredRun[];
   replay: { log: RunLog; index: number } | null;
-  refreshKey: number;
+  onRefresh: () => void;
   onOpen: (log: RunLog) => void;
   onIndex: (index: number) => void;
   onClose: () => void;
 }
 
-export function Replay({ api, replay, refreshKey, onOpen, onIndex, onClose }: Props) {
-  const [runs, setRuns] = useState<StoredRun[]>([]);
+export function Replay({ api, runs, replay, onRefresh, onOpen, onIndex, onClose }: Props) {
   const [playing, setPlaying] = useState(false);
   const [error, setError] = useState('');
-
-  useEffect(() => {
-    api.runs().then(setRuns, (e: Error) => setError(e.message));
-  }, [api, refreshKey]);
 
   useEffect(() => {
     if (!playing || !replay) return;
@@ -43,10 +42,12 @@ export function Replay({ api, replay, refreshKey, onOpen, onIndex, onClose }: Pr
         <select
           aria-label="past run"
           value={replay?.log.id ?? ''}
+          onFocus={onRefresh}
           onChange={async (e) => {
             const id = Number(e.target.value);
             if (!id) return;
             try {
+              setError('');
               onOpen(await api.runLog(id));
             } catch (err) {
               setError((err as Error).message);
@@ -56,7 +57,8 @@ export function Replay({ api, replay, refreshKey, onOpen, onIndex, onClose }: Pr
           <option value="">pick a past run…</option>
           {runs.map((run) => (
             <option key={run.id} value={run.id}>
-              #{run.id} {run.plan || '(unsaved plan)'}
+              #{run.id}
+              {run.workcell ? ` ${run.workcell}` : ''} · {run.plan || '(unsaved plan)'}
               {run.version ? ` v${run.version}` : ''} · {run.result || 'running'} ·{' '}
               {new Date(run.started_at * 1000).toLocaleTimeString()}
             </option>

@@ -30,7 +30,7 @@ export function SignIn({ problem, onToken, onDismiss }: Props) {
         <p className={problem === 'wrong' ? 'reason' : ''}>
           {problem === 'wrong'
             ? 'The server refused this token. Paste the token (or the whole address) that costar serve printed.'
-            : 'Changes and robot motions need the token that costar serve printed. Open the address it printed, or paste the token (or the whole address) here.'}
+            : 'Sign in to change plans or move the robot: open the address costar serve printed, or paste its token (or the whole address) here.'}
         </p>
         <input
           aria-label="token"

@@ -25,6 +25,7 @@ import type { NodeInfo } from '../api';
 import type { DropPosition, EditorNode } from '../model/tree';
 import { BOX, fitViewport, layout, Orientation } from '../model/layout';
 import type { NodeStatus } from '../model/status';
+import { parsePoseText } from '../model/poseText';
 
 export type { Orientation };
 export type SelectMode = 'single' | 'range' | 'toggle';
@@ -38,6 +39,12 @@ interface Props {
   problems: Map<string, string>;
   readOnly: boolean;
   orientation: Orientation;
+  /** The run is paused: its running nodes show PAUSED, not RUNNING. */
+  paused?: boolean;
+  /** The node that runs now (kept in view while the run goes on), if it is in this tree. */
+  runningKey?: string | null;
+  /** A version comparison: added or changed nodes of this tree. */
+  changes?: Map<string, 'added' | 'changed'>;
   onSelect: (key: string, mode: SelectMode) => void;
   onToggle: (key: string) => void;
   onMove: (key: string, target: string, position: DropPosition) => void;
@@ -50,15 +57,23 @@ interface Props {
 
 // The parameters that tell nodes of one type apart, in the order they are shown.
 const SUMMARY_PORTS = ['waypoint', 'object_class', 'target_class', 'target', 'predicates', 'grasp', 'predicate', 'args',
-  'expected', 'num_cycles', 'num_attempts', 'msec', 'ID', 'speed', 'mode', 'frame', 'joint', 'axis', 'amount', 'degrees', 'message'];
+  'expected', 'num_cycles', 'num_attempts', 'msec', 'ID', 'offset', 'pose', 'speed', 'mode', 'frame', 'joint', 'axis', 'amount', 'degrees', 'message'];
 
 export function summary(node: EditorNode): string {
   const shown = node.attributes.filter(([k]) => k !== 'name' && SUMMARY_PORTS.includes(k));
   shown.sort((a, b) => SUMMARY_PORTS.indexOf(a[0]) - SUMMARY_PORTS.indexOf(b[0]));
   // The values alone where the type says what they are: a class, where it goes, the conditions.
   const bare = ['waypoint', 'object_class', 'predicates'];
+  const pose = (k: string, v: string) => {
+    const f = parsePoseText(v);
+    if (!f) return `${k}=${v}`;
+    const turn = f.roll || f.pitch || f.yaw ? ` ${[f.roll, f.pitch, f.yaw].map((a) => Number(a.toFixed(1))).join(', ')}°` : '';
+    return `${k} ${[f.x, f.y, f.z].map((a) => Number(a.toFixed(1))).join(', ')} mm${turn}`;
+  };
   return shown
-    .map(([k, v]) => (k === 'target_class' ? `on ${v}` : k === 'target' ? `at ${v}` : bare.includes(k) ? v : `${k}=${v}`))
+    .map(([k, v]) =>
+      k === 'target_class' ? `on ${v}` : k === 'target' ? `at ${v}` : k === 'offset' || k === 'pose' ? pose(k, v) : bare.includes(k) ? v : `${k}=${v}`,
+    )
     .join('  ');
 }
 
@@ -90,16 +105,20 @@ const TreeBox = memo(function TreeBox({ data }: NodeProps<Node<BoxData>>) {
   const reason = last === 'FAILURE' ? status?.reason : undefined;
   const text = summary(node);
   const lr = props.orientation === 'LR';
+  const paused = running && !!props.paused;
+  const change = props.changes?.get(node.key);
   return (
     <div
-      className={`tree-node cat-${category} status-${last.toLowerCase()} ${running ? 'running' : ''} ${selected ? 'selected' : ''} ${
+      className={`tree-node cat-${category} status-${last.toLowerCase()} ${running ? (paused ? 'paused' : 'running') : ''} ${selected ? 'selected' : ''} ${
         props.selectedKey === node.key ? 'primary' : ''
-      } ${problem ? 'problem' : ''} ${drop ? `drop-${drop}-${props.orientation}` : ''} nopan`}
+      } ${problem ? 'problem' : ''} ${change ? `diff-${change}` : ''} ${drop ? `drop-${drop}-${props.orientation}` : ''} nopan`}
       style={{ width: BOX.width, height: BOX.height }}
       data-key={node.key}
       data-node-type={node.id}
       data-status={last}
       data-running={running ? 'true' : 'false'}
+      data-paused={paused ? 'true' : 'false'}
+      data-change={change ?? ''}
       title={[info?.description, reason && `FAILURE: ${reason}`, problem && `Check: ${problem}`].filter(Boolean).join('\n')}
       draggable={!props.readOnly && !root}
       onClick={(e) => props.onSelect(node.key, e.shiftKey ? 'range' : e.ctrlKey || e.metaKey ? 'toggle' : 'single')}
@@ -145,7 +164,12 @@ const TreeBox = memo(function TreeBox({ data }: NodeProps<Node<BoxData>>) {
         <span className="node-type">{node.id}</span>
         {name && <span className="node-name">“{name}”</span>}
         {node.collapsed && <span className="folded">+{node.children.length}</span>}
-        {last !== 'IDLE' && <span className={`badge badge-${running ? 'running' : last.toLowerCase()}`}>{running ? 'RUNNING' : last}</span>}
+        {change && <span className={`badge badge-${change}`}>{change === 'added' ? 'NEW' : 'CHANGED'}</span>}
+        {last !== 'IDLE' && (
+          <span className={`badge badge-${running ? (paused ? 'paused' : 'running') : last.toLowerCase()}`}>
+            {running ? (paused ? 'PAUSED' : 'RUNNING') : last}
+          </span>
+        )}
       </div>
       {reason ? (
         <div className="reason node-line">{reason}</div>
@@ -203,11 +227,11 @@ function Canvas(props: Props) {
             source: p.parent!,
             target: p.node.key,
             type: 'smoothstep',
-            animated: running,
-            className: running ? 'edge-running' : last ? `edge-${last.toLowerCase()}` : '',
+            animated: running && !props.paused,
+            className: running ? (props.paused ? 'edge-paused' : 'edge-running') : last ? `edge-${last.toLowerCase()}` : '',
           };
         }),
-    [placed, props.statuses],
+    [placed, props.statuses, props.paused],
   );
 
   // Fit the tree when it is shown, its shape or the pane's size changes, never below
@@ -228,9 +252,11 @@ function Canvas(props: Props) {
     if (props.fitRequest) void flow.fitView({ padding: 0.04, duration: 150 });
   }, [props.fitRequest, flow]);
 
-  useEffect(() => {
-    if (!props.selectedKey || !width || !height) return;
-    const p = placed.find((q) => q.node.key === props.selectedKey);
+  // Bring a node into view (the selected one: new nodes, keyboard; the running one while a run
+  // goes on), moving the view as little as needed.
+  const bringIntoView = (key: string | null | undefined) => {
+    if (!key || !width || !height) return;
+    const p = placed.find((q) => q.node.key === key);
     if (!p) return;
     const { x, y, zoom } = flow.getViewport();
     const sx = p.x * zoom + x;
@@ -243,7 +269,15 @@ function Canvas(props: Props) {
     if (sy < margin) ny = y + (margin - sy);
     if (sy + BOX.height * zoom > height - margin) ny = y - (sy + BOX.height * zoom - (height - margin));
     if (nx !== x || ny !== y) void flow.setViewport({ x: nx, y: ny, zoom }, { duration: 150 });
+  };
+  useEffect(() => {
+    bringIntoView(props.selectedKey);
+    // eslint-disable-next-line react-hooks/exhaustive-deps
   }, [props.selectedKey, placed, width, height, flow]);
+  useEffect(() => {
+    bringIntoView(props.runningKey);
+    // eslint-disable-next-line react-hooks/exhaustive-deps
+  }, [props.runningKey, placed, width, height, flow]);
 
   return (
     <ReactFlow
@@ -282,7 +316,7 @@ function Canvas(props: Props) {
 
 function minimapColour(n: Node<BoxData>): string {
   const status = n.data.status;
-  if (status?.status === 'RUNNING') return '#f0a500';
+  if (status?.status === 'RUNNING') return n.data.props.paused ? '#5b7a99' : '#f0a500';
   if (status?.last === 'SUCCESS') return '#1f8f3a';
   if (status?.last === 'FAILURE') return '#c9302c';
   return { internal: '#3b73d1', robot_action: '#2f9e52', knowledge: '#8e55c9' }[n.data.info?.category ?? 'internal'] ?? '#999';

@@ -1,8 +1,10 @@
-// Pane 2: the cell in 3D (three.js): the robot drawn along the UR5's Denavit-Hartenberg
-// frames from the joint angles the stream carries, its gripper, the table, the parts the
-// system believes are there (object symbols; a held part moves with the tool), each drawn as
-// its class's boxes in its class's colour, the waypoints, SmartMove's candidates, and on
-// request the RGB-D camera's point cloud. Drag to orbit, wheel to zoom.
+// Pane 2: the cell in 3D (three.js): the robot the cell has, drawn from the URDF its planner
+// reads (GET /api/robot, model/drawnRobot.ts) with the joint angles the stream carries and
+// the fingers from the gripper's reading, the table, the parts the system believes are there
+// (object symbols; a held part moves with the tool), each drawn as its class's boxes in its
+// class's colour, the waypoints, SmartMove's candidates, and on request the RGB-D camera's
+// point cloud. During a replay it shows the run's logged snapshots, not the cell now. Drag to
+// orbit, wheel to zoom.
 
 import { useEffect, useRef, useState } from 'react';
 import * as THREE from 'three';
@@ -10,7 +12,8 @@ import type { Believed } from '../model/belief';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import type { Api, CellState, ObjectShape } from '../api';
 import { partLook } from '../model/parts';
-import { position, ur5Frames } from '../model/kinematics';
+import { DrawnRobot } from '../model/drawnRobot';
+import type { RobotDescription } from '../model/robot';
 import type { Candidate } from './ObjectsPane';
 
 interface Props {
@@ -23,6 +26,10 @@ interface Props {
   shapes?: Record<string, ObjectShape>;
   /** Where the system believes each part is (a held part moves with the tool). */
   believed?: Believed;
+  /** The cell's robot (GET /api/robot); null until it is read, or for a cell without one. */
+  robot: RobotDescription | null;
+  /** Replaying a run: what the view shows then (e.g. "run #3 at t = 12.4 s"). */
+  replayLabel?: string;
 }
 
 interface Scene {
@@ -31,30 +38,13 @@ interface Scene {
   camera: THREE.PerspectiveCamera;
   controls: OrbitControls;
   robot: THREE.Group;
+  table: THREE.Mesh;
+  grid: THREE.GridHelper;
   parts: THREE.Group;
   waypoints: THREE.Group;
   candidates: THREE.Group;
   cloud: THREE.Group;
   render: () => void;
-}
-
-function cylinderBetween(a: THREE.Vector3, b: THREE.Vector3, radius: number, material: THREE.Material) {
-  const length = a.distanceTo(b);
-  const mesh = new THREE.Mesh(new THREE.CylinderGeometry(radius, radius, length, 16), material);
-  mesh.position.copy(a).add(b).multiplyScalar(0.5);
-  mesh.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), b.clone().sub(a).normalize());
-  return mesh;
-}
-
-function matrixOf(frame: number[][]) {
-  const m = new THREE.Matrix4();
-  m.set(
-    frame[0][0], frame[0][1], frame[0][2], frame[0][3],
-    frame[1][0], frame[1][1], frame[1][2], frame[1][3],
-    frame[2][0], frame[2][1], frame[2][2], frame[2][3],
-    0, 0, 0, 1,
-  );
-  return m;
 }
 
 function clear(group: THREE.Group) {
@@ -70,8 +60,12 @@ function clear(group: THREE.Group) {
   }
 }
 
-/** Where the 3D view looks from: close enough to tell the parts apart, the arm in view. */
-const HOME_VIEW: [number, number, number] = [1.05, -0.95, 0.7];
+/** The directions the 3D view looks from (toward the cell): 3D, from above, from the side. */
+const VIEWS: Record<'3D' | 'Top' | 'Side', [number, number, number]> = {
+  '3D': [1.05, -0.95, 0.6],
+  Top: [0, -0.12, 1],
+  Side: [0, -1, 0.12],
+};
 
 /** A part: its class's boxes in the object frame, in the colour perception saw on it (else its class's). */
 function partMesh(objectClass: string, shapes: Record<string, ObjectShape> | undefined, seen: unknown) {
@@ -86,9 +80,12 @@ function partMesh(objectClass: string, shapes: Record<string, ObjectShape> | und
   return group;
 }
 
-export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAvailable, shapes, believed }: Props) {
+export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAvailable, shapes, believed, robot, replayLabel }: Props) {
   const mount = useRef<HTMLDivElement>(null);
   const sceneRef = useRef<Scene | null>(null);
+  const [drawn, setDrawn] = useState<DrawnRobot | null>(null);
+  const [drawnTool, setDrawnTool] = useState('');
+  const framed = useRef(false);
   const [error, setError] = useState<string | null>(null);
   const [cloudInfo, setCloudInfo] = useState<string>('');
   const [cloudTime, setCloudTime] = useState<number | null>(null);
@@ -109,14 +106,16 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     scene.background = new THREE.Color(0xf4f6fa);
     const camera = new THREE.PerspectiveCamera(45, 1, 0.01, 20);
     camera.up.set(0, 0, 1);
-    camera.position.set(...HOME_VIEW);
+    camera.position.set(...VIEWS['3D']);
     const controls = new OrbitControls(camera, renderer.domElement);
     controls.target.set(0.35, -0.05, 0.12);
     scene.add(new THREE.HemisphereLight(0xffffff, 0x8899aa, 1.6));
     const sun = new THREE.DirectionalLight(0xffffff, 1.5);
     sun.position.set(1, -1, 2);
     scene.add(sun);
-    const table = new THREE.Mesh(new THREE.BoxGeometry(1.4, 1.2, 0.04), new THREE.MeshLambertMaterial({ color: 0xc8b69a }));
+    // The table: resized to the cell's once its description is read.
+    const table = new THREE.Mesh(new THREE.BoxGeometry(1, 1, 1), new THREE.MeshLambertMaterial({ color: 0xc8b69a }));
+    table.scale.set(1.4, 1.2, 0.04);
     table.position.set(0.4, 0, -0.02);
     scene.add(table);
     const grid = new THREE.GridHelper(1.2, 12, 0x998877, 0xb0a08a);
@@ -125,12 +124,12 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     scene.add(grid);
     const axes = new THREE.AxesHelper(0.15);
     scene.add(axes);
-    const robot = new THREE.Group();
+    const robotGroup = new THREE.Group();
     const parts = new THREE.Group();
     const waypoints = new THREE.Group();
     const candidateGroup = new THREE.Group();
     const cloud = new THREE.Group();
-    scene.add(robot, parts, waypoints, candidateGroup, cloud);
+    scene.add(robotGroup, parts, waypoints, candidateGroup, cloud);
     const render = () => renderer.render(scene, camera);
     controls.addEventListener('change', render);
     const resize = () => {
@@ -144,7 +143,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     const observer = new ResizeObserver(resize);
     observer.observe(element);
     resize();
-    sceneRef.current = { renderer, scene, camera, controls, robot, parts, waypoints, candidates: candidateGroup, cloud, render };
+    sceneRef.current = { renderer, scene, camera, controls, robot: robotGroup, table, grid, parts, waypoints, candidates: candidateGroup, cloud, render };
     return () => {
       observer.disconnect();
       controls.dispose();
@@ -154,39 +153,44 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     };
   }, []);
 
-  // The robot, the parts and the waypoints follow the stream.
+  // The robot the cell has, built once its description is read; the table it stands by.
+  useEffect(() => {
+    const s = sceneRef.current;
+    if (!s || !robot) return;
+    if (robot.table) {
+      s.table.scale.set(...robot.table.size);
+      s.table.position.set(...robot.table.centre);
+      s.grid.position.set(robot.table.centre[0], robot.table.centre[1], robot.table.centre[2] + robot.table.size[2] / 2 + 0.001);
+    }
+    let built: DrawnRobot;
+    try {
+      built = new DrawnRobot(robot);
+    } catch (e) {
+      setError(`the robot cannot be drawn: ${(e as Error).message}`);
+      return;
+    }
+    s.robot.add(built.object);
+    setDrawn(built);
+    framed.current = false;
+    return () => {
+      s.robot.remove(built.object);
+      built.dispose();
+      setDrawn(null);
+    };
+  }, [robot]);
+
+  // The robot, the parts and the waypoints follow the stream (or the replayed run).
   useEffect(() => {
     const s = sceneRef.current;
     if (!s || !state) return;
-    clear(s.robot);
-    const joints = state.arm.joints;
-    if (joints && joints.length === 6) {
-      const frames = ur5Frames(joints);
-      const points = frames.map((f) => new THREE.Vector3(...position(f)));
-      const linkMaterial = new THREE.MeshLambertMaterial({ color: 0x4a90d9 });
-      const jointMaterial = new THREE.MeshLambertMaterial({ color: 0x2c3e50 });
-      for (let i = 0; i + 1 < points.length - 1; i++) {
-        if (points[i].distanceTo(points[i + 1]) > 0.001) s.robot.add(cylinderBetween(points[i], points[i + 1], 0.04, linkMaterial));
-        const ball = new THREE.Mesh(new THREE.SphereGeometry(0.05, 16, 12), jointMaterial);
-        ball.position.copy(points[i]);
-        s.robot.add(ball);
+    if (drawn) {
+      drawn.update(state.arm.joints, state.gripper.reading, state.gripper.mode);
+      const tool = drawn.toolPosition();
+      setDrawnTool([tool.x, tool.y, tool.z].map((v) => v.toFixed(5)).join(','));
+      if (!framed.current) {
+        framed.current = true; // the robot as it stands: frame the cell around it once
+        look('3D');
       }
-      // The gripper: a palm and two fingers along the tool's y axis.
-      const flange = matrixOf(frames[6]);
-      const gripper = new THREE.Group();
-      gripper.matrixAutoUpdate = false;
-      gripper.matrix.copy(flange);
-      const metal = new THREE.MeshLambertMaterial({ color: 0x555555 });
-      const palm = new THREE.Mesh(new THREE.BoxGeometry(0.06, 0.1, 0.08), metal);
-      palm.position.set(0, 0, 0.04);
-      gripper.add(palm);
-      const opening = state.gripper.open ? 0.085 : state.gripper.holding ? 0.04 : 0.01;
-      for (const side of [-1, 1]) {
-        const finger = new THREE.Mesh(new THREE.BoxGeometry(0.02, 0.012, 0.06), metal);
-        finger.position.set(0, side * (opening / 2 + 0.006), 0.12);
-        gripper.add(finger);
-      }
-      s.robot.add(gripper);
     }
     clear(s.parts);
     for (const object of state.objects) {
@@ -212,7 +216,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       }
     }
     s.render();
-  }, [state, selectedWaypoint, shapes, believed]);
+  }, [state, selectedWaypoint, shapes, believed, drawn]);
 
   useEffect(() => {
     const s = sceneRef.current;
@@ -229,11 +233,34 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     s.render();
   }, [candidates]);
 
-  const look = (from: [number, number, number]) => {
+  /** Looks at the whole cell (the table and the robot) from a direction, as close as the pane allows. */
+  const look = (view: keyof typeof VIEWS) => {
     const s = sceneRef.current;
     if (!s) return;
-    s.camera.position.set(...from);
-    s.controls.target.set(0.35, -0.05, 0.12);
+    s.scene.updateMatrixWorld(true);
+    // The corners of the table's middle (where the parts lie; its edges may leave the view) and
+    // of the robot's box (not of one box round both: its far corners would stand in empty air).
+    const table = new THREE.Box3().setFromObject(s.table);
+    const middle = table.clone().expandByVector(table.getSize(new THREE.Vector3()).multiply(new THREE.Vector3(-0.2, -0.2, 0)));
+    const boxes = [middle, new THREE.Box3().setFromObject(s.robot)].filter((b) => !b.isEmpty());
+    const corners = boxes.flatMap((b) =>
+      [b.min.x, b.max.x].flatMap((x) => [b.min.y, b.max.y].flatMap((y) => [b.min.z, b.max.z].map((z) => new THREE.Vector3(x, y, z)))),
+    );
+    const centre = boxes.reduce((box, b) => box.union(b), new THREE.Box3()).getCenter(new THREE.Vector3());
+    // The nearest camera along `view` that has every corner in the frustum.
+    const back = new THREE.Vector3(...VIEWS[view]).normalize();
+    const right = new THREE.Vector3(0, 0, 1).cross(back).normalize();
+    const up = back.clone().cross(right);
+    const vertical = Math.tan(THREE.MathUtils.degToRad(s.camera.fov) / 2);
+    const horizontal = vertical * s.camera.aspect;
+    let distance = 0;
+    for (const corner of corners) {
+      const p = corner.clone().sub(centre);
+      const towards = p.dot(back);
+      distance = Math.max(distance, towards + Math.abs(p.dot(right)) / horizontal, towards + Math.abs(p.dot(up)) / vertical);
+    }
+    s.camera.position.copy(centre).addScaledVector(back, distance * 1.04);
+    s.controls.target.copy(centre);
     s.controls.update();
     s.render();
   };
@@ -263,15 +290,11 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     <section className="pane view3d" aria-label="3D view">
       <h2>
         <span className="pane-number">2</span> Cell
-        <button type="button" className="small" onClick={() => look(HOME_VIEW)}>
-          3D
-        </button>
-        <button type="button" className="small" onClick={() => look([0.35, -0.25, 2.2])}>
-          Top
-        </button>
-        <button type="button" className="small" onClick={() => look([0.35, -2.0, 0.3])}>
-          Side
-        </button>
+        {(Object.keys(VIEWS) as (keyof typeof VIEWS)[]).map((view) => (
+          <button key={view} type="button" className="small" onClick={() => look(view)}>
+            {view}
+          </button>
+        ))}
         {pointCloudAvailable && (
           <>
             <button type="button" className="small" onClick={loadCloud}>
@@ -300,7 +323,12 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
           </>
         )}
       </h2>
-      {error ? <p className="empty">{error}</p> : <div className="view3d-canvas" ref={mount} />}
+      {replayLabel && <div className="view3d-replay">{replayLabel}</div>}
+      {error ? (
+        <p className="empty">{error}</p>
+      ) : (
+        <div className="view3d-canvas" ref={mount} data-drawn-tool={drawnTool} data-robot={robot?.name ?? ''} data-finger-boxes={drawn?.fingerBoxes() ?? 0} />
+      )}
     </section>
   );
 }

@@ -1,20 +1,34 @@
-// Pane 3: waypoints (the arm's, kept in its waypoint file): jog the arm, teach where it is,
-// rename, delete, move to one. Every button runs one operation of the arm.
+// Pane 3: waypoints (the arm's, kept in its waypoint file): jog the arm (along axes, or one of
+// the cell's joints), with the tool's pose and the joint angles read out live beside the
+// buttons as a pendant shows them; teach where it is, rename, delete, move to one. Every button
+// runs one operation of the arm; while the cell would refuse it, it is disabled and says why.
 
 import { useState } from 'react';
-import type { CellState, Choices } from '../api';
+import type { CellState } from '../api';
+import { poseReadout, RobotDescription } from '../model/robot';
 
 interface Props {
   state: CellState | null;
-  choices: Choices | null;
-  busy: boolean;
+  /** Frames a pose may be taught in: those the world has now. */
+  frames: string[];
+  robot: RobotDescription | null;
+  /** Why the cell would refuse a motion or a change now (disabled with this reason), or null. */
+  refusal: string | null;
   run: (node: string, attributes?: Record<string, string>) => void;
+  /** Renames a waypoint (the page then offers to rename it in the open plan). */
+  rename: (from: string, to: string) => void;
 }
 
 const AXES = ['x', 'y', 'z'] as const;
 const ROTATIONS = ['roll', 'pitch', 'yaw'] as const;
 
-export function Waypoints({ state, choices, busy, run }: Props) {
+function degrees(rad: number) {
+  return ((rad * 180) / Math.PI).toFixed(1);
+}
+
+export function Waypoints({ state, frames, robot, refusal, run, rename }: Props) {
+  const busy = refusal !== null;
+  const why = refusal ?? undefined;
   const [name, setName] = useState('');
   const [kind, setKind] = useState<'pose' | 'joints'>('pose');
   const [frame, setFrame] = useState('world');
@@ -24,14 +38,27 @@ export function Waypoints({ state, choices, busy, run }: Props) {
   const [newName, setNewName] = useState('');
   const waypoints = state?.waypoints ?? [];
   const joints = state?.arm.joints ?? [];
+  const endpoint = state?.arm.endpoint;
+  const tool = endpoint ? poseReadout(endpoint.p, endpoint.q) : null;
   return (
     <section className="pane waypoints" aria-label="Waypoints">
       <h2>
         <span className="pane-number">3</span> Waypoints
       </h2>
       <div className="jog">
+        {tool && (
+          <div className="tool-readout" aria-label="tool pose" title="The tool centre point in the world (the arm's endpoint), as the arm reports it">
+            <span className="readout-label">tool</span>
+            <span data-readout="X">X {(tool.x * 1000).toFixed(1)}</span>
+            <span data-readout="Y">Y {(tool.y * 1000).toFixed(1)}</span>
+            <span data-readout="Z">Z {(tool.z * 1000).toFixed(1)} mm</span>
+            <span data-readout="roll">R {tool.roll.toFixed(1)}</span>
+            <span data-readout="pitch">P {tool.pitch.toFixed(1)}</span>
+            <span data-readout="yaw">Y {tool.yaw.toFixed(1)}°</span>
+          </div>
+        )}
         <div className="jog-row">
-          step
+          jog by
           <select value={step} onChange={(e) => setStep(Number(e.target.value))} aria-label="jog step">
             {[1, 5, 10, 50].map((s) => (
               <option key={s} value={s}>
@@ -40,44 +67,39 @@ export function Waypoints({ state, choices, busy, run }: Props) {
             ))}
           </select>
           <select value={jogFrame} onChange={(e) => setJogFrame(e.target.value as 'world' | 'tool')} aria-label="jog frame">
-            <option value="world">world axes</option>
-            <option value="tool">tool axes</option>
+            <option value="world">along world axes</option>
+            <option value="tool">along tool axes</option>
           </select>
         </div>
-        <div className="jog-row">
-          {AXES.map((axis) => (
-            <span key={axis} className="jog-pair">
-              {axis}
-              <button type="button" disabled={busy} onClick={() => run('JogCartesian', { axis, amount: String(-step / 1000), frame: jogFrame })}>
-                −
-              </button>
-              <button type="button" disabled={busy} onClick={() => run('JogCartesian', { axis, amount: String(step / 1000), frame: jogFrame })}>
-                +
-              </button>
-            </span>
-          ))}
-          {ROTATIONS.map((axis) => (
-            <span key={axis} className="jog-pair">
-              {axis}
-              <button type="button" disabled={busy} onClick={() => run('JogCartesian', { axis, amount: String(-step), frame: jogFrame })}>
-                −
-              </button>
-              <button type="button" disabled={busy} onClick={() => run('JogCartesian', { axis, amount: String(step), frame: jogFrame })}>
-                +
-              </button>
-            </span>
-          ))}
+        <div className="jog-grid">
+          {[...AXES, ...ROTATIONS].map((axis) => {
+            const amount = (sign: number) => String((sign * (AXES.includes(axis as (typeof AXES)[number]) ? step / 1000 : step)));
+            return (
+              <span key={axis} className="jog-pair">
+                <span className="jog-name">{axis}</span>
+                <button type="button" disabled={busy} title={why} aria-label={`jog ${axis} minus`} onClick={() => run('JogCartesian', { axis, amount: amount(-1), frame: jogFrame })}>
+                  −
+                </button>
+                <button type="button" disabled={busy} title={why} aria-label={`jog ${axis} plus`} onClick={() => run('JogCartesian', { axis, amount: amount(1), frame: jogFrame })}>
+                  +
+                </button>
+              </span>
+            );
+          })}
         </div>
-        <div className="jog-row">
-          {[1, 2, 3, 4, 5, 6].map((j) => (
-            <span key={j} className="jog-pair" title={joints[j - 1] !== undefined ? `${((joints[j - 1] * 180) / Math.PI).toFixed(1)}°` : ''}>
-              J{j}
-              <button type="button" disabled={busy} onClick={() => run('JogJoint', { joint: String(j), degrees: String(-step) })}>
+        <div className="jog-grid joints">
+          {(robot?.joints ?? []).map((joint, i) => (
+            <span key={joint.name} className="jog-pair" title={joint.label ? `${joint.label} (${joint.name})` : joint.name} data-joint={i + 1}>
+              <span className="jog-name">J{i + 1}</span>
+              <button type="button" disabled={busy} title={why} aria-label={`jog J${i + 1} minus`} onClick={() => run('JogJoint', { joint: String(i + 1), degrees: String(-step) })}>
                 −
               </button>
-              <button type="button" disabled={busy} onClick={() => run('JogJoint', { joint: String(j), degrees: String(step) })}>
+              <button type="button" disabled={busy} title={why} aria-label={`jog J${i + 1} plus`} onClick={() => run('JogJoint', { joint: String(i + 1), degrees: String(step) })}>
                 +
               </button>
+              <span className="readout" data-readout={`J${i + 1}`}>
+                {joints[i] !== undefined ? `${degrees(joints[i])}°` : '–'}
+              </span>
             </span>
           ))}
         </div>
@@ -90,7 +112,7 @@ export function Waypoints({ state, choices, busy, run }: Props) {
         </select>
         {kind === 'pose' && (
           <select value={frame} onChange={(e) => setFrame(e.target.value)} aria-label="relative to">
-            {(choices?.frame ?? ['world']).map((f) => (
+            {frames.map((f) => (
               <option key={f} value={f}>
                 in {f}
               </option>
@@ -100,6 +122,7 @@ export function Waypoints({ state, choices, busy, run }: Props) {
         <button
           type="button"
           disabled={busy || !name}
+          title={why ?? (!name ? 'name the waypoint first' : 'save where the arm is now')}
           onClick={() => {
             run('Teach', kind === 'pose' ? { waypoint: name, kind, frame } : { waypoint: name, kind });
             setName('');
@@ -128,9 +151,10 @@ export function Waypoints({ state, choices, busy, run }: Props) {
                   <>
                     <button
                       type="button"
-                      disabled={busy || !newName}
+                      disabled={busy || !newName || newName === w.name}
+                      title={why}
                       onClick={() => {
-                        run('RenameWaypoint', { waypoint: w.name, new_name: newName });
+                        rename(w.name, newName);
                         setRenaming(null);
                       }}
                     >
@@ -142,12 +166,13 @@ export function Waypoints({ state, choices, busy, run }: Props) {
                   </>
                 ) : (
                   <>
-                    <button type="button" disabled={busy} onClick={() => run('Move', { waypoint: w.name })}>
+                    <button type="button" disabled={busy} title={why} onClick={() => run('Move', { waypoint: w.name })}>
                       Move to
                     </button>
                     <button
                       type="button"
                       disabled={busy}
+                      title={why}
                       onClick={() => {
                         setRenaming(w.name);
                         setNewName(w.name);
@@ -158,6 +183,7 @@ export function Waypoints({ state, choices, busy, run }: Props) {
                     <button
                       type="button"
                       disabled={busy}
+                      title={why}
                       onClick={() => {
                         if (confirm(`Delete waypoint '${w.name}'?`)) run('DeleteWaypoint', { waypoint: w.name });
                       }}

@@ -8,12 +8,18 @@ import type { EditorNode } from './tree';
 export type Orientation = 'LR' | 'TB';
 
 // Compact boxes (two lines: type and name, then what tells it apart or what went wrong), so
-// the structure assembly's 15 nodes fit a 1280x800 screen at a readable zoom.
-export const BOX = { width: 260, height: 40 };
-export const GAP = { sibling: 6, level: 44 };
-/** The first view of a tree never zooms out further than this (the rest is a scroll away). */
-export const MIN_FIT_ZOOM = 0.75;
-const FIT_MARGIN = 16;
+// that as much of a tree as can be shows at a zoom where its smallest text (11 px) stays
+// readable: the structure assembly's 15 nodes whole at 1600x1000, and with the larger tree (M)
+// at 1280x800.
+export const BOX = { width: 260, height: 34 };
+export const GAP = { sibling: 4, level: 44 };
+/**
+ * The first view of a tree never zooms out further than this: the boxes' smallest text is
+ * 11 px at zoom 1, the least a person reads at arm's length; the rest is a scroll away, and the
+ * running node is kept in view.
+ */
+export const MIN_FIT_ZOOM = 1;
+const FIT_MARGIN = 8;
 
 /**
  * The viewport that shows the whole tree in a pane of this size, centred, at zoom 1 at most

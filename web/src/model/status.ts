@@ -130,3 +130,102 @@ export function mergeStatuses(statuses: Map<number, NodeStatus>, update: NodeSta
   for (const status of update) next.set(status.uid, status);
   return next;
 }
+
+/** A run's node mapped onto the editor, with what the node was when it was mapped. */
+export interface MappedRef extends NodeRef {
+  signature: string;
+}
+
+/** What a node is, for telling whether it was edited: its type, attributes and children's keys. */
+export function nodeSignature(node: EditorNode): string {
+  return JSON.stringify([node.id, node.attributes, node.children.map((c) => c.key)]);
+}
+
+/**
+ * mapRun, keeping each node's signature as it was then: a node edited since (an attribute
+ * changed, a child added, removed or moved) no longer shows the run's status.
+ */
+export function mapRunSigned(plan: EditorPlan, nodes: RunNode[]): Map<number, MappedRef> {
+  const signed = new Map<number, MappedRef>();
+  for (const [uid, ref] of mapRun(plan, nodes)) {
+    const node = findNode(plan, ref);
+    if (node) signed.set(uid, { ...ref, signature: nodeSignature(node) });
+  }
+  return signed;
+}
+
+function findNode(plan: EditorPlan, ref: NodeRef): EditorNode | undefined {
+  const walk = (node: EditorNode | null): EditorNode | undefined => {
+    if (!node) return undefined;
+    if (node.key === ref.key) return node;
+    for (const child of node.children) {
+      const found = walk(child);
+      if (found) return found;
+    }
+    return undefined;
+  };
+  return walk(findTree(plan, ref.tree)?.root ?? null);
+}
+
+/** statusesByKey for the nodes of `tree` not edited since they were mapped. */
+export function unchangedStatusesByKey(
+  statuses: Map<number, NodeStatus>,
+  mapping: Map<number, MappedRef>,
+  plan: EditorPlan,
+  tree: string,
+): Map<string, NodeStatus> {
+  const current = new Map<string, string>();
+  const walk = (node: EditorNode | null) => {
+    if (!node) return;
+    current.set(node.key, nodeSignature(node));
+    node.children.forEach(walk);
+  };
+  walk(findTree(plan, tree)?.root ?? null);
+  const out = new Map<string, NodeStatus>();
+  for (const [uid, status] of statuses) {
+    const ref = mapping.get(uid);
+    if (ref && ref.tree === tree && current.get(ref.key) === ref.signature) out.set(ref.key, status);
+  }
+  return out;
+}
+
+/** The node that runs now: the deepest one RUNNING (the operation under its parents), if any. */
+export function runningNode(statuses: Map<number, NodeStatus>, nodes: RunNode[]): RunNode | undefined {
+  const byUid = new Map(nodes.map((n) => [n.uid, n]));
+  const depth = (uid: number) => {
+    let d = 0;
+    for (let n = byUid.get(uid); n && n.parent >= 0 && d < 1000; n = byUid.get(n.parent)) d++;
+    return d;
+  };
+  let best: RunNode | undefined;
+  let bestDepth = -1;
+  for (const [uid, status] of statuses) {
+    if (status.status !== 'RUNNING') continue;
+    const d = depth(uid);
+    if (d > bestDepth && byUid.has(uid)) {
+      best = byUid.get(uid);
+      bestDepth = d;
+    }
+  }
+  return best;
+}
+
+/**
+ * A run mapped onto the plan open in the editor: only the nodes that are still what ran (the
+ * same type and attributes as in the run's own plan, `ran`), each with its signature now, so
+ * that later edits clear their statuses (unchangedStatusesByKey). Without `ran` (an old server),
+ * every node mapRun finds.
+ */
+export function mapRunOnto(plan: EditorPlan, nodes: RunNode[], ran?: EditorPlan): Map<number, MappedRef> {
+  const ours = mapRunSigned(plan, nodes);
+  if (!ran) return ours;
+  const theirs = mapRun(ran, nodes);
+  const same = (a: EditorNode | undefined, b: EditorNode | undefined) =>
+    !!a && !!b && a.id === b.id && JSON.stringify(a.attributes) === JSON.stringify(b.attributes) && a.children.length === b.children.length;
+  const out = new Map<number, MappedRef>();
+  for (const [uid, ref] of ours) {
+    const theirRef = theirs.get(uid);
+    if (theirRef && same(findNode(plan, ref), findNode(ran, theirRef))) out.set(uid, ref);
+  }
+  return out;
+}

@@ -1,0 +1,194 @@
+// What the editor's end-to-end tests share: starting `costar serve` on a simulated cell (its
+// token in a private file, a store and a waypoint file of its own), Debian's Chromium driven by
+// playwright-core, checks that log what they proved, counting UI actions, the simulator's true
+// state (a TEST ONLY endpoint), and the readability check at a screen size.
+
+import { spawn } from 'node:child_process';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+export const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+
+/** --name value pairs of the command line. */
+export function parseArgs(argv = process.argv.slice(2)) {
+  return Object.fromEntries(argv.reduce((pairs, arg, i, all) => (arg.startsWith('--') ? [...pairs, [arg.slice(2), all[i + 1]]] : pairs), []));
+}
+
+export const args = parseArgs();
+export const costar = path.resolve(args.costar ?? path.join(root, 'build/cli/costar'));
+export const artifacts = path.resolve(args.artifacts ?? path.join(root, 'build/test-artifacts'));
+export const chromiumPath = args.chromium ?? '/usr/bin/chromium';
+fs.mkdirSync(artifacts, { recursive: true });
+
+export function makeLog(name) {
+  const log = (...m) => console.log(`${name}:`, ...m);
+  const check = (condition, message) => {
+    if (!condition) throw new Error(message);
+    log('ok -', message);
+  };
+  return { log, check };
+}
+
+/**
+ * Starts `costar serve` in a fresh folder: resolves with its URL, the address it prints (with
+ * the token), the token, and a stop function.
+ */
+export async function startServer({ workcell = 'ur5-sim', scene, waypoints, pace = 1, extra = [] } = {}) {
+  const work = fs.mkdtempSync(path.join(os.tmpdir(), 'costar-e2e-'));
+  const waypointFile = path.join(work, 'waypoints.json');
+  if (waypoints) fs.copyFileSync(path.join(root, waypoints), waypointFile);
+  const tokenFile = path.join(work, 'token');
+  const argv = ['serve', '--workcell', workcell, '--port', '0', '--waypoints', waypointFile, '--store', path.join(work, 'editor.sqlite'),
+    '--token-file', tokenFile, '--web-root', path.join(root, 'web/dist'), '--pace', String(pace), '--test-endpoints', ...extra];
+  if (scene) argv.push('--scene', path.join(root, scene));
+  const server = spawn(costar, argv, { stdio: ['ignore', 'pipe', 'pipe'] });
+  server.stderr.on('data', (d) => process.stderr.write(`serve: ${d}`));
+  const started = await new Promise((resolve, reject) => {
+    let text = '';
+    const timer = setTimeout(() => reject(new Error('costar serve did not start within 90 s')), 90000);
+    server.stdout.on('data', (d) => {
+      text += d;
+      const listening = /listening on (http:\/\/\S+)/.exec(text);
+      if (listening) {
+        clearTimeout(timer);
+        resolve({ url: listening[1], open: /open the editor at (\S+)/.exec(text)?.[1] ?? '' });
+      }
+    });
+    server.on('exit', (code) => reject(new Error(`costar serve exited with ${code}`)));
+  });
+  const token = fs.readFileSync(tokenFile, 'utf8').trim();
+  return {
+    ...started,
+    token,
+    work,
+    waypointFile,
+    stop: () => {
+      server.kill('SIGTERM');
+      fs.rmSync(work, { recursive: true, force: true });
+    },
+  };
+}
+
+export async function launchBrowser() {
+  return chromium.launch({
+    executablePath: chromiumPath,
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync',
+      '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  });
+}
+
+/** A page of a new browser context at this size, its errors collected in `errors`. */
+export async function openPage(browser, address, errors, viewport = { width: 1600, height: 1000 }) {
+  const context = await browser.newContext({ viewport });
+  const page = await context.newPage();
+  page.on('pageerror', (e) => errors.push(e.message));
+  await page.goto(address);
+  await page.waitForSelector('.connection.on', { timeout: 30000 });
+  return { context, page };
+}
+
+/** Counts every UI action a task takes. */
+export function actionCounter(page, log) {
+  const counter = { actions: 0 };
+  counter.act = async (what, fn) => {
+    counter.actions += 1;
+    await fn();
+    log(`action ${counter.actions}: ${what}`);
+  };
+  counter.palette = (type) => counter.act(`click ${type} in the operations`, () => page.click(`.palette-item[data-node-type="${type}"]`));
+  counter.choose = (port, value) => counter.act(`choose ${port} = ${value}`, () => page.selectOption(`#port-${port}`, value));
+  counter.condition = (name) => counter.act(`add condition ${name}(part, …)`, () => page.selectOption('select[aria-label="add condition"]', name));
+  counter.node = (type, n) => page.locator(`.tree-node[data-node-type="${type}"]`).nth(n);
+  counter.clickNode = (type, n, modifiers) =>
+    counter.act(`${modifiers ? 'shift+' : ''}click ${type} #${n + 1} in the tree`, () => counter.node(type, n).click({ modifiers }));
+  counter.key = (combo) => counter.act(`press ${combo}`, () => page.keyboard.press(combo));
+  counter.fill = (what, selector, value) => counter.act(what, () => page.fill(selector, value));
+  counter.click = (what, selector) => counter.act(what, () => page.click(selector));
+  return counter;
+}
+
+export async function groundTruth(url, token) {
+  const response = await fetch(`${url}api/test/ground_truth`, { headers: { Authorization: `Bearer ${token}` } });
+  if (!response.ok) throw new Error(`ground truth: ${response.status}`);
+  return response.json();
+}
+
+export async function api(url, token, method, pathname, body) {
+  const response = await fetch(`${url}${pathname.replace(/^\//, '')}`, {
+    method,
+    headers: { Authorization: `Bearer ${token}`, ...(body ? { 'Content-Type': 'application/json' } : {}) },
+    body: body ? JSON.stringify(body) : undefined,
+  });
+  const text = await response.text();
+  return { status: response.status, json: text ? JSON.parse(text) : null };
+}
+
+/** Waits until the page's run label says the run ended; returns its result and text. */
+export async function waitForRunEnd(page, seconds = 240) {
+  const deadline = Date.now() + seconds * 1000;
+  let sawRunning = false;
+  while (Date.now() < deadline) {
+    if (await page.$('.tree-node[data-running="true"]')) sawRunning = true;
+    const result = await page.getAttribute('.run-label', 'data-run-result');
+    if (result) return { result, label: await page.textContent('.run-label'), sawRunning };
+    await page.waitForTimeout(100);
+  }
+  return { result: '', label: await page.textContent('.run-label'), sawRunning };
+}
+
+/**
+ * The readability check (run in the page): the smallest text drawn in the tree pane (font size
+ * times the canvas zoom, px), and every element that overflows its pane or clips its text
+ * (a scrolling list or the tree's canvas may hold more than shows: that is not overflow).
+ */
+export function readability() {
+  const viewport = document.querySelector('.react-flow__viewport');
+  const zoom = Number(/scale\(([\d.]+)\)/.exec(viewport?.style.transform ?? '')?.[1] ?? 1);
+  let smallest = Infinity;
+  let smallestWhat = '';
+  for (const element of document.querySelectorAll('.tree-node *')) {
+    if (!element.childNodes.length || ![...element.childNodes].some((n) => n.nodeType === 3 && n.textContent.trim())) continue;
+    const size = parseFloat(getComputedStyle(element).fontSize) * zoom;
+    if (size < smallest) {
+      smallest = size;
+      smallestWhat = `${element.className}: ${element.textContent.trim().slice(0, 30)}`;
+    }
+  }
+  const problems = [];
+  // Inside a list that scrolls up and down, or the tree's canvas (a pan area): more than shows
+  // is not overflow. A pane that scrolls sideways is (nothing is meant to be wider than its pane).
+  const scrolls = (element) => {
+    for (let e = element.parentElement; e; e = e.parentElement) {
+      if (e.classList.contains('react-flow')) return true;
+      const style = getComputedStyle(e);
+      if (/(auto|scroll)/.test(style.overflowY) && e.scrollHeight > e.clientHeight + 1 && e.scrollWidth <= e.clientWidth + 1) return true;
+    }
+    return false;
+  };
+  for (const pane of document.querySelectorAll('.pane, .menu, .status-line')) {
+    const box = pane.getBoundingClientRect();
+    if (pane.scrollWidth > pane.clientWidth + 1) problems.push(`${pane.className.split(' ')[0] || pane.tagName} is wider than itself: it scrolls sideways`);
+    for (const element of pane.querySelectorAll('*')) {
+      const style = getComputedStyle(element);
+      if (style.display === 'none' || style.visibility === 'hidden' || element.closest('option, .react-flow__minimap, .react-flow__controls')) continue;
+      const b = element.getBoundingClientRect();
+      if (b.width === 0 || b.height === 0) continue;
+      const name = `${element.tagName.toLowerCase()}.${String(element.className).split(' ')[0]} "${(element.textContent ?? '').trim().slice(0, 30)}"`;
+      if (!scrolls(element) && (b.left < box.left - 1 || b.right > box.right + 1 || b.top < box.top - 1 || b.bottom > box.bottom + 1)) {
+        problems.push(`${name} overflows its pane (${pane.className.split(' ')[0] || pane.tagName})`);
+      }
+      // Text cut by its own box (ellipsis or hidden overflow), but not in the tree's canvas (a
+      // pan area whose boxes end long parameters in an ellipsis, shown whole in their tooltip
+      // and pane 5) nor in a field (its text scrolls as it is typed).
+      const field = ['INPUT', 'SELECT', 'TEXTAREA'].includes(element.tagName);
+      if (!field && !element.closest('.react-flow') && element.scrollWidth > element.clientWidth + 1 && /(hidden|clip)/.test(style.overflowX) && element.clientWidth > 0) {
+        problems.push(`${name} clips its text`);
+      }
+    }
+  }
+  return { smallest, smallestWhat, zoom, problems };
+}

@@ -1,0 +1,107 @@
+// The cell's robot as a three.js object: the URDF the planner reads (GET /api/robot: the arm's
+// with the gripper's mounted on the flange), built by urdf-loader from its collision primitives
+// (no meshes needed), placed where the cell stands it, its joints set by name from the stream,
+// and the fingers drawn from the gripper's reading in place of the URDF's finger links (which
+// cover the fingers' whole travel for the planner).
+
+import * as THREE from 'three';
+import URDFLoader from 'urdf-loader';
+import type { URDFRobot } from 'urdf-loader';
+import { adaptiveFingerBoxes, baseMatrix, FingerReading, jointValues, parallelFingerBoxes, RobotDescription } from './robot';
+
+const ARM_COLOUR = 0x4a90d9;
+const GRIPPER_COLOUR = 0x55595f;
+const FINGER_COLOUR = 0x33363a;
+
+export class DrawnRobot {
+  /** Add this to the scene: the robot at its base in the world. */
+  readonly object = new THREE.Group();
+  private readonly robot: URDFRobot;
+  private readonly fingers = new THREE.Group();
+  private readonly fingerMaterial = new THREE.MeshLambertMaterial({ color: FINGER_COLOUR });
+  private readonly materials: THREE.Material[] = [];
+  private fingerKey = '';
+
+  constructor(readonly description: RobotDescription) {
+    const loader = new URDFLoader();
+    loader.parseVisual = false;
+    loader.parseCollision = true;
+    this.robot = loader.parse(description.urdf);
+    const base = baseMatrix(description);
+    this.object.matrixAutoUpdate = false;
+    this.object.matrix.copy(base);
+    this.object.add(this.robot);
+    // The gripper's links: the flange's subtree beyond the arm (the mounted URDF adds them there).
+    const gripperLinks = new Set<string>();
+    const flange = this.robot.links[description.flange_link];
+    flange?.traverse((o) => {
+      const link = o as THREE.Object3D & { isURDFLink?: boolean; urdfName?: string };
+      if (link.isURDFLink && link !== flange && link.urdfName) gripperLinks.add(link.urdfName);
+    });
+    const armMaterial = new THREE.MeshLambertMaterial({ color: ARM_COLOUR });
+    const gripperMaterial = new THREE.MeshLambertMaterial({ color: GRIPPER_COLOUR });
+    this.materials.push(armMaterial, gripperMaterial, this.fingerMaterial);
+    for (const [name, link] of Object.entries(this.robot.links)) {
+      const hidden = description.gripper.finger_links.includes(name);
+      for (const child of link.children) {
+        const collider = child as THREE.Object3D & { isURDFCollider?: boolean };
+        if (!collider.isURDFCollider) continue;
+        collider.visible = !hidden;
+        collider.traverse((o) => {
+          const mesh = o as THREE.Mesh;
+          if (!mesh.isMesh) return;
+          (mesh.material as THREE.Material).dispose();
+          // The flange carries the gripper's mount (mountUrdf adds its shapes there).
+          mesh.material = gripperLinks.has(name) || name === description.flange_link ? gripperMaterial : armMaterial;
+        });
+      }
+    }
+    flange?.add(this.fingers);
+  }
+
+  /** Joint angles (the description's order, rad), the fingers' reading and the gripper's mode. */
+  update(joints: number[] | undefined, reading: FingerReading | undefined, mode: string | undefined) {
+    this.robot.setJointValues(jointValues(this.description, joints));
+    const key = JSON.stringify([reading?.positions, mode]);
+    if (key !== this.fingerKey) {
+      this.fingerKey = key;
+      this.drawFingers(reading, mode);
+    }
+    this.object.updateMatrixWorld(true);
+  }
+
+  private drawFingers(reading: FingerReading | undefined, mode: string | undefined) {
+    for (const child of [...this.fingers.children]) {
+      this.fingers.remove(child);
+      (child as THREE.Mesh).geometry.dispose();
+    }
+    const gripper = this.description.gripper;
+    const boxes =
+      gripper.kind === 'adaptive' && gripper.description
+        ? adaptiveFingerBoxes(gripper.description, mode, reading)
+        : parallelFingerBoxes(this.description, reading?.positions[0] ?? gripper.max_opening ?? 0);
+    for (const box of boxes) {
+      const mesh = new THREE.Mesh(new THREE.BoxGeometry(...box.size), this.fingerMaterial);
+      mesh.matrixAutoUpdate = false;
+      mesh.matrix.copy(box.matrix);
+      this.fingers.add(mesh);
+    }
+  }
+
+  /** The tool centre point as drawn, in the world (m). */
+  toolPosition(): THREE.Vector3 {
+    const tcp = this.robot.links[this.description.tcp_link] ?? this.robot.links[this.description.flange_link];
+    this.object.updateMatrixWorld(true);
+    return new THREE.Vector3().setFromMatrixPosition(tcp.matrixWorld);
+  }
+
+  /** How many of the gripper's finger boxes are drawn (tests). */
+  fingerBoxes(): number {
+    return this.fingers.children.length;
+  }
+
+  dispose() {
+    this.object.traverse((o) => (o as THREE.Mesh).geometry?.dispose?.());
+    this.materials.forEach((m) => m.dispose());
+  }
+}

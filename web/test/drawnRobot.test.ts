@@ -1,0 +1,47 @@
+// @vitest-environment happy-dom
+// urdf-loader reads the URDF with the browser's DOMParser: happy-dom stands in for the browser.
+import { readFileSync } from 'node:fs';
+import path from 'node:path';
+import { describe, expect, it } from 'vitest';
+import { DrawnRobot } from '../src/model/drawnRobot';
+import type { FingerReading, RobotDescription } from '../src/model/robot';
+
+interface Fixture {
+  robot: RobotDescription;
+  samples: { joints: number[]; endpoint: { p: [number, number, number] }; gripper: { mode?: string; reading?: FingerReading } }[];
+}
+// Recorded from `costar serve` (the note in each file says how).
+const fixture = (cell: string) => JSON.parse(readFileSync(path.join(__dirname, 'fixtures', `robot_${cell}.json`), 'utf8')) as Fixture;
+
+describe("the robot drawn from the planner's URDF", () => {
+  for (const cell of ['ur5-sim', 'iiwa-3f-sim']) {
+    it(`puts the tool centre point where the arm's endpoint symbol says (${cell})`, () => {
+      const { robot, samples } = fixture(cell);
+      const drawn = new DrawnRobot(robot);
+      for (const sample of samples) {
+        drawn.update(sample.joints, sample.gripper.reading, sample.gripper.mode);
+        const tool = drawn.toolPosition();
+        const error = Math.hypot(tool.x - sample.endpoint.p[0], tool.y - sample.endpoint.p[1], tool.z - sample.endpoint.p[2]);
+        expect(error).toBeLessThan(1e-4); // 0.1 mm: the same model, rounded on the stream
+      }
+      drawn.dispose();
+    });
+  }
+
+  it("draws the 3-finger gripper's phalanges and the 2-finger gripper's fingers, not the planner's boxes over their travel", () => {
+    const three = fixture('iiwa-3f-sim');
+    const drawn = new DrawnRobot(three.robot);
+    drawn.update(three.samples[1].joints, three.samples[1].gripper.reading, three.samples[1].gripper.mode);
+    expect(drawn.fingerBoxes()).toBe(9);
+    let hidden = 0;
+    drawn.object.traverse((o) => {
+      const collider = o as typeof o & { isURDFCollider?: boolean };
+      if (collider.isURDFCollider && !collider.visible) hidden++;
+    });
+    expect(hidden).toBeGreaterThan(0);
+    const two = fixture('ur5-sim');
+    const parallel = new DrawnRobot(two.robot);
+    parallel.update(two.samples[0].joints, two.samples[0].gripper.reading, two.samples[0].gripper.mode);
+    expect(parallel.fingerBoxes()).toBe(4);
+  });
+});
