@@ -263,23 +263,31 @@ class SimWorkcell final : public Workcell {
            {"lower", robot_description_.limits.min_position[j]},
            {"upper", robot_description_.limits.max_position[j]}});
     }
-    nlohmann::json gripper = {{"key", gripper_model_.key}};
-    if (adaptive_) {
+    // The fingers are drawn from the gripper's reading where the page knows how (in place of the
+    // finger link's shapes); a gripper whose fingers are not modelled keeps its URDF shapes.
+    nlohmann::json gripper = {{"key", gripper_model_.key}, {"finger_links", nlohmann::json::array()}};
+    if (!gripper_model_.adaptive.empty()) {
       gripper["kind"] = "adaptive";
       std::ifstream in(gripper::gripperDescriptionFile(gripper_model_.adaptive));
       gripper["description"] = nlohmann::json::parse(in);
-      gripper["finger_links"] = {gripper_model_.finger_link};
+      gripper["finger_links"].push_back(gripper_model_.finger_link);
     } else {
       gripper["kind"] = "parallel";
-      gripper["finger_links"] = gripper_model_.links;
-      if (gripper_model_.fingers) {
-        gripper["max_opening"] = gripper_model_.fingers->max_opening;
-        nlohmann::json boxes = nlohmann::json::array();
-        for (const gripper::FingerBox& box : gripper_model_.fingers->closed) {
-          boxes.push_back({{"centre", {box.centre.x(), box.centre.y(), box.centre.z()}},
-                           {"size", {box.size.x(), box.size.y(), box.size.z()}}});
+      gripper::FingerStance closed;
+      closed.opening = 0.0;
+      const auto stroke = gripper_model_.geometry->stroke();
+      const auto boxes = gripper_model_.geometry->fingerBoxes(closed);
+      if (stroke && boxes) {
+        gripper["max_opening"] = *stroke;
+        nlohmann::json finger = nlohmann::json::array();  // the +y finger closed; the other mirrors it
+        for (const gripper::OrientedBox& box : *boxes) {
+          const Eigen::Vector3d c = box.pose.translation();
+          if (c.y() > 0.0) {
+            finger.push_back({{"centre", {c.x(), c.y(), c.z()}}, {"size", {box.size.x(), box.size.y(), box.size.z()}}});
+          }
         }
-        gripper["finger_boxes"] = std::move(boxes);
+        gripper["finger_boxes"] = std::move(finger);
+        gripper["finger_links"].push_back(gripper_model_.finger_link);
       }
     }
     const Eigen::Quaterniond q(cell_.robot_base.linear());

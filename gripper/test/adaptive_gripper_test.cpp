@@ -194,6 +194,22 @@ TEST_F(AdaptiveGripperTest, CloseOnNothingClosesFully) {
   EXPECT_FALSE(holds("gripper_holding"));
 }
 
+// The fingers' reading is a symbol (the editor draws the fingers from it): each finger's
+// position, finger_middle first.
+TEST_F(AdaptiveGripperTest, TheReportCarriesEachFingersPosition) {
+  hand.block = {0.3, 0.35, 0.32};
+  ASSERT_EQ(run("Close", {{"force", 30.0}}).state, OperationState::kSuccess);
+  world::WorldState world;
+  world.update("gripper", gripper.report());
+  const world::Symbol* fingers = world.symbol("gripper_fingers");
+  ASSERT_NE(fingers, nullptr);
+  ASSERT_NE(fingers->joints(), nullptr);
+  EXPECT_EQ(fingers->joints()->joint_names, (std::vector<std::string>{"finger_middle", "finger_1", "finger_2"}));
+  ASSERT_EQ(fingers->joints()->positions.size(), 3u);
+  EXPECT_NEAR(fingers->joints()->positions[0], 0.3, 0.02);
+  EXPECT_NEAR(fingers->joints()->positions[1], 0.35, 0.02);
+}
+
 TEST_F(AdaptiveGripperTest, CloseOnAPartHoldsIt) {
   hand.block = {0.3, 0.35, 0.32};
   const OperationResult result = run("Close", {{"force", 30.0}});

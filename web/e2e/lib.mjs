@@ -127,14 +127,22 @@ export async function api(url, token, method, pathname, body) {
   return { status: response.status, json: text ? JSON.parse(text) : null };
 }
 
-/** Waits until the page's run label says the run ended; returns its result and text. */
-export async function waitForRunEnd(page, seconds = 240) {
+/** The run the page's status line names (0: none yet). */
+export async function shownRunId(page) {
+  return Number(/^(?:Run|Last run:) #(\d+)/.exec((await page.textContent('.run-label')) ?? '')?.[1] ?? 0);
+}
+
+/**
+ * Waits until the page's run label says a run after `after` (a run id) ended; returns its
+ * result and text (a result shown before the new run's start reached the page is not it).
+ */
+export async function waitForRunEnd(page, seconds = 240, after = 0) {
   const deadline = Date.now() + seconds * 1000;
   let sawRunning = false;
   while (Date.now() < deadline) {
     if (await page.$('.tree-node[data-running="true"]')) sawRunning = true;
     const result = await page.getAttribute('.run-label', 'data-run-result');
-    if (result) return { result, label: await page.textContent('.run-label'), sawRunning };
+    if (result && (await shownRunId(page)) > after) return { result, label: await page.textContent('.run-label'), sawRunning };
     await page.waitForTimeout(100);
   }
   return { result: '', label: await page.textContent('.run-label'), sawRunning };

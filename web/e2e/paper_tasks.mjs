@@ -11,7 +11,7 @@
 
 import fs from 'node:fs';
 import path from 'node:path';
-import { actionCounter, artifacts, groundTruth, launchBrowser, makeLog, openPage, startServer, waitForRunEnd } from './lib.mjs';
+import { actionCounter, artifacts, groundTruth, launchBrowser, makeLog, openPage, shownRunId, startServer, waitForRunEnd } from './lib.mjs';
 
 const { log, check } = makeLog('paper tasks');
 const NODE_HALF = 0.025;
@@ -81,8 +81,9 @@ async function main() {
   await r2l.fill('type the plan name', 'input[aria-label="plan name"]', 'move_nodes_right_to_left');
   await r2l.click('click Save', '.menu button:has-text("Save")');
   await page.waitForSelector('text=Saved move_nodes_right_to_left version 1');
+  const before = await shownRunId(page);
   await r2l.click('click Run', '.menu button.run');
-  const moved = await waitForRunEnd(page, 400);
+  const moved = await waitForRunEnd(page, 400, before);
   check(moved.result === 'SUCCESS', `right to left: ${moved.label}`);
   const first = await groundTruth(url, token);
   await page.waitForTimeout(500);
