@@ -243,7 +243,7 @@ TEST_F(HostileTest, AChainOfThousandsOfSubTreesIsRefusedNotACrash) {
   const json body = json::parse(validated.body);
   EXPECT_FALSE(body["valid"].get<bool>());
   ASSERT_EQ(body["diagnostics"].size(), 1u);
-  EXPECT_TRUE(body["diagnostics"][0]["where"].get<std::string>().starts_with("plan.xml:"));
+  EXPECT_TRUE(body["diagnostics"][0]["where"].get<std::string>().starts_with("plan:"));
   EXPECT_EQ(body["diagnostics"][0]["message"],
             "the plan nests deeper than 1000 levels once its subtrees are instantiated");
   EXPECT_EQ(body["diagnostics"][0]["node"]["tree"], "T500");  // the editor's node
