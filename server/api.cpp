@@ -81,6 +81,20 @@ std::optional<long long> parseLong(const std::string& text) {
   return value;
 }
 
+/// A count from the query (`name` = 1 to `most`), `fallback` when absent.
+/// @throws RequestError 400 when it is not such a number.
+std::size_t countParameter(const Target& target, const std::string& name, std::size_t fallback, std::size_t most) {
+  const auto it = target.query.find(name);
+  if (it == target.query.end()) {
+    return fallback;
+  }
+  const auto value = parseLong(it->second);
+  if (!value || *value < 1 || static_cast<unsigned long long>(*value) > most) {
+    throw RequestError(400, name + " must be 1 to " + std::to_string(most));
+  }
+  return static_cast<std::size_t>(*value);
+}
+
 std::optional<int> versionParameter(const Target& target) {
   const auto it = target.query.find("version");
   if (it == target.query.end()) {
@@ -193,7 +207,6 @@ constexpr std::size_t kRunPageBytes = 4u << 20;
 
 TransitionPage transitionPage(const Target& target, std::size_t most) {
   TransitionPage page;
-  page.limit = most;
   page.max_bytes = kRunPageBytes;
   if (const auto it = target.query.find("from"); it != target.query.end()) {
     const auto value = parseLong(it->second);
@@ -202,13 +215,7 @@ TransitionPage transitionPage(const Target& target, std::size_t most) {
     }
     page.from = static_cast<std::uint64_t>(*value);
   }
-  if (const auto it = target.query.find("limit"); it != target.query.end()) {
-    const auto value = parseLong(it->second);
-    if (!value || *value < 1 || *value > static_cast<long long>(most)) {
-      throw RequestError(400, "limit must be 1 to " + std::to_string(most));
-    }
-    page.limit = static_cast<std::size_t>(*value);
-  }
+  page.limit = countParameter(target, "limit", most, most);
   return page;
 }
 
@@ -249,6 +256,410 @@ json runLogJson(const RunLog& log) {
   return out;
 }
 
+// --- the handlers: one per route, each given the request as a Call ---------------------------
+
+/// A request matched to a route: its path parameters (the pattern's {…} segments, in order)
+/// and query, and what the API answers from.
+struct Call {
+  const HttpRequest& request;
+  const std::vector<std::string>& params;
+  const Target& target;
+  Backend& backend;
+  Store& store;
+  const ApiOptions& options;
+
+  json body() const { return parseRequestJson(request.body); }
+  /// A logged run's id from the path: a positive integer.
+  std::int64_t loggedRunId() const {
+    const auto id = parseLong(params[0]);
+    if (!id || *id < 1) {
+      throw RequestError(400, "a logged run's id is a positive integer");
+    }
+    return *id;
+  }
+};
+
+HttpResponse getInfo(const Call& call) { return jsonResponse(call.backend.info()); }
+
+HttpResponse getNodes(const Call& call) {
+  HttpResponse response;
+  response.body = call.backend.nodesJson();
+  return response;
+}
+
+HttpResponse getChoices(const Call& call) { return jsonResponse(call.backend.choices()); }
+
+HttpResponse getState(const Call& call) { return jsonResponse(call.backend.state()); }
+
+HttpResponse getPointCloud(const Call& call) {
+  const auto cloud = call.backend.pointCloud(countParameter(call.target, "max", 20000, 200000));
+  return cloud ? jsonResponse(*cloud) : errorResponse(404, "this workcell has no RGB-D camera to show");
+}
+
+HttpResponse getRobot(const Call& call) {
+  const auto robot = call.backend.robot();
+  return robot ? jsonResponse(*robot) : errorResponse(404, "this cell has no robot to draw");
+}
+
+HttpResponse resetScene(const Call& call) {
+  const StartResult reset = call.backend.resetScene();
+  return reset.status == 0 ? jsonResponse({{"reset", true}}) : errorResponse(reset.status, reset.error);
+}
+
+// Saved plans and subtrees: the same handlers for both kinds of document.
+constexpr const char* noun(DocumentKind kind) { return kind == DocumentKind::kPlan ? "plan" : "subtree"; }
+
+HttpResponse noDocument(DocumentKind kind, const std::string& name, const std::string& detail = {}) {
+  return errorResponse(404, std::string("no ") + noun(kind) + " '" + name + "'" + detail);
+}
+
+template <DocumentKind kind>
+HttpResponse listDocuments(const Call& call) {
+  json list = json::array();
+  for (const auto& summary : call.store.list(kind)) {
+    list.push_back({{"name", summary.name},
+                    {"latest_version", summary.latest_version},
+                    {"versions", summary.versions},
+                    {"updated_at", summary.updated_at}});
+  }
+  return jsonResponse(list);
+}
+
+template <DocumentKind kind>
+HttpResponse getDocument(const Call& call) {
+  const std::string& name = call.params[0];
+  const auto document = call.store.load(kind, name, versionParameter(call.target));
+  return document ? jsonResponse(documentJson(*document))
+                  : noDocument(kind, name, call.target.query.contains("version") ? " with that version" : "");
+}
+
+template <DocumentKind kind>
+HttpResponse saveDocument(const Call& call) {
+  const std::string& name = call.params[0];
+  ParsedPlan parsed = planFromBody(call.body(), name + ".xml");
+  if (kind == DocumentKind::kSubtree) {
+    if (parsed.plan.file.trees.size() != 1 || parsed.plan.file.trees.front().id != name) {
+      throw RequestError(422, "a saved subtree is one BehaviorTree whose ID is its name ('" + name + "')");
+    }
+    parsed.plan.file.main_tree = name;
+    parsed.xml = bt::writePlanFile(parsed.plan.file);
+    parsed.plan = bt::loadPlanText(parsed.xml, name + ".xml", {.follow_includes = false});
+  }
+  if (auto diagnostics = call.backend.validate(parsed.plan); !diagnostics.empty()) {
+    return invalidPlan(diagnostics, parsed.plan.file, name);
+  }
+  const int version = call.store.save(kind, name, parsed.xml);
+  return jsonResponse({{"name", name}, {"version", version}}, 201);
+}
+
+template <DocumentKind kind>
+HttpResponse deleteDocument(const Call& call) {
+  const std::string& name = call.params[0];
+  return call.store.remove(kind, name) ? jsonResponse({{"deleted", name}}) : noDocument(kind, name);
+}
+
+template <DocumentKind kind>
+HttpResponse listVersions(const Call& call) {
+  json list = json::array();
+  for (const auto& version : call.store.versions(kind, call.params[0])) {
+    list.push_back({{"version", version.version}, {"saved_at", version.saved_at}});
+  }
+  return list.empty() ? noDocument(kind, call.params[0]) : jsonResponse(list);
+}
+
+template <DocumentKind kind>
+HttpResponse getDocumentXml(const Call& call) {
+  const std::string& name = call.params[0];
+  const auto document = call.store.load(kind, name, versionParameter(call.target));
+  if (!document) {
+    return noDocument(kind, name);
+  }
+  HttpResponse response;
+  response.content_type = "application/xml";
+  response.body = document->xml;
+  response.headers.emplace_back("Content-Disposition", "attachment; filename=\"" + name + ".xml\"");
+  return response;
+}
+
+HttpResponse validatePlan(const Call& call) {
+  // "name": the plan's name in messages (optional; the page sends the name it has).
+  const json request_body = call.body();
+  std::string label = "plan";
+  if (request_body.is_object()) {
+    if (const auto it = request_body.find("name");
+        it != request_body.end() && it->is_string() && checkName(it->get_ref<const std::string&>()).empty()) {
+      label = it->get<std::string>();
+    }
+  }
+  const ParsedPlan parsed = planFromBody(request_body, label);
+  const auto diagnostics = call.backend.checkForCell(parsed.plan);
+  return jsonResponse({{"valid", diagnostics.empty()},
+                       {"diagnostics", diagnosticsToJson(diagnostics, parsed.plan.file)},
+                       {"xml", parsed.xml},
+                       {"plan", planFileToJson(parsed.plan.file)}});
+}
+
+HttpResponse listRuns(const Call& call) {
+  json list = json::array();
+  for (const auto& run : call.store.runs(countParameter(call.target, "limit", 100, 10000))) {
+    list.push_back(runJson(run));
+  }
+  return jsonResponse(list);
+}
+
+/// POST /api/runs: a saved plan by name (and version), or a plan in the body.
+HttpResponse startPlanRun(const Call& call) {
+  const json request_body = call.body();
+  RunRequest run;
+  if (request_body.is_object() && request_body.contains("name")) {
+    if (!request_body["name"].is_string()) {
+      throw RequestError(400, "'name' must be a string");
+    }
+    const std::string& name = checkedName(request_body["name"].get_ref<const std::string&>());
+    std::optional<int> version;
+    if (const auto it = request_body.find("version"); it != request_body.end() && !it->is_null()) {
+      if (!it->is_number_integer() || it->get<long long>() < 1 || it->get<long long>() > 1'000'000'000) {
+        throw RequestError(400, "'version' must be a positive integer");
+      }
+      version = it->get<int>();
+    }
+    const auto document = call.store.load(DocumentKind::kPlan, name, version);
+    if (!document) {
+      return errorResponse(404, "no plan '" + name + "'");
+    }
+    run.plan = bt::loadPlanText(document->xml, name + ".xml", {.follow_includes = false});
+    run.xml = document->xml;
+    run.plan_name = name;
+    run.version = document->version;
+  } else {
+    ParsedPlan parsed = planFromBody(request_body, "plan.xml");
+    run.plan = std::move(parsed.plan);
+    run.xml = std::move(parsed.xml);
+  }
+  if (const auto it = request_body.find("paused"); it != request_body.end()) {
+    if (!it->is_boolean()) {
+      throw RequestError(400, "'paused' must be true or false");
+    }
+    run.start_paused = it->get<bool>();
+  }
+  return startRun(call.backend, std::move(run));
+}
+
+/// GET /api/runs/ID: a logged run (a page of its transitions, and its live status while it
+/// runs), an operation the engine remembers (negative ids), or "active".
+HttpResponse getRun(const Call& call) {
+  if (call.params[0] == "active") {
+    const auto status = call.backend.runStatus(std::nullopt);
+    return status ? jsonResponse(*status) : errorResponse(404, "nothing has run yet");
+  }
+  const auto id = parseLong(call.params[0]);
+  if (!id || *id == 0) {
+    throw RequestError(400, "a run id is a nonzero integer (plan runs count up from 1, operations down from -1)");
+  }
+  if (const auto log = *id > 0 ? call.store.run(*id, transitionPage(call.target, call.options.run_page_transitions))
+                               : std::nullopt) {
+    json out = runLogJson(*log);
+    if (const auto status = call.backend.runStatus(*id)) {
+      out["live"] = *status;
+    }
+    return jsonResponse(out);
+  }
+  const auto status = call.backend.runStatus(*id);
+  return status ? jsonResponse(*status) : errorResponse(404, "no run " + std::to_string(*id));
+}
+
+HttpResponse getRunStates(const Call& call) {
+  const std::int64_t id = call.loggedRunId();
+  const std::vector<StateRecord> records = call.store.runStates(id);
+  if (records.empty() && !call.store.run(id)) {
+    return errorResponse(404, "no run " + std::to_string(id));
+  }
+  json states = json::array();
+  for (const StateRecord& state : records) {
+    json snapshot = json::parse(state.state, nullptr, false);
+    if (!snapshot.is_discarded()) {
+      states.push_back({{"t", state.t}, {"state", std::move(snapshot)}});
+    }
+  }
+  return jsonResponse({{"run", id}, {"states", std::move(states)}});
+}
+
+HttpResponse getRunTransitions(const Call& call) {
+  const std::int64_t id = call.loggedRunId();
+  const auto log = call.store.run(id, transitionPage(call.target, call.options.run_page_transitions),
+                                  /*with_nodes=*/false);
+  if (!log) {
+    return errorResponse(404, "no logged run " + std::to_string(id));
+  }
+  json out = {{"id", id}, {"transitions", log->run.transitions}};
+  addTransitions(out, *log);
+  return jsonResponse(out);
+}
+
+HttpResponse controlRun(const Call& call) {
+  const json request_body = call.body();
+  if (!request_body.is_object() || !request_body.contains("action") || !request_body["action"].is_string()) {
+    throw RequestError(400, "the body must be {\"action\": \"pause\" | \"resume\" | \"step\" | \"stop\"}");
+  }
+  const std::string& action = request_body["action"].get_ref<const std::string&>();
+  static const std::map<std::string, RunControl> kActions = {{"pause", RunControl::kPause},
+                                                             {"resume", RunControl::kResume},
+                                                             {"step", RunControl::kStep},
+                                                             {"stop", RunControl::kStop}};
+  const auto it = kActions.find(action);
+  if (it == kActions.end()) {
+    throw RequestError(400, "unknown action '" + action.substr(0, 32) + "' (pause, resume, step, stop)");
+  }
+  if (!call.backend.control(it->second)) {
+    return errorResponse(409, "nothing is running");
+  }
+  return jsonResponse({{"ok", action}});
+}
+
+/// POST /api/operations: one operation from the menu or the waypoint panel, as a one-node plan.
+HttpResponse startOperation(const Call& call) {
+  const json request_body = call.body();
+  if (!request_body.is_object() || !request_body.contains("node") || !request_body["node"].is_string()) {
+    throw RequestError(400, "the body must be {\"node\": TYPE, \"attributes\": {NAME: VALUE, ...}}");
+  }
+  json node = {{"id", request_body["node"]}, {"attributes", json::array()}, {"children", json::array()}};
+  if (const auto it = request_body.find("attributes"); it != request_body.end()) {
+    if (!it->is_object()) {
+      throw RequestError(400, "'attributes' must be an object of strings");
+    }
+    for (const auto& [key, value] : it->items()) {
+      if (!value.is_string()) {
+        throw RequestError(400, "attribute '" + key.substr(0, 64) + "' must be a string");
+      }
+      node["attributes"].push_back({key, value});
+    }
+  }
+  ParsedPlan parsed = planFromBody(
+      {{"plan", {{"main_tree", "operation"}, {"trees", {{{"id", "operation"}, {"root", node}}}}}}}, "operation.xml");
+  RunRequest run;
+  run.plan = std::move(parsed.plan);
+  run.xml = std::move(parsed.xml);
+  run.operation = true;
+  return startRun(call.backend, std::move(run));
+}
+
+HttpResponse getGroundTruth(const Call& call) {
+  const auto truth = call.backend.groundTruth();
+  return truth ? jsonResponse(*truth) : errorResponse(404, "this workcell has no simulator");
+}
+
+// --- the route table ---------------------------------------------------------------------------
+
+/// Who may call a route: kRead, anyone while the server listens on loopback only (else the
+/// token); kChange, the token (every method but GET); kToken, the token always (test endpoints).
+enum class Access { kRead, kChange, kToken };
+
+/// A command's body is small: 16 KiB is far more than any needs.
+constexpr std::size_t kSmallBody = 16u << 10;
+
+struct Route {
+  /// "GET" (which answers HEAD too), "POST", "PUT" or "DELETE".
+  std::string_view method;
+  /// Segments after /api/; "{name}" is a plan's or subtree's name (refused with 400 unless it
+  /// is an identifier), any other "{…}" one segment as it is. Both are the handler's params.
+  std::string_view pattern;
+  HttpResponse (*handler)(const Call&);
+  Access access;
+  /// The most bytes of body this route reads; 0: ApiOptions::max_body_bytes.
+  std::size_t max_body = 0;
+  /// A long read (run logs, the run list, the point cloud), answered on a thread of its own.
+  bool bulk = false;
+  /// TEST ONLY: served only with ApiOptions::test_endpoints.
+  bool test_only = false;
+};
+
+// Adding an endpoint is a row here and its handler above (and its line in docs/EDITOR.md).
+constexpr Route kRoutes[] = {
+    {"GET", "info", getInfo, Access::kRead},
+    {"GET", "nodes", getNodes, Access::kRead},
+    {"GET", "choices", getChoices, Access::kRead},
+    {"GET", "state", getState, Access::kRead},
+    {"GET", "pointcloud", getPointCloud, Access::kRead, 0, true},
+    {"GET", "robot", getRobot, Access::kRead},
+    {"POST", "scene/reset", resetScene, Access::kChange, kSmallBody},
+    {"GET", "plans", listDocuments<DocumentKind::kPlan>, Access::kRead},
+    {"GET", "plans/{name}", getDocument<DocumentKind::kPlan>, Access::kRead},
+    {"PUT", "plans/{name}", saveDocument<DocumentKind::kPlan>, Access::kChange},
+    {"DELETE", "plans/{name}", deleteDocument<DocumentKind::kPlan>, Access::kChange},
+    {"GET", "plans/{name}/versions", listVersions<DocumentKind::kPlan>, Access::kRead},
+    {"GET", "plans/{name}/xml", getDocumentXml<DocumentKind::kPlan>, Access::kRead},
+    {"GET", "subtrees", listDocuments<DocumentKind::kSubtree>, Access::kRead},
+    {"GET", "subtrees/{name}", getDocument<DocumentKind::kSubtree>, Access::kRead},
+    {"PUT", "subtrees/{name}", saveDocument<DocumentKind::kSubtree>, Access::kChange},
+    {"DELETE", "subtrees/{name}", deleteDocument<DocumentKind::kSubtree>, Access::kChange},
+    {"GET", "subtrees/{name}/versions", listVersions<DocumentKind::kSubtree>, Access::kRead},
+    {"GET", "subtrees/{name}/xml", getDocumentXml<DocumentKind::kSubtree>, Access::kRead},
+    {"POST", "validate", validatePlan, Access::kChange},
+    {"GET", "runs", listRuns, Access::kRead, 0, true},
+    {"POST", "runs", startPlanRun, Access::kChange},
+    {"GET", "runs/{id}", getRun, Access::kRead, 0, true},
+    {"GET", "runs/{id}/states", getRunStates, Access::kRead, 0, true},
+    {"GET", "runs/{id}/transitions", getRunTransitions, Access::kRead, 0, true},
+    {"POST", "control", controlRun, Access::kChange, kSmallBody},
+    {"POST", "operations", startOperation, Access::kChange},
+    {"GET", "test/ground_truth", getGroundTruth, Access::kToken, 0, false, true},
+};
+
+bool isRead(std::string_view method) { return method == "GET" || method == "HEAD"; }
+
+/// Whether a request's path (segments after "api") has a route's pattern; fills its params.
+bool matches(const Route& route, const std::vector<std::string>& segments, std::vector<std::string>& params) {
+  params.clear();
+  std::size_t i = 1;
+  std::string_view rest = route.pattern;
+  while (!rest.empty()) {
+    const std::size_t slash = rest.find('/');
+    const std::string_view part = rest.substr(0, slash);
+    rest = slash == std::string_view::npos ? std::string_view() : rest.substr(slash + 1);
+    if (i >= segments.size()) {
+      return false;
+    }
+    if (part.starts_with('{')) {
+      params.push_back(segments[i]);
+    } else if (segments[i] != part) {
+      return false;
+    }
+    ++i;
+  }
+  return i == segments.size();
+}
+
+/// What a request reaches: the route for its path and method, whether any route has its path
+/// (then a wrong method is 405), and the route's params.
+struct Match {
+  const Route* route = nullptr;
+  const Route* path = nullptr;
+  std::vector<std::string> params;
+};
+
+Match findRoute(const Target& target, std::string_view method, bool test_endpoints) {
+  Match match;
+  if (target.segments.empty() || target.segments[0] != "api") {
+    return match;
+  }
+  std::vector<std::string> params;
+  for (const Route& route : kRoutes) {
+    if ((route.test_only && !test_endpoints) || !matches(route, target.segments, params)) {
+      continue;
+    }
+    if (match.path == nullptr) {
+      match.path = &route;
+      match.params = params;
+    }
+    if (route.method == method || (route.method == "GET" && method == "HEAD")) {
+      match.route = &route;
+      match.params = std::move(params);
+      return match;
+    }
+  }
+  return match;
+}
+
 }  // namespace
 
 Api::Api(Backend& backend, Store& store, ApiOptions options)
@@ -259,9 +670,8 @@ bool Api::authorized(std::string_view authorization) const {
 }
 
 bool Api::isBulkRead(const HttpRequest& request) {
-  const std::string_view path = std::string_view(request.target).substr(0, request.target.find('?'));
-  return (request.method == "GET" || request.method == "HEAD") &&
-         (path == "/api/runs" || path.starts_with("/api/runs/") || path == "/api/pointcloud");
+  const Match match = findRoute(parseTarget(request.target), request.method, false);
+  return match.route != nullptr && match.route->bulk;
 }
 
 bool Api::tokenMatches(std::string_view token) const { return sameToken(token, options_.token); }
@@ -279,17 +689,34 @@ HttpResponse Api::handle(const HttpRequest& request) {
 
 HttpResponse Api::answer(const HttpRequest& request) {
   try {
-    if (request.body.size() > options_.max_body_bytes) {
-      return errorResponse(413, "the body is larger than " + std::to_string(options_.max_body_bytes) + " bytes");
+    // Refusals come in this order: too large, not signed in, no such endpoint, a bad name in
+    // the path, a method the endpoint does not take.
+    const Target target = parseTarget(request.target);
+    const Match match = findRoute(target, request.method, options_.test_endpoints);
+    const std::size_t max_body =
+        match.route != nullptr && match.route->max_body != 0 ? match.route->max_body : options_.max_body_bytes;
+    if (request.body.size() > max_body) {
+      return errorResponse(413, "the body is larger than " + std::to_string(max_body) + " bytes");
     }
-    const bool read = request.method == "GET" || request.method == "HEAD";
-    if ((!read || options_.reads_need_token) && !authorized(request.authorization)) {
-      return errorResponse(401, read ? "sign in: this server needs the token for everything (it listens beyond "
-                                       "this machine)"
-                                     : "sign in to change plans or move the robot (with the token `costar serve` "
-                                       "printed or wrote to its token file)");
+    const bool read = isRead(request.method);
+    const Access access = match.route != nullptr ? match.route->access : (read ? Access::kRead : Access::kChange);
+    if ((access != Access::kRead || options_.reads_need_token) && !authorized(request.authorization)) {
+      return errorResponse(401, access == Access::kToken ? "test endpoints need the token"
+                                : read ? "sign in: this server needs the token for everything (it listens beyond "
+                                         "this machine)"
+                                       : "sign in to change plans or move the robot (with the token `costar serve` "
+                                         "printed or wrote to its token file)");
     }
-    return route(request);
+    if (match.path == nullptr) {
+      return errorResponse(404, "no such endpoint: " + request.target.substr(0, 200));
+    }
+    if (match.path->pattern.find("{name}") != std::string_view::npos) {
+      checkedName(match.params[0]);
+    }
+    if (match.route == nullptr) {
+      return errorResponse(405, "method " + request.method.substr(0, 16) + " not allowed here");
+    }
+    return match.route->handler(Call{request, match.params, target, backend_, store_, options_});
   } catch (const RequestError& error) {
     return errorResponse(error.status(), error.what());
   } catch (const bt::PlanError& error) {
@@ -301,356 +728,6 @@ HttpResponse Api::answer(const HttpRequest& request) {
   } catch (const std::exception& error) {
     return errorResponse(500, std::string("internal error: ") + error.what());
   }
-}
-
-HttpResponse Api::route(const HttpRequest& request) {
-  const Target target = parseTarget(request.target);
-  const auto& s = target.segments;
-  const std::string& method = request.method;
-  const bool get = method == "GET" || method == "HEAD";
-  if (s.empty() || s[0] != "api") {
-    return errorResponse(404, "no such endpoint: " + request.target.substr(0, 200));
-  }
-  const auto is = [&s](std::initializer_list<const char*> path) {
-    if (s.size() != path.size() + 1) {
-      return false;
-    }
-    std::size_t i = 1;
-    for (const char* part : path) {
-      if (part[0] != '*' && s[i] != part) {
-        return false;
-      }
-      ++i;
-    }
-    return true;
-  };
-  const auto body = [&request] { return parseRequestJson(request.body); };
-  const auto wrongMethod = [&method] {
-    return errorResponse(405, "method " + method.substr(0, 16) + " not allowed here");
-  };
-
-  if (is({"info"})) {
-    return get ? jsonResponse(backend_.info()) : wrongMethod();
-  }
-  if (is({"nodes"})) {
-    if (!get) {
-      return wrongMethod();
-    }
-    HttpResponse response;
-    response.body = backend_.nodesJson();
-    return response;
-  }
-  if (is({"choices"})) {
-    return get ? jsonResponse(backend_.choices()) : wrongMethod();
-  }
-  if (is({"state"})) {
-    return get ? jsonResponse(backend_.state()) : wrongMethod();
-  }
-  if (is({"pointcloud"})) {
-    if (!get) {
-      return wrongMethod();
-    }
-    std::size_t max_points = 20000;
-    if (const auto it = target.query.find("max"); it != target.query.end()) {
-      const auto value = parseLong(it->second);
-      if (!value || *value < 1 || *value > 200000) {
-        throw RequestError(400, "max must be 1 to 200000");
-      }
-      max_points = static_cast<std::size_t>(*value);
-    }
-    const auto cloud = backend_.pointCloud(max_points);
-    return cloud ? jsonResponse(*cloud) : errorResponse(404, "this workcell has no RGB-D camera to show");
-  }
-
-  // --- plans and saved subtrees ----------------------------------------------------------
-  if (s.size() >= 2 && (s[1] == "plans" || s[1] == "subtrees")) {
-    const DocumentKind kind = s[1] == "plans" ? DocumentKind::kPlan : DocumentKind::kSubtree;
-    const char* noun = kind == DocumentKind::kPlan ? "plan" : "subtree";
-    if (s.size() == 2) {
-      if (!get) {
-        return wrongMethod();
-      }
-      json list = json::array();
-      for (const auto& summary : store_.list(kind)) {
-        list.push_back({{"name", summary.name},
-                        {"latest_version", summary.latest_version},
-                        {"versions", summary.versions},
-                        {"updated_at", summary.updated_at}});
-      }
-      return jsonResponse(list);
-    }
-    const std::string& name = checkedName(s[2]);
-    if (s.size() == 3) {
-      if (get) {
-        const auto document = store_.load(kind, name, versionParameter(target));
-        return document ? jsonResponse(documentJson(*document))
-                        : errorResponse(404, std::string("no ") + noun + " '" + name + "'" +
-                                                 (target.query.contains("version") ? " with that version" : ""));
-      }
-      if (method == "PUT") {
-        ParsedPlan parsed = planFromBody(body(), name + ".xml");
-        if (kind == DocumentKind::kSubtree) {
-          if (parsed.plan.file.trees.size() != 1 || parsed.plan.file.trees.front().id != name) {
-            throw RequestError(422, "a saved subtree is one BehaviorTree whose ID is its name ('" + name + "')");
-          }
-          parsed.plan.file.main_tree = name;
-          parsed.xml = bt::writePlanFile(parsed.plan.file);
-          parsed.plan = bt::loadPlanText(parsed.xml, name + ".xml", {.follow_includes = false});
-        }
-        if (auto diagnostics = backend_.validate(parsed.plan); !diagnostics.empty()) {
-          return invalidPlan(diagnostics, parsed.plan.file, name);
-        }
-        const int version = store_.save(kind, name, parsed.xml);
-        return jsonResponse({{"name", name}, {"version", version}}, 201);
-      }
-      if (method == "DELETE") {
-        return store_.remove(kind, name) ? jsonResponse({{"deleted", name}})
-                                         : errorResponse(404, std::string("no ") + noun + " '" + name + "'");
-      }
-      return wrongMethod();
-    }
-    if (s.size() == 4 && s[3] == "versions") {
-      if (!get) {
-        return wrongMethod();
-      }
-      json list = json::array();
-      for (const auto& version : store_.versions(kind, name)) {
-        list.push_back({{"version", version.version}, {"saved_at", version.saved_at}});
-      }
-      return list.empty() ? errorResponse(404, std::string("no ") + noun + " '" + name + "'") : jsonResponse(list);
-    }
-    if (s.size() == 4 && s[3] == "xml") {
-      if (!get) {
-        return wrongMethod();
-      }
-      const auto document = store_.load(kind, name, versionParameter(target));
-      if (!document) {
-        return errorResponse(404, std::string("no ") + noun + " '" + name + "'");
-      }
-      HttpResponse response;
-      response.content_type = "application/xml";
-      response.body = document->xml;
-      response.headers.emplace_back("Content-Disposition", "attachment; filename=\"" + name + ".xml\"");
-      return response;
-    }
-    return errorResponse(404, "no such endpoint");
-  }
-
-  if (is({"robot"})) {
-    if (!get) {
-      return wrongMethod();
-    }
-    const auto robot = backend_.robot();
-    return robot ? jsonResponse(*robot) : errorResponse(404, "this cell has no robot to draw");
-  }
-  if (is({"scene", "reset"})) {
-    if (method != "POST") {
-      return wrongMethod();
-    }
-    const StartResult reset = backend_.resetScene();
-    return reset.status == 0 ? jsonResponse({{"reset", true}}) : errorResponse(reset.status, reset.error);
-  }
-
-  if (is({"validate"})) {
-    if (method != "POST") {
-      return wrongMethod();
-    }
-    // "name": the plan's name in messages (optional; the page sends the name it has).
-    const json request_body = body();
-    std::string label = "plan";
-    if (request_body.is_object()) {
-      if (const auto it = request_body.find("name");
-          it != request_body.end() && it->is_string() && checkName(it->get_ref<const std::string&>()).empty()) {
-        label = it->get<std::string>();
-      }
-    }
-    const ParsedPlan parsed = planFromBody(request_body, label);
-    const auto diagnostics = backend_.checkForCell(parsed.plan);
-    return jsonResponse({{"valid", diagnostics.empty()},
-                         {"diagnostics", diagnosticsToJson(diagnostics, parsed.plan.file)},
-                         {"xml", parsed.xml},
-                         {"plan", planFileToJson(parsed.plan.file)}});
-  }
-
-  // --- runs ----------------------------------------------------------------------------------
-  if (is({"runs"})) {
-    if (get) {
-      std::size_t limit = 100;
-      if (const auto it = target.query.find("limit"); it != target.query.end()) {
-        const auto value = parseLong(it->second);
-        if (!value || *value < 1 || *value > 10000) {
-          throw RequestError(400, "limit must be 1 to 10000");
-        }
-        limit = static_cast<std::size_t>(*value);
-      }
-      json list = json::array();
-      for (const auto& run : store_.runs(limit)) {
-        list.push_back(runJson(run));
-      }
-      return jsonResponse(list);
-    }
-    if (method != "POST") {
-      return wrongMethod();
-    }
-    const json request_body = body();
-    RunRequest run;
-    if (request_body.is_object() && request_body.contains("name")) {
-      if (!request_body["name"].is_string()) {
-        throw RequestError(400, "'name' must be a string");
-      }
-      const std::string& name = checkedName(request_body["name"].get_ref<const std::string&>());
-      std::optional<int> version;
-      if (const auto it = request_body.find("version"); it != request_body.end() && !it->is_null()) {
-        if (!it->is_number_integer() || it->get<long long>() < 1 || it->get<long long>() > 1'000'000'000) {
-          throw RequestError(400, "'version' must be a positive integer");
-        }
-        version = it->get<int>();
-      }
-      const auto document = store_.load(DocumentKind::kPlan, name, version);
-      if (!document) {
-        return errorResponse(404, "no plan '" + name + "'");
-      }
-      run.plan = bt::loadPlanText(document->xml, name + ".xml", {.follow_includes = false});
-      run.xml = document->xml;
-      run.plan_name = name;
-      run.version = document->version;
-    } else {
-      ParsedPlan parsed = planFromBody(request_body, "plan.xml");
-      run.plan = std::move(parsed.plan);
-      run.xml = std::move(parsed.xml);
-    }
-    if (const auto it = request_body.find("paused"); it != request_body.end()) {
-      if (!it->is_boolean()) {
-        throw RequestError(400, "'paused' must be true or false");
-      }
-      run.start_paused = it->get<bool>();
-    }
-    return startRun(backend_, std::move(run));
-  }
-  if (is({"runs", "*", "states"})) {
-    if (!get) {
-      return wrongMethod();
-    }
-    const auto id = parseLong(s[2]);
-    if (!id || *id <= 0) {
-      throw RequestError(400, "a logged run's id is a positive integer");
-    }
-    const std::vector<StateRecord> records = store_.runStates(*id);
-    if (records.empty() && !store_.run(*id)) {
-      return errorResponse(404, "no run " + std::to_string(*id));
-    }
-    json states = json::array();
-    for (const StateRecord& state : records) {
-      json snapshot = json::parse(state.state, nullptr, false);
-      if (!snapshot.is_discarded()) {
-        states.push_back({{"t", state.t}, {"state", std::move(snapshot)}});
-      }
-    }
-    return jsonResponse({{"run", *id}, {"states", std::move(states)}});
-  }
-  if (is({"runs", "*"})) {
-    if (!get) {
-      return wrongMethod();
-    }
-    if (s[2] == "active") {
-      const auto status = backend_.runStatus(std::nullopt);
-      return status ? jsonResponse(*status) : errorResponse(404, "nothing has run yet");
-    }
-    const auto id = parseLong(s[2]);
-    if (!id || *id == 0) {
-      throw RequestError(400, "a run id is a nonzero integer (plan runs count up from 1, operations down from -1)");
-    }
-    if (const auto log =
-            *id > 0 ? store_.run(*id, transitionPage(target, options_.run_page_transitions)) : std::nullopt) {
-      json out = runLogJson(*log);
-      if (const auto status = backend_.runStatus(*id)) {
-        out["live"] = *status;
-      }
-      return jsonResponse(out);
-    }
-    const auto status = backend_.runStatus(*id);
-    return status ? jsonResponse(*status) : errorResponse(404, "no run " + std::to_string(*id));
-  }
-  if (is({"runs", "*", "transitions"})) {
-    if (!get) {
-      return wrongMethod();
-    }
-    const auto id = parseLong(s[2]);
-    if (!id || *id < 1) {
-      throw RequestError(400, "a logged run's id is a positive integer");
-    }
-    const auto log = store_.run(*id, transitionPage(target, options_.run_page_transitions), /*with_nodes=*/false);
-    if (!log) {
-      return errorResponse(404, "no logged run " + std::to_string(*id));
-    }
-    json out = {{"id", *id}, {"transitions", log->run.transitions}};
-    addTransitions(out, *log);
-    return jsonResponse(out);
-  }
-  if (is({"control"})) {
-    if (method != "POST") {
-      return wrongMethod();
-    }
-    const json request_body = body();
-    if (!request_body.is_object() || !request_body.contains("action") || !request_body["action"].is_string()) {
-      throw RequestError(400, "the body must be {\"action\": \"pause\" | \"resume\" | \"step\" | \"stop\"}");
-    }
-    const std::string& action = request_body["action"].get_ref<const std::string&>();
-    static const std::map<std::string, RunControl> kActions = {{"pause", RunControl::kPause},
-                                                               {"resume", RunControl::kResume},
-                                                               {"step", RunControl::kStep},
-                                                               {"stop", RunControl::kStop}};
-    const auto it = kActions.find(action);
-    if (it == kActions.end()) {
-      throw RequestError(400, "unknown action '" + action.substr(0, 32) + "' (pause, resume, step, stop)");
-    }
-    if (!backend_.control(it->second)) {
-      return errorResponse(409, "nothing is running");
-    }
-    return jsonResponse({{"ok", action}});
-  }
-  if (is({"operations"})) {
-    if (method != "POST") {
-      return wrongMethod();
-    }
-    const json request_body = body();
-    if (!request_body.is_object() || !request_body.contains("node") || !request_body["node"].is_string()) {
-      throw RequestError(400, "the body must be {\"node\": TYPE, \"attributes\": {NAME: VALUE, ...}}");
-    }
-    json node = {{"id", request_body["node"]}, {"attributes", json::array()}, {"children", json::array()}};
-    if (const auto it = request_body.find("attributes"); it != request_body.end()) {
-      if (!it->is_object()) {
-        throw RequestError(400, "'attributes' must be an object of strings");
-      }
-      for (const auto& [key, value] : it->items()) {
-        if (!value.is_string()) {
-          throw RequestError(400, "attribute '" + key.substr(0, 64) + "' must be a string");
-        }
-        node["attributes"].push_back({key, value});
-      }
-    }
-    ParsedPlan parsed = planFromBody(
-        {{"plan", {{"main_tree", "operation"}, {"trees", {{{"id", "operation"}, {"root", node}}}}}}}, "operation.xml");
-    RunRequest run;
-    run.plan = std::move(parsed.plan);
-    run.xml = std::move(parsed.xml);
-    run.operation = true;
-    return startRun(backend_, std::move(run));
-  }
-  if (is({"test", "ground_truth"})) {
-    if (!options_.test_endpoints) {
-      return errorResponse(404, "no such endpoint");
-    }
-    if (!get) {
-      return wrongMethod();
-    }
-    if (!authorized(request.authorization)) {
-      return errorResponse(401, "test endpoints need the token");
-    }
-    const auto truth = backend_.groundTruth();
-    return truth ? jsonResponse(*truth) : errorResponse(404, "this workcell has no simulator");
-  }
-  return errorResponse(404, "no such endpoint: " + request.target.substr(0, 200));
 }
 
 }  // namespace costar::server

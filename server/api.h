@@ -66,9 +66,10 @@ class Api {
   const ApiOptions& options() const { return options_; }
 
  private:
-  /// handle() without its last guard: every failure it knows becomes a 4xx or 5xx answer.
+  /// handle() without its last guard: finds the request's route in the route table (api.cpp:
+  /// method, path pattern, handler, who may call it, its body limit) and answers; every
+  /// failure it knows becomes a 4xx or 5xx answer.
   HttpResponse answer(const HttpRequest& request);
-  HttpResponse route(const HttpRequest& request);
 
   Backend& backend_;
   Store& store_;

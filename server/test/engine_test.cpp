@@ -227,6 +227,32 @@ TEST(Api, RefusesBadRequestsWithAMessage) {
   EXPECT_EQ(h.engine().stats().runs, 0u);
 }
 
+// The route table's data: a command's body is small (16 KiB), a plan's may be 1 MiB; a bad
+// name in the path comes before a wrong method; long reads are the routes marked so.
+TEST(Api, TheRouteTableLimitsBodiesAndMarksLongReads) {
+  Harness h(testCell());
+  const auto expect = [](int status, const HttpResponse& response, const std::string& words) {
+    EXPECT_EQ(response.status, status) << response.body;
+    EXPECT_NE(json::parse(response.body)["error"].get<std::string>().find(words), std::string::npos) << response.body;
+  };
+  expect(413, h.api_call_raw("POST", "/api/control", std::string((16u << 10) + 1, ' ')), "16384 bytes");
+  expect(400, h.api_call_raw("POST", "/api/control", std::string(16u << 10, ' ')), "not valid JSON");
+  expect(400, h.call("POST", "/api/plans/a.b"), "bad name");
+  expect(405, h.call("POST", "/api/plans/ab"), "not allowed");
+  const auto bulk = [](const std::string& method, const std::string& target) {
+    return Api::isBulkRead({.method = method, .target = target});
+  };
+  EXPECT_TRUE(bulk("GET", "/api/runs"));
+  EXPECT_TRUE(bulk("GET", "/api/runs/"));
+  EXPECT_TRUE(bulk("HEAD", "/api/runs/3?from=10"));
+  EXPECT_TRUE(bulk("GET", "/api/runs/3/transitions"));
+  EXPECT_TRUE(bulk("GET", "/api/runs/3/states"));
+  EXPECT_TRUE(bulk("GET", "/api/pointcloud?max=10"));
+  EXPECT_FALSE(bulk("POST", "/api/runs"));
+  EXPECT_FALSE(bulk("GET", "/api/info"));
+  EXPECT_FALSE(bulk("GET", "/api/plans/runs"));
+}
+
 TEST(Engine, RunsAPlanAndLogsEveryTransition) {
   Harness h(testCell());
   const json p = plan(node("Sequence", {{"name", "demo"}},
