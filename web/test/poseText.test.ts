@@ -1,5 +1,5 @@
 import { describe, expect, it } from 'vitest';
-import { formatPoseText, parsePoseText } from '../src/model/poseText';
+import { formatPoseText, parsePoseText, readoutNumber } from '../src/model/poseText';
 
 describe('poses entered in labelled fields', () => {
   it('reads a plan offset in metres as millimetres, and writes it back in metres', () => {
@@ -19,5 +19,14 @@ describe('poses entered in labelled fields', () => {
 
   it('keeps a tenth of a millimetre and writes no float noise', () => {
     expect(formatPoseText({ x: 100.1, y: 0.3, z: -0.2, roll: 0, pitch: 0, yaw: 0 })).toBe('0.1001;0.0003;-0.0002');
+  });
+});
+
+describe('the readout', () => {
+  it('shows a value that rounds to zero as 0.0, never -0.0', () => {
+    expect(readoutNumber(-0.04)).toBe('0.0');
+    expect(readoutNumber(-0.05)).toBe('-0.1');
+    expect(readoutNumber(-1e-12, 3)).toBe('0.000');
+    expect(readoutNumber(426.94)).toBe('426.9');
   });
 });

@@ -6,6 +6,7 @@
 import { useState } from 'react';
 import type { CellState } from '../api';
 import { poseReadout, RobotDescription } from '../model/robot';
+import { readoutNumber } from '../model/poseText';
 
 interface Props {
   state: CellState | null;
@@ -23,7 +24,7 @@ const AXES = ['x', 'y', 'z'] as const;
 const ROTATIONS = ['roll', 'pitch', 'yaw'] as const;
 
 function degrees(rad: number) {
-  return ((rad * 180) / Math.PI).toFixed(1);
+  return readoutNumber((rad * 180) / Math.PI);
 }
 
 export function Waypoints({ state, frames, robot, refusal, run, rename }: Props) {
@@ -49,12 +50,13 @@ export function Waypoints({ state, frames, robot, refusal, run, rename }: Props)
         {tool && (
           <div className="tool-readout" aria-label="tool pose" title="The tool centre point in the world (the arm's endpoint), as the arm reports it">
             <span className="readout-label">tool</span>
-            <span data-readout="X">X {(tool.x * 1000).toFixed(1)}</span>
-            <span data-readout="Y">Y {(tool.y * 1000).toFixed(1)}</span>
-            <span data-readout="Z">Z {(tool.z * 1000).toFixed(1)} mm</span>
-            <span data-readout="roll">R {tool.roll.toFixed(1)}</span>
-            <span data-readout="pitch">P {tool.pitch.toFixed(1)}</span>
-            <span data-readout="yaw">Y {tool.yaw.toFixed(1)}°</span>
+            <span data-readout="X">X {readoutNumber(tool.x * 1000)}</span>
+            <span data-readout="Y">Y {readoutNumber(tool.y * 1000)}</span>
+            <span data-readout="Z">Z {readoutNumber(tool.z * 1000)} mm</span>
+            <span className="readout-label" />
+            <span data-readout="roll">roll {readoutNumber(tool.roll)}°</span>
+            <span data-readout="pitch">pitch {readoutNumber(tool.pitch)}°</span>
+            <span data-readout="yaw">yaw {readoutNumber(tool.yaw)}°</span>
           </div>
         )}
         <div className="jog-row">

@@ -48,3 +48,9 @@ export function formatPoseText(fields: PoseFields): string {
   if (rotation.every((v) => v === 0)) return metres.join(';');
   return [...metres, ...rotation.map(String)].join(';');
 }
+
+/** A readout's number to `digits` decimals, never "-0.0" (a value that rounds to zero is 0). */
+export function readoutNumber(value: number, digits = 1): string {
+  const text = value.toFixed(digits);
+  return Number(text) === 0 ? (0).toFixed(digits) : text;
+}
