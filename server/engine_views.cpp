@@ -6,7 +6,7 @@
 
 #include <algorithm>
 #include <set>
-#include "arm/arm_component.h"
+#include "arm/motion_service.h"
 #include "workcell/workcell.h"
 
 namespace costar::server {
@@ -114,15 +114,11 @@ json Engine::buildState() const {
 
   std::set<std::string> arm_sources;
   std::set<std::string> declared;
-  const arm::ArmComponent* arm = nullptr;
   for (const auto& component : cell_->components().components()) {
     const auto& description = component->description();
     if (std::find(description.implements.begin(), description.implements.end(), "Arm") !=
         description.implements.end()) {
       arm_sources.insert(description.name);
-      if (arm == nullptr) {
-        arm = dynamic_cast<const arm::ArmComponent*>(component.get());
-      }
     }
     for (const auto& symbol : description.symbols) {
       declared.insert(symbol.name);
@@ -133,7 +129,11 @@ json Engine::buildState() const {
   if (const auto endpoint = world.worldPose("endpoint")) {
     arm_json["endpoint"] = poseJson(*endpoint);
   }
+  // A joint waypoint is drawn where the cell's motion service puts the tool at its joints.
+  const arm::MotionService* motion = cell_->motion();
+  std::size_t arm_joint_count = 0;
   if (const world::Symbol* joints = world.symbol("arm_joints"); joints != nullptr && joints->joints() != nullptr) {
+    arm_joint_count = joints->joints()->positions.size();
     json positions = json::array();
     for (const double q : joints->joints()->positions) {
       positions.push_back(rounded(q));
@@ -198,10 +198,10 @@ json Engine::buildState() const {
         }
       } else if (const world::JointsValue* joints = symbol->joints()) {
         item["kind"] = "joints";
-        if (arm != nullptr && joints->positions.size() == static_cast<std::size_t>(arm->jointCount())) {
+        if (motion != nullptr && joints->positions.size() == arm_joint_count) {
           const arm::JointVector q = arm::JointVector::fromEigen(
-              Eigen::Map<const Eigen::VectorXd>(joints->positions.data(), arm->jointCount()));
-          item.update(poseJson(arm->toolAt(q)));
+              Eigen::Map<const Eigen::VectorXd>(joints->positions.data(), static_cast<Eigen::Index>(arm_joint_count)));
+          item.update(poseJson(motion->toolAt(q)));
         }
       }
       waypoints.push_back(std::move(item));

@@ -311,6 +311,7 @@ class SimWorkcell final : public Workcell {
   std::string name() const override { return cell_.name; }
   std::string description() const override { return cell_.label + ", scene '" + scene_.label + "'"; }
   sim::Simulation* simulation() override { return simulation_.get(); }
+  const arm::MotionService* motion() const override { return motion_.get(); }
 
  private:
   static sim::SimulationOptions simOptions(const WorkcellOptions& options, const arm::RobotDescription& robot,

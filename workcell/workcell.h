@@ -16,6 +16,9 @@
 #include "component/registry.h"
 #include "core/clock.h"
 
+namespace costar::arm {
+class MotionService;
+}
 namespace costar::sim {
 class Simulation;
 }
@@ -84,6 +87,9 @@ class Workcell {
   /// The simulation behind a simulated cell (for tests, pictures and the trial judge, never
   /// for plans), or nullptr.
   virtual sim::Simulation* simulation() { return nullptr; }
+  /// What may be asked of the cell's arm (forward and inverse kinematics, collisions, plans:
+  /// arm/motion_service.h), or nullptr for a cell without an arm.
+  virtual const arm::MotionService* motion() const { return nullptr; }
   /// The robot as the editor draws it, from the description the simulator and the planner
   /// use, or null for a cell without a robot: `urdf` (the arm's URDF with the gripper's mounted
   /// on its flange: the planner's model), `base_link`, `flange_link`, `tcp_link`,

@@ -614,6 +614,30 @@ TEST(Ur5Cell, TheStateCarriesEachPartsSeenColour) {
   EXPECT_EQ(nearest, "red") << seen.transpose();
 }
 
+// A joint waypoint is drawn where its joints put the tool (the cell's motion service, not the
+// arm's class): taught where the arm stands, it is drawn at the endpoint.
+TEST(Ur5Cell, AJointWaypointIsDrawnWhereItsJointsPutTheTool) {
+  Harness h(blindCell());
+  const HttpResponse taught = h.call("POST", "/api/operations",
+                                     {{"node", "Teach"}, {"attributes", {{"waypoint", "here"}, {"kind", "joints"}}}});
+  ASSERT_EQ(taught.status, 202) << taught.body;
+  ASSERT_EQ(h.waitForRun(json::parse(taught.body)["run"])["result"], "SUCCESS");
+  h.waitTicks(2);  // the next snapshot
+  const json state = h.get("/api/state");
+  const json* here = nullptr;
+  for (const json& waypoint : state["waypoints"]) {
+    if (waypoint["name"] == "here") {
+      here = &waypoint;
+    }
+  }
+  ASSERT_NE(here, nullptr) << state["waypoints"].dump();
+  EXPECT_EQ((*here)["kind"], "joints");
+  ASSERT_TRUE(here->contains("p")) << here->dump();
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR((*here)["p"][i].get<double>(), state["arm"]["endpoint"]["p"][i].get<double>(), 1e-4) << i;
+  }
+}
+
 // Stepping through a SmartGrasp ends as a normal run does: while paused the simulated cell
 // stands still, so no time limit (the fingers settling, the motion) runs out between steps.
 TEST(Ur5Cell, SteppingThroughASmartGraspSucceeds) {
