@@ -1,8 +1,9 @@
-// The Engine's thread and run control: the task queue network threads hand work to, the loop
-// (idle ticks between runs, paced), starting, executing, pausing, stepping and stopping runs,
-// and the observer that records each node's status. The lists the editor offers are in
-// engine_lists.cpp, what the stream shows in engine_views.cpp, the simulator's views in
-// engine_sim_views.cpp, the run-log writer in engine_log.cpp.
+// The Engine's thread and run control: the loop (idle ticks between runs, paced), starting,
+// executing, pausing, stepping and stopping runs, and the observer that records each node's
+// status. The work network threads hand it comes through task_queue.h; the lists the editor
+// offers are in engine_lists.cpp (the palette in palette.cpp), what the stream shows in
+// engine_views.cpp, the simulator's views in engine_sim_views.cpp; runs are logged by
+// run_log_writer.h.
 
 #include "server/engine_parts.h"
 
@@ -20,33 +21,26 @@ Engine::Engine(std::unique_ptr<workcell::Workcell> cell, Store* store, EngineOpt
 }
 
 Engine::Engine(workcell::Workcell& cell, Store* store, EngineOptions options)
-    : cell_(&cell), store_(store), options_(std::move(options)) {
+    : cell_(&cell), options_(std::move(options)), palette_(describePalette(cell)) {
   const double pace = options_.pace;
   pacer_.setFactor(pace > 0 ? pace : 1.0);
-  if (store_ != nullptr) {
-    next_run_id_ = store_->maxRunId() + 1;
+  if (store != nullptr) {
+    next_run_id_ = store->maxRunId() + 1;
+    log_ = std::make_unique<RunLogWriter>(*store);
   }
-
-  describeNodes();
   takeSnapshot();
 }
 
 Engine::~Engine() { shutdown(); }
 
 void Engine::startThread() {
-  {
-    const std::lock_guard lock(task_mutex_);
-    if (started_) {
-      return;
-    }
-    started_ = true;
+  if (!tasks_.open()) {
+    return;
   }
-  // An exception that escapes a loop is logged and the loop goes on (guard.h).
-  log_thread_ = std::thread([this] {
-    prepareServerThread("runlog");
-    while (!guarded("run log writer", [this] { logWriterLoop(); })) {
-    }
-  });
+  if (log_) {
+    log_->start();
+  }
+  // An exception that escapes the loop is logged and the loop goes on (guard.h).
   thread_ = std::thread([this] {
     prepareServerThread("engine");
     while (!guarded("engine thread", [this] { loop(); })) {
@@ -55,51 +49,25 @@ void Engine::startThread() {
 }
 
 void Engine::shutdown() {
-  {
-    const std::lock_guard lock(task_mutex_);
-    if (!started_ || stopping_) {
-      return;
-    }
-    stopping_ = true;
-    stop_requested_ = true;
+  if (!tasks_.close()) {
+    return;
   }
-  task_cv_.notify_all();
+  stopping_ = true;
+  stop_requested_ = true;
+  tasks_.notify();
   if (thread_.joinable()) {
     thread_.join();
   }
-  {
-    const std::lock_guard lock(log_mutex_);
-    log_stopping_ = true;
-  }
-  log_cv_.notify_all();
-  if (log_thread_.joinable()) {
-    log_thread_.join();
-  }
-}
-
-void Engine::runTasks() {
-  while (true) {
-    std::function<void()> task;
-    {
-      const std::lock_guard lock(task_mutex_);
-      if (tasks_.empty()) {
-        return;
-      }
-      task = std::move(tasks_.front());
-      tasks_.pop_front();
-    }
-    task();  // exceptions are carried by the packaged_task's future
+  if (log_) {
+    log_->stop();
   }
 }
 
 void Engine::waitWall(std::chrono::steady_clock::duration duration) {
   const auto deadline = std::chrono::steady_clock::now() + duration;
   while (!stopping_) {
-    {
-      std::unique_lock lock(task_mutex_);
-      task_cv_.wait_until(lock, deadline, [this] { return !tasks_.empty() || stopping_.load(); });
-    }
-    runTasks();
+    tasks_.waitUntil(deadline);
+    tasks_.runPending();
     if (std::chrono::steady_clock::now() >= deadline) {
       return;
     }
@@ -108,7 +76,7 @@ void Engine::waitWall(std::chrono::steady_clock::duration duration) {
 
 void Engine::loop() {
   while (!stopping_) {
-    runTasks();
+    tasks_.runPending();
     if (pending_tree_) {
       executePending();
       continue;
@@ -126,11 +94,11 @@ void Engine::loop() {
       waitWall(std::chrono::milliseconds(100));
     }
   }
-  runTasks();
+  tasks_.runPending();
 }
 
 void Engine::hook(bool running) {
-  runTasks();
+  tasks_.runPending();
   if (const double pace = pace_request_.exchange(-1); pace >= 0) {
     {
       const std::lock_guard lock(mutex_);
@@ -240,11 +208,8 @@ void Engine::executePending() {
   stop_requested_ = false;
   pause_requested_ = 0;
   steps_requested_ = 0;
-  if (!run->operation && store_ != nullptr) {
-    LogCommand end;
-    end.kind = LogCommand::Kind::kEnd;
-    end.record = std::move(record);
-    pushLog(std::move(end));
+  if (!run->operation && log_) {
+    log_->end(std::move(record));
   }
   cell_->beforeTick();
   takeSnapshot();
@@ -300,7 +265,7 @@ void Engine::holdWhilePaused(bt::Executor& executor) {
 }
 
 void Engine::logState(const RunState& run) {
-  if (run.operation || store_ == nullptr || options_.logged_state_hz <= 0) {
+  if (run.operation || !log_ || options_.logged_state_hz <= 0) {
     return;
   }
   const TimePoint now = cell_->clock().now();
@@ -314,9 +279,7 @@ void Engine::logState(const RunState& run) {
   StateRecord record;
   record.t = toSeconds(now - run.start_time);
   record.state = state.dump(-1, ' ', false, json::error_handler_t::replace);
-  const std::lock_guard lock(log_mutex_);
-  log_pending_run_ = run.id;
-  log_pending_states_.push_back(std::move(record));
+  log_->addState(run.id, std::move(record));
 }
 
 void Engine::onTransition(TimePoint time, const bt::TreeNode& node, bt::Status from, bt::Status to) {
@@ -369,7 +332,7 @@ void Engine::onTransition(TimePoint time, const bt::TreeNode& node, bt::Status f
       run->dirty.push_back(node.uid());
     }
     record.seq = ++run->transitions;
-    keep = !run->operation && store_ != nullptr && record.seq <= options_.max_logged_transitions;
+    keep = !run->operation && log_ && record.seq <= options_.max_logged_transitions;
     if (!run->operation && record.seq > options_.max_logged_transitions) {
       run->truncated = true;
     }
@@ -378,9 +341,7 @@ void Engine::onTransition(TimePoint time, const bt::TreeNode& node, bt::Status f
     if (!data.is_null()) {
       record.data = data.dump(-1, ' ', false, json::error_handler_t::replace);
     }
-    const std::lock_guard lock(log_mutex_);
-    log_pending_run_ = run->id;
-    log_pending_.push_back(std::move(record));
+    log_->addTransition(run->id, std::move(record));
   }
 }
 
@@ -476,17 +437,15 @@ StartResult Engine::start(RunRequest run_request) {
           -1, ' ', false, json::error_handler_t::replace));
     }
     active_run_ = run->id;
-    if (!run->operation && store_ != nullptr) {
-      LogCommand begin;
-      begin.kind = LogCommand::Kind::kBegin;
-      begin.record.id = run->id;
-      begin.record.plan = run->plan_name;
-      begin.record.version = run->version;
-      begin.record.xml = run->xml;
-      begin.record.started_at = run->started_at;
-      begin.record.workcell = cell_->name();
-      begin.nodes = run->nodes;
-      pushLog(std::move(begin));
+    if (!run->operation && log_) {
+      RunRecord begin;
+      begin.id = run->id;
+      begin.plan = run->plan_name;
+      begin.version = run->version;
+      begin.xml = run->xml;
+      begin.started_at = run->started_at;
+      begin.workcell = cell_->name();
+      log_->begin(std::move(begin), run->nodes);
     }
     pending_run_ = run;
     out.run_id = run->id;
@@ -550,7 +509,7 @@ bool Engine::control(RunControl control) {
       ++steps_requested_;
       break;
   }
-  task_cv_.notify_all();
+  tasks_.notify();
   return true;
 }
 
@@ -561,7 +520,7 @@ EngineStats Engine::stats() const {
 
 void Engine::setPace(double pace) {
   pace_request_ = std::max(0.0, pace);
-  task_cv_.notify_all();
+  tasks_.notify();
 }
 
 }  // namespace costar::server

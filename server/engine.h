@@ -20,11 +20,9 @@
 // tick period pass. A real clock cannot be held: there the tree is not ticked, and time goes on.
 
 #include <atomic>
-#include <condition_variable>
 #include <deque>
 #include <filesystem>
 #include <functional>
-#include <future>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -37,7 +35,10 @@
 #include "bt/tree.h"
 #include "server/backend.h"
 #include "server/pacing.h"
+#include "server/palette.h"
+#include "server/run_log_writer.h"
 #include "server/store.h"
+#include "server/task_queue.h"
 
 namespace costar::workcell {
 class Workcell;
@@ -96,7 +97,7 @@ class Engine final : public Backend {
 
   // --- Backend ----------------------------------------------------------------------------
   nlohmann::json info() override;
-  const std::string& nodesJson() override { return nodes_json_; }
+  const std::string& nodesJson() override { return palette_.nodes_json; }
   nlohmann::json choices() override;
   std::vector<bt::Diagnostic> validate(const bt::Plan& plan) override;
   std::vector<bt::Diagnostic> checkForCell(const bt::Plan& plan) override;
@@ -131,21 +132,17 @@ class Engine final : public Backend {
  private:
   struct RunState;
   class Observer;
-  struct LogCommand;
 
   /// Runs `task` on the engine thread and waits for its result.
   template <typename F>
   auto call(F task) -> decltype(task());
 
-  /// The palette (GET /api/nodes) and the workcell's info, built once (engine_lists.cpp).
-  void describeNodes();
   /// What a plan names that the cell does not know now: waypoints (unless the plan teaches
   /// them), frames (unless it detects parts first), object classes (engine thread).
   std::vector<bt::Diagnostic> checkAgainstCell(const bt::Plan& plan);
   /// Every problem of a plan for this cell: the plan's own, then checkAgainstCell (engine thread).
   std::vector<bt::Diagnostic> problems(const bt::Plan& plan);
   void loop();
-  void runTasks();
   void hook(bool running);
   /// Applies stop, pause and resume requests to a run; true when it is to stop.
   bool applyControls(bt::Executor& executor);
@@ -161,26 +158,18 @@ class Engine final : public Backend {
   void onTransition(TimePoint time, const bt::TreeNode& node, bt::Status from, bt::Status to);
   nlohmann::json runJson(const RunState& run, bool with_nodes) const;
   nlohmann::json statusesJson(RunState& run, bool all);
-  void logWriterLoop();
-  void pushLog(LogCommand command);
-  /// Moves the pending transitions and snapshots to the writer's queue (log_mutex_ held).
-  void queuePending();
 
   std::unique_ptr<workcell::Workcell> owned_cell_;  // a cell made by the engine (reset), or given to it
   workcell::Workcell* cell_;                        // the cell now (engine thread only, after construction)
-  Store* store_;
   EngineOptions options_;
-  std::string nodes_json_;
-  nlohmann::json info_;
+  const Palette palette_;
 
   std::thread thread_;
   std::atomic<bool> stopping_{false};
-  bool started_ = false;
-
   // Work handed to the engine thread.
-  std::mutex task_mutex_;
-  std::condition_variable task_cv_;
-  std::deque<std::function<void()>> tasks_;
+  TaskQueue tasks_;
+  // Plan runs to the store (null without a store).
+  std::unique_ptr<RunLogWriter> log_;
 
   // Control of the active run, set by network threads, applied by the engine thread.
   std::atomic<std::int64_t> active_run_{0};
@@ -211,16 +200,6 @@ class Engine final : public Backend {
   std::int64_t next_run_id_ = 1;
   std::int64_t next_operation_id_ = -1;
   std::string last_error_;  // the last exception of the idle loop, shown by info()
-
-  // The run log writer.
-  std::thread log_thread_;
-  std::mutex log_mutex_;
-  std::condition_variable log_cv_;
-  std::deque<LogCommand> log_queue_;
-  std::vector<TransitionRecord> log_pending_;
-  std::vector<StateRecord> log_pending_states_;
-  std::int64_t log_pending_run_ = 0;
-  bool log_stopping_ = false;
 };
 
 }  // namespace costar::server

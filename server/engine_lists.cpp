@@ -1,7 +1,6 @@
-// What the editor offers: the palette of node types with their ports (where each parameter's
-// choices come from, extra choices, exclusions, ranges), the workcell's info, and the choice
-// lists read from what the cell knows now (waypoints, frames, object classes, predicates, the
-// grasps taught per class), and each object class's shape and colours (for drawing the parts).
+// What the editor offers: the workcell's info (the palette's, with the engine's pace, active
+// run and counters), and the choice lists read from what the cell knows now (waypoints, frames, object classes,
+// predicates, the grasps taught per class), and each object class's shape and colours (for drawing the parts).
 
 #include "server/engine_parts.h"
 
@@ -157,73 +156,8 @@ std::optional<json> Engine::robot() {
   });
 }
 
-void Engine::describeNodes() {
-  // The palette: every node type with its ports; operation parameters add where their
-  // choices come from and their range.
-  json nodes = json::array();
-  bool detect = false;
-  bool calibrate = false;
-  for (const bt::NodeSpec* spec : cell_->nodes().all()) {
-    const component::Component* provider = cell_->components().provider(spec->id);
-    const component::OperationSpec* operation =
-        provider != nullptr ? provider->description().operation(spec->id) : nullptr;
-    json ports = json::array();
-    for (const auto& port : spec->ports) {
-      json item = {{"name", port.name}, {"type", port.type_name}, {"description", port.description}};
-      if (port.default_value) {
-        item["default"] = *port.default_value;
-      }
-      if (!port.choices.empty()) {
-        item["choices"] = port.choices;
-      }
-      if (const component::ParamSpec* param = operation != nullptr ? operation->param(port.name) : nullptr) {
-        if (!param->choices_from.empty()) {
-          item["choices_from"] = param->choices_from;
-        }
-        if (!param->extra_choices.empty()) {
-          item["extra_choices"] = param->extra_choices;
-        }
-        if (!param->excludes.empty()) {
-          item["excludes"] = param->excludes;
-        }
-        if (param->min) {
-          item["min"] = *param->min;
-        }
-        if (param->max) {
-          item["max"] = *param->max;
-        }
-      }
-      ports.push_back(std::move(item));
-    }
-    json node = {{"id", spec->id},
-                 {"kind", bt::toString(spec->kind)},
-                 {"category", bt::toString(spec->category)},
-                 {"description", spec->description},
-                 {"asynchronous", spec->asynchronous},
-                 {"ports", std::move(ports)}};
-    if (provider != nullptr) {
-      node["component"] = provider->description().name;
-    }
-    nodes.push_back(std::move(node));
-    detect = detect || spec->id == "DetectObjects";
-    calibrate = calibrate || spec->id == "Calibrate" || spec->id == "HandEyeCalibration";
-  }
-  nodes_json_ = nodes.dump();
-  info_ = {{"workcell", cell_->name()},
-           {"description", cell_->description()},
-           {"simulated_clock", cell_->clock().simulated()},
-           {"simulator", cell_->simulation() != nullptr},
-           {"features",
-            {{"detect", detect},
-             {"calibrate", calibrate},
-             {"pointcloud", cell_->simulation() != nullptr},
-             {"detect_node", detect ? "DetectObjects" : ""},
-             {"calibrate_node", cell_->nodes().find("Calibrate") != nullptr ? "Calibrate" : "HandEyeCalibration"}}},
-           {"version", "0.1.0"}};
-}
-
 json Engine::info() {
-  json out = info_;
+  json out = palette_.info;
   const std::lock_guard lock(mutex_);
   out["pace"] = options_.pace;
   out["active_run"] = active_run_.load();

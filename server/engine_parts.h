@@ -1,13 +1,12 @@
 #pragma once
 // Private to the Engine's parts (engine.cpp, engine_lists.cpp, engine_views.cpp,
-// engine_sim_views.cpp, engine_log.cpp): the state of one run as the browser sees it, the
-// tree observer, the run-log writer's commands, and Engine::call, which hands a task to the
-// engine thread and waits for its answer. Not for other parts of the server.
+// engine_sim_views.cpp): the state of one run as the browser sees it, the tree observer, and
+// Engine::call, which hands a task to the engine thread and waits for its answer. Not for
+// other parts of the server.
 
 #include <time.h>
 
 #include <cmath>
-#include <future>
 #include <span>
 
 #include "bt/executor.h"
@@ -93,37 +92,9 @@ class Engine::Observer final : public bt::TreeObserver {
   Engine& engine_;
 };
 
-struct Engine::LogCommand {
-  enum class Kind { kBegin, kTransitions, kEnd } kind = Kind::kBegin;
-  RunRecord record;
-  std::vector<RunNode> nodes;
-  std::vector<TransitionRecord> transitions;
-  std::vector<StateRecord> states;
-};
-
 template <typename F>
 auto Engine::call(F task) -> decltype(task()) {
-  using Result = decltype(task());
-  // The task owns what it uses (captured by value): it may run after the caller gave up.
-  auto packaged = std::make_shared<std::packaged_task<Result()>>(std::move(task));
-  std::future<Result> future = packaged->get_future();
-  {
-    const std::lock_guard lock(task_mutex_);
-    if (!started_ || stopping_) {
-      throw BackendBusy("the engine is not running (the server is stopping)");
-    }
-    tasks_.emplace_back([packaged] { (*packaged)(); });
-  }
-  task_cv_.notify_all();
-  if (future.wait_for(options_.call_timeout) != std::future_status::ready) {
-    throw BackendBusy("the engine did not answer within " + std::to_string(toSeconds(options_.call_timeout)) +
-                      " s (busy with a long computation); try again");
-  }
-  try {
-    return future.get();
-  } catch (const std::future_error&) {
-    throw BackendBusy("the engine stopped before answering");
-  }
+  return tasks_.call(std::move(task), options_.call_timeout);
 }
 
 }  // namespace costar::server
