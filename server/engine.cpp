@@ -2,13 +2,14 @@
 // executing, pausing, stepping and stopping runs, and the observer that records each node's
 // status. The work network threads hand it comes through task_queue.h; the lists the editor
 // offers are in engine_lists.cpp (the palette in palette.cpp), what the stream shows in
-// engine_views.cpp, the simulator's views in engine_sim_views.cpp; runs are logged by
-// run_log_writer.h.
+// engine_views.cpp (the cell's state in cell_state.cpp), the simulator's views in
+// engine_sim_views.cpp; runs are logged by run_log_writer.h.
 
 #include "server/engine_parts.h"
 
 #include "bt/builder.h"
 #include "component/nodes.h"
+#include "server/cell_state.h"
 #include "server/guard.h"
 #include "server/plan_json.h"
 #include "workcell/workcell.h"
@@ -273,7 +274,7 @@ void Engine::logState(const RunState& run) {
     return;
   }
   next_logged_state_ = now + fromSeconds(1.0 / options_.logged_state_hz);
-  json state = buildState();
+  json state = cellState(*cell_, active_run_.load(), paused_);
   state.erase("waypoints");
   state.erase("frames");
   StateRecord record;

@@ -154,7 +154,6 @@ class Engine final : public Backend {
   void waitWall(std::chrono::steady_clock::duration duration);
   void executePending();
   void takeSnapshot();
-  nlohmann::json buildState() const;
   void onTransition(TimePoint time, const bt::TreeNode& node, bt::Status from, bt::Status to);
   nlohmann::json runJson(const RunState& run, bool with_nodes) const;
   nlohmann::json statusesJson(RunState& run, bool all);

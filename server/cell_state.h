@@ -1,0 +1,21 @@
+#pragma once
+// The cell as the editor's page draws it (GET /api/state, the stream's "state" messages, the
+// snapshots a run's log keeps for replay), read from the world state the components report.
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+
+namespace costar::workcell {
+class Workcell;
+}
+
+namespace costar::server {
+
+/// {type: "state", t (clock s), run (the active run's id, 0: none), mode (idle, running,
+/// paused), arm {endpoint, joints, moving}, gripper {open, closed, holding, mode, reading},
+/// objects [{name, class, source, p, q, color}], waypoints [{name, kind, frame, p, q}] (the
+/// arm's; a joint waypoint drawn where the cell's motion service puts the tool), frames, and up
+/// to 2,000 predicates that hold}. Engine thread only (it reads the cell).
+nlohmann::json cellState(workcell::Workcell& cell, std::int64_t active, bool paused);
+
+}  // namespace costar::server
