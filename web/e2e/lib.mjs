@@ -183,6 +183,9 @@ export function readability() {
     for (const element of pane.querySelectorAll('*')) {
       const style = getComputedStyle(element);
       if (style.display === 'none' || style.visibility === 'hidden' || element.closest('option, .react-flow__minimap, .react-flow__controls')) continue;
+      // The content of a folded <details> is not shown (Chromium still lays it out).
+      const folded = element.closest('details:not([open])');
+      if (folded && folded !== element && !element.closest('summary')) continue;
       const b = element.getBoundingClientRect();
       if (b.width === 0 || b.height === 0) continue;
       const name = `${element.tagName.toLowerCase()}.${String(element.className).split(' ')[0]} "${(element.textContent ?? '').trim().slice(0, 30)}"`;

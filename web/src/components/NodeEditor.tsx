@@ -3,7 +3,7 @@
 
 import type { Choices, NodeInfo, PortInfo } from '../api';
 import type { EditorNode } from '../model/tree';
-import { formatPredicates, parsePredicates, PredicateTerm } from '../model/predicates';
+import { formatPredicates, parsePredicates, PredicateTerm, referenceChoices } from '../model/predicates';
 import { formatPoseText, parsePoseText, POSE_FIELDS, PoseFields } from '../model/poseText';
 
 interface Props {
@@ -146,6 +146,8 @@ function PredicateList(props: {
                 <select
                   value={arg}
                   disabled={props.disabled}
+                  className={props.references.includes(arg) ? undefined : 'unknown-choice'}
+                  title={props.references.includes(arg) ? undefined : `'${arg}' is not in the cell now`}
                   aria-label="reference"
                   onChange={(e) => {
                     const next = [...terms];
@@ -155,9 +157,9 @@ function PredicateList(props: {
                     update(next);
                   }}
                 >
-                  {[...new Set([arg, ...props.references])].map((r) => (
-                    <option key={r} value={r}>
-                      {r}
+                  {referenceChoices(arg, props.references).map((r) => (
+                    <option key={r.value} value={r.value}>
+                      {r.label}
                     </option>
                   ))}
                 </select>

@@ -32,3 +32,16 @@ export function formatPredicates(terms: PredicateTerm[]): string {
     .map((term) => `${term.name}(${term.args.join(',')})`)
     .join('; ');
 }
+
+/**
+ * The choices for a condition's reference: what the cell knows now (frames, parts, classes),
+ * and the one the plan names first, marked, when the cell does not know it any more (a part the
+ * last detection did not see): it stays shown until it is changed.
+ */
+export function referenceChoices(current: string, references: string[]): { value: string; label: string; known: boolean }[] {
+  const known = references.includes(current);
+  return [
+    ...(known ? [] : [{ value: current, label: `${current} (not in the cell now)`, known: false }]),
+    ...references.map((r) => ({ value: r, label: r, known: true })),
+  ];
+}
