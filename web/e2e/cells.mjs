@@ -1,7 +1,7 @@
 // End-to-end test: every simulated cell drawn as it is (Debian's Chromium, headless, driven by
 // playwright-core, against `costar serve --workcell CELL`): the arm and its gripper built from
-// the URDF the planner reads (GET /api/robot), the tool centre point as drawn within 5 mm of the
-// arm's own `endpoint` symbol (at home and after jogging a joint), the jog pane with the cell's
+// the URDF the planner reads (GET /api/robot), the tool centre point as drawn within 5 mm and 1°
+// of the arm's own `endpoint` symbol (at home and after jogging a joint), the jog pane with the cell's
 // joints (J1-J6 on the UR5, J1-J7 on the iiwa) and a live tool pose and joint readout, the
 // 3-finger gripper's fingers drawn from its reading (closing them changes the drawing).
 // Screenshots at 1280x800 of each cell after a detection.
@@ -17,6 +17,7 @@ import { api, args, artifacts, launchBrowser, makeLog, openPage, startServer } f
 const { log, check } = makeLog('cells');
 const CELLS = { 'ur5-sim': 6, 'iiwa-sim': 7, 'iiwa-3f-sim': 7 };
 const MAX_ERROR_MM = 5;
+const MAX_ERROR_DEG = 1;
 let server;
 let browser;
 
@@ -29,19 +30,38 @@ async function waitOperation(url, token, page, id) {
   throw new Error(`operation ${id} did not end`);
 }
 
-/** The drawn tool centre point against the arm's endpoint symbol (mm), once the page has caught up. */
+/** The angle between two quaternions [x, y, z, w] (degrees; normalised first: the stream rounds). */
+function angleDegrees(a, b) {
+  const norm = (q) => Math.hypot(...q);
+  const dot = Math.abs(a.reduce((sum, v, i) => sum + v * b[i], 0)) / (norm(a) * norm(b));
+  return (2 * Math.acos(Math.min(1, dot)) * 180) / Math.PI;
+}
+
+/**
+ * The drawn tool centre point against the arm's endpoint symbol, once the page has caught up:
+ * the position (mm) and the orientation (degrees).
+ */
 async function drawnError(page, url, token) {
   let error = Infinity;
+  let angle = Infinity;
   let drawn = [];
   let endpoint = [];
   for (let i = 0; i < 30; i++) {
-    endpoint = (await api(url, token, 'GET', '/api/state')).json.arm.endpoint.p;
+    const pose = (await api(url, token, 'GET', '/api/state')).json.arm.endpoint;
+    endpoint = pose.p;
     await page.waitForTimeout(200);
     drawn = ((await page.getAttribute('.view3d-canvas', 'data-drawn-tool')) ?? '').split(',').map(Number);
-    if (drawn.length === 3) error = Math.min(error, 1000 * Math.hypot(...drawn.map((v, i) => v - endpoint[i])));
-    if (error < MAX_ERROR_MM) break;
+    const drawnQ = ((await page.getAttribute('.view3d-canvas', 'data-drawn-tool-q')) ?? '').split(',').map(Number);
+    if (drawn.length === 3 && drawnQ.length === 4) {
+      const e = 1000 * Math.hypot(...drawn.map((v, i) => v - endpoint[i]));
+      if (e < error) {
+        error = e;
+        angle = angleDegrees(drawnQ, pose.q);
+      }
+    }
+    if (error < MAX_ERROR_MM && angle < MAX_ERROR_DEG) break;
   }
-  return { error, drawn, endpoint };
+  return { error, angle, drawn, endpoint };
 }
 
 async function cell(name, joints, figures) {
@@ -54,7 +74,10 @@ async function cell(name, joints, figures) {
   check((await page.getAttribute('.view3d-canvas', 'data-robot')) === robot.name, `${name}: the 3D view draws the cell's robot (${robot.label}) from its URDF`);
 
   const home = await drawnError(page, url, token);
-  check(home.error < MAX_ERROR_MM, `${name}: at home the drawn tool centre point is ${home.error.toFixed(2)} mm from the arm's endpoint symbol (${home.endpoint.map((v) => v.toFixed(3))})`);
+  check(
+    home.error < MAX_ERROR_MM && home.angle < MAX_ERROR_DEG,
+    `${name}: at home the drawn tool centre point is ${home.error.toFixed(2)} mm and ${home.angle.toFixed(3)}° from the arm's endpoint symbol (${home.endpoint.map((v) => v.toFixed(3))})`,
+  );
 
   const shown = await page.$$eval('.jog-grid.joints .jog-pair', (p) => p.map((x) => x.textContent?.trim().slice(0, 2)));
   check(shown.length === joints && shown[joints - 1] === `J${joints}`, `${name}: the jog pane has the cell's ${joints} joints (${shown.join(' ')})`);
@@ -67,8 +90,17 @@ async function cell(name, joints, figures) {
   await page.waitForFunction(() => /^JogJoint: SUCCESS/.test(document.querySelector('.status-line .message')?.textContent ?? ''), null, { timeout: 30000 });
   const jogged = await drawnError(page, url, token);
   const moved = 1000 * Math.hypot(...jogged.endpoint.map((v, i) => v - home.endpoint[i]));
-  check(moved > 5 && jogged.error < MAX_ERROR_MM, `${name}: jogged ${moved.toFixed(0)} mm, the drawn tool is ${jogged.error.toFixed(2)} mm from the endpoint`);
-  figures[name] = { home_mm: Number(home.error.toFixed(3)), jogged_mm: Number(jogged.error.toFixed(3)), joints };
+  check(
+    moved > 5 && jogged.error < MAX_ERROR_MM && jogged.angle < MAX_ERROR_DEG,
+    `${name}: jogged ${moved.toFixed(0)} mm, the drawn tool is ${jogged.error.toFixed(2)} mm and ${jogged.angle.toFixed(3)}° from the endpoint`,
+  );
+  figures[name] = {
+    home_mm: Number(home.error.toFixed(3)),
+    home_deg: Number(home.angle.toFixed(3)),
+    jogged_mm: Number(jogged.error.toFixed(3)),
+    jogged_deg: Number(jogged.angle.toFixed(3)),
+    joints,
+  };
 
   if (robot.gripper.kind === 'adaptive') {
     check(Number(await page.getAttribute('.view3d-canvas', 'data-finger-boxes')) === 9, `${name}: the 3 fingers are drawn, 3 phalanges each`);
@@ -104,7 +136,7 @@ async function main() {
   const names = (args.cells ?? Object.keys(CELLS).join(',')).split(',');
   for (const name of names) await cell(name, CELLS[name], figures);
   fs.writeFileSync(path.join(artifacts, 'cells_drawn_vs_endpoint.json'), JSON.stringify(figures, null, 2));
-  log('drawn tool centre point against the endpoint symbol (mm):', JSON.stringify(figures));
+  log('drawn tool centre point against the endpoint symbol (mm, degrees):', JSON.stringify(figures));
 }
 
 let failed = false;

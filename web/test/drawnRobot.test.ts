@@ -2,20 +2,21 @@
 // urdf-loader reads the URDF with the browser's DOMParser: happy-dom stands in for the browser.
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
+import { Quaternion } from 'three';
 import { describe, expect, it } from 'vitest';
 import { DrawnRobot } from '../src/model/drawnRobot';
 import type { FingerReading, RobotDescription } from '../src/model/robot';
 
 interface Fixture {
   robot: RobotDescription;
-  samples: { joints: number[]; endpoint: { p: [number, number, number] }; gripper: { mode?: string; reading?: FingerReading } }[];
+  samples: { joints: number[]; endpoint: { p: [number, number, number]; q: [number, number, number, number] }; gripper: { mode?: string; reading?: FingerReading } }[];
 }
 // Recorded from `costar serve` (the note in each file says how).
 const fixture = (cell: string) => JSON.parse(readFileSync(path.join(__dirname, 'fixtures', `robot_${cell}.json`), 'utf8')) as Fixture;
 
 describe("the robot drawn from the planner's URDF", () => {
   for (const cell of ['ur5-sim', 'iiwa-3f-sim']) {
-    it(`puts the tool centre point where the arm's endpoint symbol says (${cell})`, () => {
+    it(`puts the tool centre point and its orientation where the arm's endpoint symbol says (${cell})`, () => {
       const { robot, samples } = fixture(cell);
       const drawn = new DrawnRobot(robot);
       for (const sample of samples) {
@@ -23,6 +24,10 @@ describe("the robot drawn from the planner's URDF", () => {
         const tool = drawn.toolPosition();
         const error = Math.hypot(tool.x - sample.endpoint.p[0], tool.y - sample.endpoint.p[1], tool.z - sample.endpoint.p[2]);
         expect(error).toBeLessThan(1e-4); // 0.1 mm: the same model, rounded on the stream
+        // The tool's orientation too (the stream's quaternion is rounded: normalised first).
+        const { quaternion } = drawn.toolPose();
+        const angle = (quaternion.angleTo(new Quaternion(...sample.endpoint.q).normalize()) * 180) / Math.PI;
+        expect(angle).toBeLessThan(0.01);
       }
       drawn.dispose();
     });

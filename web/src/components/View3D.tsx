@@ -85,6 +85,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
   const sceneRef = useRef<Scene | null>(null);
   const [drawn, setDrawn] = useState<DrawnRobot | null>(null);
   const [drawnTool, setDrawnTool] = useState('');
+  const [drawnToolQ, setDrawnToolQ] = useState('');
   const framed = useRef(false);
   const [error, setError] = useState<string | null>(null);
   const [cloudInfo, setCloudInfo] = useState<string>('');
@@ -185,8 +186,9 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     if (!s || !state) return;
     if (drawn) {
       drawn.update(state.arm.joints, state.gripper.reading, state.gripper.mode);
-      const tool = drawn.toolPosition();
-      setDrawnTool([tool.x, tool.y, tool.z].map((v) => v.toFixed(5)).join(','));
+      const tool = drawn.toolPose();
+      setDrawnTool([tool.position.x, tool.position.y, tool.position.z].map((v) => v.toFixed(5)).join(','));
+      setDrawnToolQ([tool.quaternion.x, tool.quaternion.y, tool.quaternion.z, tool.quaternion.w].map((v) => v.toFixed(6)).join(','));
       if (!framed.current) {
         framed.current = true; // the robot as it stands: frame the cell around it once
         look('3D');
@@ -327,7 +329,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       {error ? (
         <p className="empty">{error}</p>
       ) : (
-        <div className="view3d-canvas" ref={mount} data-drawn-tool={drawnTool} data-robot={robot?.name ?? ''} data-finger-boxes={drawn?.fingerBoxes() ?? 0} />
+        <div className="view3d-canvas" ref={mount} data-drawn-tool={drawnTool} data-drawn-tool-q={drawnToolQ} data-robot={robot?.name ?? ''} data-finger-boxes={drawn?.fingerBoxes() ?? 0} />
       )}
     </section>
   );

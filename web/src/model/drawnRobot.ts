@@ -90,9 +90,17 @@ export class DrawnRobot {
 
   /** The tool centre point as drawn, in the world (m). */
   toolPosition(): THREE.Vector3 {
+    return this.toolPose().position;
+  }
+
+  /** The tool centre point's frame as drawn, in the world: position (m) and orientation. */
+  toolPose(): { position: THREE.Vector3; quaternion: THREE.Quaternion } {
     const tcp = this.robot.links[this.description.tcp_link] ?? this.robot.links[this.description.flange_link];
     this.object.updateMatrixWorld(true);
-    return new THREE.Vector3().setFromMatrixPosition(tcp.matrixWorld);
+    const position = new THREE.Vector3();
+    const quaternion = new THREE.Quaternion();
+    tcp.matrixWorld.decompose(position, quaternion, new THREE.Vector3());
+    return { position, quaternion };
   }
 
   /** How many of the gripper's finger boxes are drawn (tests). */
