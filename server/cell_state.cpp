@@ -9,24 +9,30 @@
 
 namespace costar::server {
 
+WaypointFinder::WaypointFinder(workcell::Workcell& cell) {
+  for (const auto& component : cell.components().components()) {
+    const auto& description = component->description();
+    if (std::find(description.implements.begin(), description.implements.end(), "Arm") !=
+        description.implements.end()) {
+      arm_sources_.insert(description.name);
+    }
+    for (const auto& symbol : description.symbols) {
+      declared_.insert(symbol.name);
+    }
+  }
+}
+
+bool WaypointFinder::isWaypoint(const world::Symbol& symbol) const {
+  return arm_sources_.contains(symbol.source) && !declared_.contains(symbol.name);
+}
+
 json cellState(workcell::Workcell& cell, std::int64_t active, bool paused) {
   const world::WorldState& world = cell.components().world();
   json state = {{"type", "state"}, {"t", rounded(toSeconds(cell.clock().now()), 1e4)}};
   state["run"] = active;
   state["mode"] = active == 0 ? "idle" : (paused ? "paused" : "running");
 
-  std::set<std::string> arm_sources;
-  std::set<std::string> declared;
-  for (const auto& component : cell.components().components()) {
-    const auto& description = component->description();
-    if (std::find(description.implements.begin(), description.implements.end(), "Arm") !=
-        description.implements.end()) {
-      arm_sources.insert(description.name);
-    }
-    for (const auto& symbol : description.symbols) {
-      declared.insert(symbol.name);
-    }
-  }
+  const WaypointFinder waypoints_of_arms(cell);
 
   json arm_json = json::object();
   if (const auto endpoint = world.worldPose("endpoint")) {
@@ -91,7 +97,7 @@ json cellState(workcell::Workcell& cell, std::int64_t active, bool paused) {
   json waypoints = json::array();
   json frames = json::array();
   for (const world::Symbol* symbol : world.symbols()) {
-    if (arm_sources.contains(symbol->source) && !declared.contains(symbol->name)) {
+    if (waypoints_of_arms.isWaypoint(*symbol)) {
       json item = {{"name", symbol->name}};
       if (const world::FrameValue* frame = symbol->frame()) {
         item["kind"] = "pose";

@@ -4,12 +4,29 @@
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <set>
+#include <string>
 
 namespace costar::workcell {
 class Workcell;
 }
+namespace costar::world {
+struct Symbol;
+}
 
 namespace costar::server {
+
+/// Which symbols of the world state are waypoints: those an arm (a component implementing the
+/// abstract Arm) reports that no component declares.
+class WaypointFinder {
+ public:
+  explicit WaypointFinder(workcell::Workcell& cell);
+  bool isWaypoint(const world::Symbol& symbol) const;
+
+ private:
+  std::set<std::string> arm_sources_;
+  std::set<std::string> declared_;
+};
 
 /// {type: "state", t (clock s), run (the active run's id, 0: none), mode (idle, running,
 /// paused), arm {endpoint, joints, moving}, gripper {open, closed, holding, mode, reading},

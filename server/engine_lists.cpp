@@ -1,12 +1,14 @@
 // What the editor offers: the workcell's info (the palette's, with the engine's pace, active
-// run and counters), and the choice lists read from what the cell knows now (waypoints, frames, object classes,
-// predicates, the grasps taught per class), and each object class's shape and colours (for drawing the parts).
+// run and counters), the choice lists read from what the cell knows now (waypoints, frames,
+// object classes, predicates, the grasps taught per class), and each object class's shape and
+// colours (for drawing the parts).
 
 #include "server/engine_parts.h"
 
 #include <algorithm>
 #include <functional>
 #include <set>
+#include "server/cell_state.h"
 #include "sim/simulation.h"
 #include "smartmove/grasps.h"
 #include "workcell/workcell.h"
@@ -41,23 +43,12 @@ struct Known {
 Known knownNow(workcell::Workcell& cell) {
   Known known;
   const world::WorldState& world = cell.components().world();
-  std::set<std::string> arm_sources;
-  std::set<std::string> declared;
-  for (const auto& component : cell.components().components()) {
-    const auto& description = component->description();
-    if (std::find(description.implements.begin(), description.implements.end(), "Arm") !=
-        description.implements.end()) {
-      arm_sources.insert(description.name);
-    }
-    for (const auto& symbol : description.symbols) {
-      declared.insert(symbol.name);
-    }
-  }
+  const WaypointFinder waypoints_of_arms(cell);
   for (const world::Symbol* symbol : world.symbols()) {
     if (symbol->frame() != nullptr) {
       known.frames.insert(symbol->name);
     }
-    if (arm_sources.contains(symbol->source) && !declared.contains(symbol->name)) {
+    if (waypoints_of_arms.isWaypoint(*symbol)) {
       known.waypoints.insert(symbol->name);
     }
   }
