@@ -9,9 +9,12 @@ each class it must still answer, with the arm's run still active. Prints, per cl
 crashes (the server died or stopped answering), 5xx answers, security findings (a refused kind
 of request accepted: a Host or Origin that is not this server's, a change without the token, a
 hostile plan saved or called valid), data loss (the saved plan or the long log changed), the
-largest gap of the live stream and the server's peak memory. Exit 0 when every count is 0.
+largest gap of the live stream and the server's peak memory. Then SIGTERM with the arm moving
+(exit 0, the run logged STOPPED, the plan and the long log intact after a restart), and rounds of
+kill -9 while the arm moves and plans are saved (every acknowledged save is there after a
+restart). Exit 0 when every count is 0. scripts/hostile_server.sh runs it on every cell.
 
-Usage: server/bench/hostile_serve.py PATH/TO/costar [--workcell ur5-sim] [--transitions 120000]
+Usage: server/bench/hostile_serve.py PATH/TO/costar [--workcell ur5-sim] [--transitions 120000] [--kills 5]
 Stdlib only (no browser needed: the requests are written byte by byte).
 """
 
@@ -19,7 +22,9 @@ import argparse
 import json
 import os
 import re
+import signal
 import socket
+import struct
 import subprocess
 import sys
 import tempfile
@@ -104,6 +109,48 @@ def upgrade(host, origin):
     return (text + "\r\n").encode()
 
 
+def frame(opcode, payload, fin=True, rsv=0, mask=True, length=None):
+    """One WebSocket frame as a client writes it (masked unless told), `length` announced in
+    place of the payload's."""
+    n = len(payload) if length is None else length
+    head = bytes([(0x80 if fin else 0) | (rsv << 4) | opcode])
+    bit = 0x80 if mask else 0
+    if n < 126:
+        head += bytes([bit | n])
+    elif n < 1 << 16:
+        head += bytes([bit | 126]) + struct.pack(">H", n)
+    else:
+        head += bytes([bit | 127]) + struct.pack(">Q", n)
+    if not mask:
+        return head + payload
+    key = os.urandom(4)
+    if not payload:
+        return head + key
+    mask_bytes = (key * (len(payload) // 4 + 1))[:len(payload)]
+    return head + key + (int.from_bytes(payload, "big") ^ int.from_bytes(mask_bytes, "big")).to_bytes(len(payload), "big")
+
+
+def frame_attacks():
+    """(what, bytes sent on an open stream) that break the WebSocket protocol or the stream's
+    messages."""
+    text = lambda data: frame(0x1, data)  # noqa: E731
+    return [("unmasked text frame", frame(0x1, b'{"type":"ping"}', mask=False)),
+            ("reserved opcode 3", frame(0x3, b"x")), ("reserved opcode 11", frame(0xB, b"x")),
+            ("RSV bits set", frame(0x1, b'{"type":"ping"}', rsv=7)),
+            ("text that is not UTF-8", text(b'{"type":"ping","x":"\xff\xfe"}')),
+            ("ping of 126 bytes", frame(0x9, b"p" * 126)), ("fragmented ping", frame(0x9, b"p", fin=False)),
+            ("continuation first", frame(0x0, b"x")),
+            ("text inside a fragmented text", frame(0x1, b"{", fin=False) + frame(0x1, b"}")),
+            ("2^63 bytes announced", frame(0x2, b"abc", length=(1 << 63) - 1)),
+            ("16 MiB announced, 1 KiB sent", frame(0x1, b"a" * 1024, length=16 << 20)),
+            ("2 MiB message", text(b'{"type":"ping","pad":"' + b"a" * (2 << 20) + b'"}')),
+            ("close code 999", frame(0x8, struct.pack(">H", 999))), ("close of 1 byte", frame(0x8, b"\x03")),
+            ("100,000 nested arrays", text(b"[" * 100000)), ("message that is not JSON", text(b"\x00\x01garbage")),
+            ("unknown type", text(b'{"type":"shutdown"}')), ("type not a string", text(b'{"type":[1,2]}')),
+            ("1,000 pings at once", b"".join(frame(0x9, b"p") for _ in range(1000))),
+            ("1,000 ping messages at once", b"".join(text(b'{"type":"ping"}') for _ in range(1000)))]
+
+
 def chain(trees, loop=False):
     xml = '<root BTCPP_format="4" main_tree_to_execute="T0">\n'
     for i in range(trees):
@@ -171,6 +218,7 @@ def main():
     parser.add_argument("costar")
     parser.add_argument("--workcell", default="ur5-sim")
     parser.add_argument("--transitions", type=int, default=120000)
+    parser.add_argument("--kills", type=int, default=5, help="rounds of kill -9 during a motion and saves")
     args = parser.parse_args()
     folder = tempfile.mkdtemp(prefix="costar_hostile_")
     process, port, token = start(args.costar, args.workcell, folder)
@@ -354,6 +402,96 @@ def main():
                 tally.note("errors", f"a full read got {count} transitions ({size})")
         alive(tally, "12 concurrent reads of the long log")
 
+    def stream_frames(tally):
+        """Malformed frames and messages on the live stream; commands on it without the token."""
+        def stream(data, wait=1.0):
+            try:
+                with socket.create_connection(("127.0.0.1", port), timeout=10) as sock:
+                    sock.sendall(upgrade(f"127.0.0.1:{port}", None))
+                    answer = b""
+                    while b"\r\n\r\n" not in answer:
+                        chunk = sock.recv(4096)
+                        if not chunk:
+                            return False, answer
+                        answer += chunk
+                    try:
+                        sock.sendall(data)
+                    except OSError:
+                        pass  # closed on a protocol error before all was read
+                    # The stream goes on (a snapshot 20 times a second): read what comes for
+                    # `wait` seconds, or until the server closes it.
+                    deadline = time.monotonic() + wait
+                    received = answer
+                    try:
+                        while time.monotonic() < deadline:
+                            sock.settimeout(max(0.01, deadline - time.monotonic()))
+                            chunk = sock.recv(65536)
+                            if not chunk:
+                                break
+                            received += chunk
+                    except OSError:
+                        pass
+                    return True, received
+            except OSError as error:
+                return False, str(error).encode()
+
+        for what, data in frame_attacks():
+            tally.attempts += 1
+            opened, _ = stream(data)
+            if not alive(tally, what):
+                return
+            if not opened:
+                tally.note("errors", f"{what}: the stream did not open")
+            status, _ = exchange(port, request("GET", "/api/info"), timeout=10)
+            if status != 200:
+                tally.note("errors", f"{what}: GET /api/info then answered {status}")
+        # Commands without the token (loopback: the stream opens without it): refused, the run
+        # goes on unpaused.
+        for bad in [None, "wrong", token + "x", token[:-1]]:
+            for action in ["pause", "stop", "step"]:
+                tally.attempts += 1
+                auth = b"" if bad is None else frame(0x1, json.dumps({"type": "auth", "token": bad}).encode())
+                stream(auth + frame(0x1, json.dumps({"type": "control", "action": action}).encode()))
+                if not alive(tally, f"control {action} with token {bad!r}"):
+                    return
+                status, active = exchange(port, request("GET", "/api/runs/active"))
+                if status != 200 or not json.loads(active).get("active") or json.loads(active).get("paused"):
+                    tally.note("security", f"control {action} with token {bad!r} took effect: {active[:160]}")
+                    exchange(port, request("POST", "/api/control", b'{"action":"resume"}', token))
+
+    def saves(tally):
+        """20 saves of one plan and 20 of plans of their own at once: each acknowledged save is
+        kept, as the version it was acknowledged as."""
+        results = {}
+
+        def save(key, name, marker):
+            plan = KEEP_PLAN.replace('name="kept"', f'name="{marker}"')
+            results[key] = exchange(port, request("PUT", f"/api/plans/{name}", json.dumps({"xml": plan}), token))
+
+        threads = [threading.Thread(target=save, args=(("same", i), "shared", f"s{i}")) for i in range(20)] + \
+                  [threading.Thread(target=save, args=(("own", i), f"own{i}", f"o{i}")) for i in range(20)]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        versions = {}
+        for (kind, i), (status, body) in sorted(results.items()):
+            tally.attempts += 1
+            if status != 201:
+                tally.note("errors", f"save {kind} {i}: {status} {body[:120]}")
+                continue
+            version = json.loads(body)["version"]
+            name = "shared" if kind == "same" else f"own{i}"
+            marker = f"s{i}" if kind == "same" else f"o{i}"
+            if kind == "same":
+                if version in versions:
+                    tally.note("loss", f"saves {versions[version]} and {i} were both acknowledged as version {version}")
+                versions[version] = i
+            got, saved = exchange(port, request("GET", f"/api/plans/{name}?version={version}"))
+            if got != 200 or f'name="{marker}"' not in json.loads(saved)["xml"]:
+                tally.note("loss", f"{name} version {version} does not hold save {marker}: {got} {saved[:120]}")
+        alive(tally, "40 concurrent saves")
+
     def connections(tally):
         idle = []
         for _ in range(200):
@@ -379,8 +517,9 @@ def main():
 
     for name, body in [("deep, wide and huge plans", plans), ("text that is not UTF-8", texts),
                        ("huge bodies", huge), ("odd paths and methods", paths), ("Host and Origin", hosts),
-                       ("no or wrong token", no_token), ("12 concurrent reads of a 120k log", logs),
-                       ("idle connections", connections)]:
+                       ("no or wrong token", no_token), (f"12 concurrent reads of a {args.transitions:,}-transition log", logs),
+                       ("malformed WebSocket frames, commands without the token", stream_frames),
+                       ("40 concurrent saves", saves), ("idle connections", connections)]:
         if process.poll() is None:
             run_class(name, body)
     sampling[0] = False
@@ -408,6 +547,51 @@ def main():
         tally.note("loss", f"the moving run's log after SIGTERM: {status} {body[:200]}")
     tally.gap, tally.peak_mb = float("nan"), memory_kb(process.pid, "VmRSS") / 1024
     tallies.append(tally)
+
+    # kill -9 while the arm moves and plans are being saved: every acknowledged save survives,
+    # the store opens again, the interrupted run's log reads.
+    killed = Tally(f"kill -9 during a motion and saves ({args.kills} kills)")
+    peak_mb = 0.0
+    for round_ in range(args.kills):
+        status, body = exchange(port, request("POST", "/api/runs", json.dumps({"xml": MOVING_PLAN}), token))
+        if status != 202:
+            killed.note("errors", f"round {round_}: the moving plan did not start: {status} {body[:120]}")
+            break
+        interrupted = json.loads(body)["run"]
+        acknowledged = []
+        saving = [True]
+
+        def saver(round_=round_, port=port, token=token):
+            n = 0
+            while saving[0]:
+                name = f"k{round_}_{n}"
+                plan = KEEP_PLAN.replace('name="kept"', f'name="{name}"')
+                status, _ = exchange(port, request("PUT", f"/api/plans/{name}", json.dumps({"xml": plan}), token), 5)
+                if status == 201:
+                    acknowledged.append(name)
+                n += 1
+
+        thread = threading.Thread(target=saver)
+        thread.start()
+        time.sleep(1.0 + 0.37 * round_)
+        process.send_signal(signal.SIGKILL)
+        process.wait()
+        saving[0] = False
+        thread.join()
+        killed.attempts += 1 + len(acknowledged)  # the kill, and each acknowledged save looked for
+        process, port, token = start(args.costar, args.workcell, folder)
+        peak_mb = max(peak_mb, memory_kb(process.pid, "VmRSS") / 1024)
+        for name in acknowledged:
+            got, saved = exchange(port, request("GET", f"/api/plans/{name}"))
+            if got != 200 or f'name="{name}"' not in json.loads(saved)["xml"]:
+                killed.note("loss", f"acknowledged save {name} lost: {got} {saved[:120]}")
+        got, body = exchange(port, request("GET", f"/api/runs/{interrupted}"))
+        if got not in (200, 404):  # 404: killed before the writer's first batch
+            killed.note("errors", f"the interrupted run's log: {got} {body[:160]}")
+        if not acknowledged:
+            killed.note("errors", f"round {round_}: no save was acknowledged before the kill")
+    killed.gap, killed.peak_mb = float("nan"), peak_mb
+    tallies.append(killed)
     stop_server(process)
 
     print(f"costar serve -w {args.workcell} ({args.costar}); the arm moving under run {moving_run} throughout")
