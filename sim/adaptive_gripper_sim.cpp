@@ -247,6 +247,14 @@ void SimAdaptiveGripper::control() {
   data_->ctrl[scissor_actuator_] = scissor_setpoint_;
 }
 
+double SimAdaptiveGripper::commandedClosure() const {
+  double closure = 0.0;
+  for (const Finger& finger : fingers_) {
+    closure = std::max(closure, finger.target);
+  }
+  return closure;
+}
+
 bool SimAdaptiveGripper::isGripperGeom(int geom) const {
   return geom >= 0 && geom < model_->ngeom && geom_finger_[static_cast<std::size_t>(geom)] >= 0;
 }

@@ -58,6 +58,8 @@ class SimAdaptiveGripper final : public gripper::AdaptiveGripperDriver {
   void control();
   /// Puts the fingers open and the scissor axis at `mode` at once (a model's initial state).
   void reset(gripper::GripperMode mode);
+  /// How far the fingers were last told to close: the most closed finger's target, 0 (open) to 1.
+  double commandedClosure() const;
   /// Whether a geom belongs to the gripper, and to which finger (-1: the palm or not a finger).
   bool isGripperGeom(int geom) const;
   int fingerOfGeom(int geom) const;

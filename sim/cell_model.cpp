@@ -121,4 +121,21 @@ std::string composeCellModel(const CellModelPieces& pieces) {
   return out.str();
 }
 
+double modelTimestep(const std::string& mjcf) {
+  pugi::xml_document doc;
+  if (!doc.load_string(mjcf.c_str())) {
+    throw std::runtime_error("the workcell model is not XML");
+  }
+  const pugi::xml_attribute timestep = doc.child("mujoco").child("option").attribute("timestep");
+  if (!timestep) {
+    return 0.002;
+  }
+  const double value = timestep.as_double(-1.0);
+  if (!(value > 0.0 && value < 1.0)) {
+    throw std::runtime_error(std::string("the workcell model's <option timestep=\"") + timestep.value() +
+                             "\"> is not a time step in seconds");
+  }
+  return value;
+}
+
 }  // namespace costar::sim

@@ -39,4 +39,9 @@ struct CellModelPieces {
 /// that cannot be read or parsed, no ROBOT marker, no flange body, no gripper mount body).
 std::string composeCellModel(const CellModelPieces& pieces);
 
+/// The physics time step a model's text sets (<option timestep>), MuJoCo's 0.002 s when it sets
+/// none: what bodies added to it are made stable for (sim/wire_sim.h).
+/// @throws std::runtime_error when the text is not XML or the value not a positive number.
+double modelTimestep(const std::string& mjcf);
+
 }  // namespace costar::sim

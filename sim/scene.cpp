@@ -11,6 +11,8 @@
 
 #include "core/files.h"
 #include "core/json_file.h"
+#include "sim/scene_fields.h"
+#include "sim/wire_scene.h"
 
 namespace costar::sim {
 
@@ -24,74 +26,15 @@ Region tableTop() { return {{-0.3, -0.6}, {1.1, 0.6}}; }
 
 namespace {
 
+using fields::fail;
+using fields::number;
+using fields::numbers;
+using fields::object;
+using fields::onlyKnownFields;
+using fields::shown;
+using fields::stringField;
+using fields::whole;
 using nlohmann::json;
-
-/// A problem with one field of a scene file: "parts[2].count: must be ...".
-[[noreturn]] void fail(const std::string& field, const std::string& problem) {
-  throw std::runtime_error(field + ": " + problem);
-}
-
-/// The value as the file has it, shortened: for "must be ..., not VALUE".
-std::string shown(const json& value) {
-  std::string text = value.dump();
-  return text.size() <= 40 ? text : text.substr(0, 37) + "...";
-}
-
-void onlyKnownFields(const json& object, const std::string& field, std::initializer_list<const char*> known) {
-  for (const auto& item : object.items()) {
-    const std::string& key = item.key();  // not a structured binding: clang 14 cannot capture one
-    if (std::none_of(known.begin(), known.end(), [&key](const char* name) { return key == name; })) {
-      std::string list;
-      for (const char* name : known) {
-        list += (list.empty() ? "" : ", ") + std::string(name);
-      }
-      fail(field.empty() ? key : field + "." + key, "unknown field (known: " + list + ")");
-    }
-  }
-}
-
-const json& object(const json& value, const std::string& field) {
-  if (!value.is_object()) {
-    fail(field, "must be an object {...}, not " + shown(value));
-  }
-  return value;
-}
-
-std::string stringField(const json& value, const std::string& field) {
-  if (!value.is_string()) {
-    fail(field, "must be a string, not " + shown(value));
-  }
-  return value.get<std::string>();
-}
-
-double number(const json& value, const std::string& field) {
-  // JSON has no nan; a number too large for a double is read as infinity.
-  if (!value.is_number() || !std::isfinite(value.get<double>())) {
-    fail(field, "must be a finite number, not " + shown(value));
-  }
-  return value.get<double>();
-}
-
-/// A whole number in [low, high]; 4294967297 or 2.5 is an error, never truncated.
-std::uint64_t whole(const json& value, const std::string& field, std::uint64_t low, std::uint64_t high) {
-  const std::string range = "a whole number from " + std::to_string(low) + " to " + std::to_string(high);
-  if (!value.is_number_unsigned() || value.get<std::uint64_t>() < low || value.get<std::uint64_t>() > high) {
-    fail(field, "must be " + range + ", not " + shown(value));
-  }
-  return value.get<std::uint64_t>();
-}
-
-std::vector<double> numbers(const json& value, const std::string& field, std::size_t min_size, std::size_t max_size,
-                            const std::string& what) {
-  if (!value.is_array() || value.size() < min_size || value.size() > max_size) {
-    fail(field, "must be " + what + ", not " + shown(value));
-  }
-  std::vector<double> out;
-  for (std::size_t i = 0; i < value.size(); ++i) {
-    out.push_back(number(value[i], field + "[" + std::to_string(i) + "]"));
-  }
-  return out;
-}
 
 bool inside(const Region& outer, const Eigen::Vector2d& point) {
   return (point.array() >= outer.min.array()).all() && (point.array() <= outer.max.array()).all();
@@ -257,7 +200,7 @@ Scene parseScene(const std::string& text, const std::string& label) {
   try {
     const json file = core::parseJson(text);
     onlyKnownFields(object(file, "the file"), "",
-                    {"description", "seed", "min_gap", "camera_offset", "regions", "parts"});
+                    {"description", "seed", "min_gap", "camera_offset", "regions", "parts", "jig", "wire"});
     Scene scene;
     scene.label = label;
     if (file.contains("description")) {
@@ -297,6 +240,13 @@ Scene parseScene(const std::string& text, const std::string& label) {
     for (std::size_t i = 0; i < parts.size(); ++i) {
       scene.parts.push_back(parsePart(parts[i], "parts[" + std::to_string(i) + "]", scene.regions));
     }
+    if (file.contains("jig")) {
+      scene.jig = parseJig(file.at("jig"), "jig");
+    }
+    if (file.contains("wire")) {
+      scene.wire = parseWire(file.at("wire"), "wire");
+    }
+    checkJigAndWire(scene.jig, scene.wire);
     return scene;
   } catch (const std::exception& e) {
     throw std::runtime_error("scene '" + label + "': " + e.what());
@@ -574,6 +524,12 @@ std::string sceneFileText(const Scene& scene) {
     parts.push_back(item);
   }
   file["parts"] = parts;
+  if (scene.jig) {
+    file["jig"] = jigJson(*scene.jig);
+  }
+  if (scene.wire) {
+    file["wire"] = wireJson(*scene.wire);
+  }
   return file.dump(1) + "\n";
 }
 

@@ -11,7 +11,8 @@
 // under it: {"class": "link", "at": [0.6, 0.05, 90], "height": 0.05} across a node at (0.6, 0.05).
 // Two parts placed with "at" that overlap by more than 1 mm (and are not one above the other)
 // are refused naming both: the physics would throw them apart at the first step.
-// Optional: "min_gap" (m, 0 to 0.5, default 0.02) between randomly placed parts. Custom
+// A bending jig and the wire it holds: "jig" and "wire" (sim/wire.h). Optional: "min_gap" (m,
+// 0 to 0.5, default 0.02) between randomly placed parts. Custom
 // regions add to (or replace) the default ones. A field the format does not know, a value of
 // the wrong type or out of range (a count of 4294967297, a negative min_gap, a region or an
 // "at" off the table) is an error naming the file and the field, e.g.
@@ -28,6 +29,7 @@
 
 #include <Eigen/Core>
 
+#include "sim/wire.h"
 #include "world/object_class.h"
 #include "world/pose.h"
 
@@ -82,6 +84,9 @@ struct Scene {
   double min_gap = 0.02;
   /// The camera away from its drawn mounting (absent: as drawn).
   std::optional<CameraOffset> camera_offset;
+  /// A bending jig on the table, and the wire clamped in it (sim/wire.h).
+  std::optional<JigSpec> jig;
+  std::optional<WireSpec> wire;
 };
 
 /// The table top (x, y in m), as sim/models/table_cell.xml has it; regions and fixed
@@ -97,7 +102,8 @@ Scene loadScene(const std::filesystem::path& file);
 Scene parseScene(const std::string& json_text, const std::string& label);
 
 /// The scene as a scene file's text (parseScene reads it back to the same scene): description,
-/// seed, min_gap, custom regions, camera_offset and every part, fixed ("at") or in a region.
+/// seed, min_gap, custom regions, camera_offset, every part, fixed ("at") or in a region, the
+/// jig and the wire.
 std::string sceneFileText(const Scene& scene);
 
 /// A part as placed: its simulator name (node_0, link_1, ...), class, colour, and pose.

@@ -16,6 +16,7 @@
 #include "sim/adaptive_gripper_sim.h"
 #include "sim/cell_model.h"
 #include "sim/gl_context.h"
+#include "sim/wire_sim.h"
 
 namespace costar::sim {
 
@@ -94,6 +95,8 @@ struct Simulation::Impl {
   int right_pad = 0;
   // The 3-finger adaptive gripper, when the cell has it.
   std::unique_ptr<SimAdaptiveGripper> adaptive;
+  // The scene's bending jig and wire, when it has them.
+  std::unique_ptr<SimJig> jig;
   int table_geom = 0;          // the box the arm collides with
   int table_surface_geom = 0;  // the plane parts rest on
   int tcp_site = 0;
@@ -129,6 +132,7 @@ struct Simulation::Impl {
       clock->removeStepListener(listener);
     }
     renderer.reset();
+    jig.reset();
     adaptive.reset();
     if (data != nullptr) {
       mj_deleteData(data);
@@ -258,12 +262,36 @@ struct Simulation::Impl {
     }
     countTableContacts();
     ++steps;
+    if (jig) {
+      jig->afterStep(toSeconds(now()));
+    }
+  }
+
+  /// The finger a geom belongs to for the jig's watch on the wire: the adaptive gripper's
+  /// fingers 0..2, the 2-finger gripper's left (0) and right (1); -1 for any other geom.
+  int fingerOfGeom(int geom) const {
+    if (adaptive) {
+      return adaptive->fingerOfGeom(geom);
+    }
+    const char* body = mj_id2name(model, mjOBJ_BODY, model->geom_bodyid[geom]);
+    const std::string name = body != nullptr ? body : "";
+    return name == "left_finger" ? 0 : name == "right_finger" ? 1 : -1;
+  }
+
+  /// How far the gripper was last told to close, 0 (open) to 1 (closed).
+  double commandedClosure() const {
+    return adaptive ? adaptive->commandedClosure() : 1.0 - finger_target / (kMaxOpening / 2);
   }
 
   /// A geom's label in contacts(): the adaptive gripper's by finger, else its body's.
   std::string geomLabel(int geom) const {
     if (geom == table_geom || geom == table_surface_geom) {
       return "table";
+    }
+    if (jig) {
+      if (std::string label = jig->geomLabel(geom); !label.empty()) {
+        return label;
+      }
     }
     if (adaptive && adaptive->isGripperGeom(geom)) {
       const int finger = adaptive->fingerOfGeom(geom);
@@ -356,6 +384,28 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
                                      [&](const world::ObjectClass& c) { return c.name == part.object_class; });
     bodies += partBody(part, *object);
   }
+  // The bending jig and its wire, drawn for this placement seed (sim/wire.h).
+  std::optional<WireMaterial> material;
+  std::optional<JigDraw> jig_draw;
+  if (scene.jig) {
+    if (scene.wire) {
+      const std::vector<WireMaterial> materials = loadWireMaterials(root / "data/wire_materials.json");
+      std::string known;
+      for (const WireMaterial& candidate : materials) {
+        if (candidate.name == scene.wire->material) {
+          material = candidate;
+        }
+        known += (known.empty() ? "" : ", ") + candidate.name;
+      }
+      if (!material) {
+        throw std::runtime_error("scene '" + scene.label + "': wire.material: unknown material '" +
+                                 scene.wire->material + "' (known: " + known + ")");
+      }
+    }
+    jig_draw =
+        drawJig(*scene.jig, scene.wire, material ? &*material : nullptr, options.placement_seed.value_or(scene.seed));
+    bodies += jigMjcf(*scene.jig, scene.wire, material ? &*material : nullptr, *jig_draw, modelTimestep(xml));
+  }
   replaceMarker(xml, "<!--PART_ASSETS-->", assets);
   replaceMarker(xml, "<!--PARTS-->", bodies);
 
@@ -416,6 +466,12 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   }
   for (const auto& part : impl->placements) {
     impl->part_bodies.push_back(impl->id(mjOBJ_BODY, part.name.c_str()));
+  }
+  if (scene.jig) {
+    const Impl* raw = impl.get();
+    SimJig::Gripper gripper{[raw](int geom) { return raw->fingerOfGeom(geom); },
+                            [raw] { return raw->commandedClosure(); }, impl->tcp_site};
+    impl->jig = std::make_unique<SimJig>(m, impl->data, *scene.jig, scene.wire, *jig_draw, std::move(gripper));
   }
   // Square pixels, principal point at the centre, focal length from the model's fovy.
   const double fovy = m->cam_fovy[impl->rgbd_camera] * M_PI / 180.0;
@@ -662,5 +718,12 @@ std::vector<std::pair<std::string, std::string>> Simulation::contacts() const {
 }
 
 const std::vector<world::ObjectClass>& Simulation::objectClasses() const { return impl_->classes; }
+
+std::optional<JigState> Simulation::jig() const {
+  if (!impl_->jig) {
+    return std::nullopt;
+  }
+  return impl_->jig->state();
+}
 
 }  // namespace costar::sim

@@ -35,6 +35,7 @@
 #include "gripper/adaptive_gripper_driver.h"
 #include "sim/depth_noise.h"
 #include "sim/scene.h"
+#include "sim/wire.h"
 #include "world/object_class.h"
 
 namespace costar::sim {
@@ -188,9 +189,12 @@ class Simulation {
   void movePart(const std::string& name, const world::Pose& pose);
   /// Pairs of bodies in contact: part names, "table", "arm", and the gripper's fingers:
   /// "left_finger", "right_finger" (2-finger), "finger_middle", "finger_1", "finger_2" and
-  /// "palm" (adaptive gripper).
+  /// "palm" (adaptive gripper); with a jig, "wire", "pin_NAME" and "jig" (its clamp).
   std::vector<std::pair<std::string, std::string>> contacts() const;
   const std::vector<world::ObjectClass>& objectClasses() const;
+  /// The scene's bending jig and wire as they truly are (sim/wire.h): the pins, the wire's
+  /// centreline and bends, how the gripper has held it so far. Absent without a "jig".
+  std::optional<JigState> jig() const;
 
   /// The default robot's "home" configuration: tool pointing down above the table.
   static ArmJoints homeConfiguration();
