@@ -149,8 +149,9 @@ int run(Options options) {
         options.trials,
         [total, &trace_failed](const trials::TrialResult& result, int done) {
           if (result.success) {
-            std::printf("[%4d/%d] trial %d (seed %llu): SUCCESS in %.1f s simulated (%.1f s wall)\n", done, total,
-                        result.index, static_cast<unsigned long long>(result.seed), result.cycle_time_s, result.wall_s);
+            std::printf("[%4d/%d] trial %d (seed %llu): SUCCESS in %.1f s simulated (%.1f s wall)%s%s\n", done, total,
+                        result.index, static_cast<unsigned long long>(result.seed), result.cycle_time_s, result.wall_s,
+                        result.reason.empty() ? "" : ": ", result.reason.c_str());
           } else {
             std::printf("[%4d/%d] trial %d (seed %llu): FAILURE at %s: %s\n", done, total, result.index,
                         static_cast<unsigned long long>(result.seed), result.failure_path.c_str(),

@@ -25,11 +25,15 @@ std::vector<std::filesystem::path> planFiles() {
   return files;
 }
 
-/// The workcell a plan is written for: by folder.
+/// The workcell a plan is written for: by folder; in iiwa/, the 3-finger cell's unless the
+/// name ends in _2f (the 2-finger gripper's cell).
 std::string workcellFor(const std::filesystem::path& file) {
   const std::string folder = file.parent_path().filename().string();
   if (folder == "test_workcell") {
     return "test";
+  }
+  if (folder == "iiwa") {
+    return file.stem().string().ends_with("_2f") ? "iiwa-sim" : "iiwa-3f-sim";
   }
   return folder == "ur5" ? "ur5-sim" : "none";
 }

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "trials/wire_judge.h"
+
 namespace costar::trials {
 
 namespace {
@@ -108,7 +110,10 @@ std::vector<JudgeInfo> judges() {
   return {{"lift", "task 1: a node is held 5 cm above the table"},
           {"right_to_left", "task 2: two nodes moved from the right to the left of table_center"},
           {"assembly", "task 3: node on the table (left), link on it, node on the link"},
-          {"blind_place", "node_0 within 1 cm of (0.45, 0.25), the blind pick-and-place example"}};
+          {"blind_place", "node_0 within 1 cm of (0.45, 0.25), the blind pick-and-place example"},
+          {"wire_bending",
+           "every bend of the jig's drawing within 5 degrees after release, the wire never pulled "
+           "out of the gripper, no pin moved (examples/iiwa/wire_bending.xml)"}};
 }
 
 Judge judge(const std::string& name) {
@@ -123,6 +128,9 @@ Judge judge(const std::string& name) {
   }
   if (name == "blind_place") {
     return blindPlace;
+  }
+  if (name == "wire_bending") {
+    return wireBending;
   }
   std::string known;
   for (const auto& info : judges()) {

@@ -29,6 +29,7 @@ struct JudgeInfo {
 /// "assembly" (task 3): a node rests on the table left of table_center, a link rests on it
 ///   (centred within 2 cm), a node rests on the link (centred within 2 cm), all at rest.
 /// "blind_place": node_0 rests within 1 cm of (0.45, 0.25) (examples/ur5/blind_pick_place.xml).
+/// "wire_bending": the scene's wire bent to its jig's drawing (trials/wire_judge.h).
 std::vector<JudgeInfo> judges();
 /// @throws std::invalid_argument naming the known judges.
 Judge judge(const std::string& name);

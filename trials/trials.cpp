@@ -159,9 +159,9 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
       simulation.stepTo(simulation.time() + checkedDuration(options.settle_s, "settle time"));
       const Verdict verdict = judge(simulation, initial);
       result.success = verdict.success;
+      result.reason = verdict.reason;
       if (!verdict.success) {
         result.failure_path = "judge";
-        result.reason = verdict.reason;
       }
     }
   } catch (const std::exception& e) {
@@ -405,6 +405,8 @@ nlohmann::json Summary::toJson() const {
     if (!trial.success) {
       item["failure_path"] = trial.failure_path;
       item["reason"] = trial.reason;
+    } else if (!trial.reason.empty()) {
+      item["judged"] = trial.reason;
     }
     list.push_back(std::move(item));
   }
@@ -504,6 +506,8 @@ Summary Summary::fromJson(const nlohmann::json& json) {
     if (!trial.success) {
       trial.failure_path = field<std::string>(item, "failure_path", at);
       trial.reason = field<std::string>(item, "reason", at);
+    } else if (item.contains("judged")) {
+      trial.reason = field<std::string>(item, "judged", at);
     }
     summary.trials.push_back(std::move(trial));
   }

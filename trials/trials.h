@@ -56,7 +56,8 @@ struct TrialResult {
   int index = 0;
   std::uint64_t seed = 0;
   bool success = false;
-  /// On failure: the failing node's path (or "judge") and the reason.
+  /// On failure: the failing node's path (or "judge") and the reason; on success, what the
+  /// judge found ("bends 91.2, -89.4 degrees; ..."; the JSON's "judged").
   std::string failure_path;
   std::string reason;
   double cycle_time_s = 0.0;  // simulated

@@ -133,6 +133,15 @@ check "perception eval --json /dev/full is written to" 2 "error: cannot write --
 check "sim snapshot to /dev/full" 2 "cannot write '/dev/full': No space left on device" \
   -- "$costar" sim snapshot sim/scenes/one_node.json --out /dev/full --width 16 --height 16
 claims_nothing "sim snapshot to /dev/full"
+check "sim snapshot after a plan in a cell" 0 \
+  '^wire: 2[45][0-9]\.[0-9] mm out of the clamp, E 1[12][0-9] GPa, yield strength [6-9][0-9] MPa; bends -?0\.[0-9] \(drawing 90, .*held 0, let go 0, pulled out 0 times' \
+  -- "$costar" sim snapshot sim/scenes/wire_bending.json -w iiwa-3f-sim --plan cli/test/fixtures/pinch_open.xml \
+  --settle 0.1 --camera jig --width 64 --height 48 --out "$tmp/jig.png"
+if ! grep -q '^ran cli/test/fixtures/pinch_open.xml: SUCCESS after' "$tmp/out" || [[ ! -s "$tmp/jig.png" ]]; then
+  echo "FAIL sim snapshot after a plan: no SUCCESS line or no picture"; cat "$tmp/out"; failures=$((failures + 1))
+fi
+check "sim snapshot in a cell without a simulator" 2 "workcell 'test' is not simulated: nothing to picture" \
+  -- "$costar" sim snapshot sim/scenes/one_node.json -w test --out "$tmp/x.png"
 
 # Teaching: jog, teach, move back, rename; waypoints persist in the file.
 printf 'jog z 0.05\nteach up\nhome\nmove up\nrename up lifted\nmove nowhere\nquit\n' |
