@@ -9,8 +9,11 @@
 #include <kdl_parser/kdl_parser.hpp>
 #include <pugixml.hpp>
 
+#include <array>
+#include <atomic>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -48,10 +51,52 @@ world::Pose toPose(const urdf::Pose& origin) {
 
 }  // namespace
 
+/// KDL 1.5's joints cache their last pose in mutable members (kdl/joint.hpp: `q_previous`,
+/// `joint_pose`), so one chain evaluated on two threads at once races: a thread can take the
+/// other's joint pose (collision queries on two threads reported contacts one thread did not).
+/// Each thread evaluates the forward kinematics on a copy of its own, a few per thread kept.
+class ThreadChains {
+ public:
+  struct Copy {
+    explicit Copy(const KDL::Chain& original) : chain(original), fk(chain) {}
+    KDL::Chain chain;
+    KDL::ChainFkSolverPos_recursive fk;  // refers to `chain`, so the copy does not move
+  };
+
+  explicit ThreadChains(const KDL::Chain& chain) : chain_(chain), id_(next_id_.fetch_add(1)) {}
+
+  /// This thread's solver for the chain.
+  KDL::ChainFkSolverPos_recursive& fk() const {
+    struct Slot {
+      std::uint64_t id = 0;
+      std::unique_ptr<Copy> copy;
+    };
+    thread_local std::array<Slot, 8> slots;  // ids start at 1: 0 is a free slot
+    thread_local std::size_t next = 0;
+    for (Slot& slot : slots) {
+      if (slot.id == id_) {
+        return slot.copy->fk;
+      }
+    }
+    Slot& slot = slots[next];  // the oldest is replaced
+    next = (next + 1) % slots.size();
+    slot.copy = std::make_unique<Copy>(chain_);
+    slot.id = id_;
+    return slot.copy->fk;
+  }
+
+ private:
+  const KDL::Chain& chain_;
+  std::uint64_t id_;  // unique for the process's life, unlike an address
+  static inline std::atomic<std::uint64_t> next_id_ = 1;
+};
+
 struct RobotModel::Impl {
-  KDL::Chain chain;
-  std::unique_ptr<KDL::ChainFkSolverPos_recursive> fk;
+  KDL::Chain chain;  // never evaluated, only copied: its joints' caches are never written
+  std::unique_ptr<ThreadChains> fk;
+  KDL::Chain ik_chain;  // the inverse solver's own
   std::unique_ptr<KDL::ChainIkSolverPos_LMA> ik;
+  std::mutex ik_mutex;  // the solver keeps its work in itself: one thread at a time
   std::vector<std::string> joint_names;
   Eigen::VectorXd lower, upper, velocity;
   std::vector<LinkGeometry> links;
@@ -209,8 +254,9 @@ RobotModel RobotModel::fromUrdfText(const std::string& urdf_text, const std::fil
       previous = static_cast<int>(impl->links.size()) - 1;
     }
   }
-  impl->fk = std::make_unique<KDL::ChainFkSolverPos_recursive>(impl->chain);
-  impl->ik = std::make_unique<KDL::ChainIkSolverPos_LMA>(impl->chain, 1e-6, 500);
+  impl->fk = std::make_unique<ThreadChains>(impl->chain);
+  impl->ik_chain = impl->chain;
+  impl->ik = std::make_unique<KDL::ChainIkSolverPos_LMA>(impl->ik_chain, 1e-6, 500);
   return RobotModel(std::move(impl));
 }
 
@@ -222,11 +268,11 @@ const Eigen::VectorXd& RobotModel::velocityLimits() const { return impl_->veloci
 const std::vector<LinkGeometry>& RobotModel::links() const { return impl_->links; }
 
 world::Pose RobotModel::forward(const Eigen::VectorXd& q) const {
-  // Local joint and frame values (the solver keeps no state): several threads may ask at once.
+  // Local joint and frame values and this thread's chain: several threads may ask at once.
   KDL::JntArray joints;
   joints.data = q;
   KDL::Frame frame;
-  impl_->fk->JntToCart(joints, frame);
+  impl_->fk->fk().JntToCart(joints, frame);
   return toPose(frame);
 }
 
@@ -234,13 +280,14 @@ void RobotModel::linkPoses(const Eigen::VectorXd& q, std::vector<world::Pose>& p
   KDL::JntArray joints;
   joints.data = q;
   KDL::Frame frame;
+  KDL::ChainFkSolverPos_recursive& fk = impl_->fk->fk();
   poses.resize(impl_->links.size());
   for (std::size_t i = 0; i < impl_->links.size(); ++i) {
     const int segment = impl_->link_segment[i];
     if (segment < 0) {
       poses[i] = world::Pose::Identity();
     } else {
-      impl_->fk->JntToCart(joints, frame, segment + 1);
+      fk.JntToCart(joints, frame, segment + 1);
       poses[i] = toPose(frame);
     }
   }
@@ -256,6 +303,7 @@ std::optional<Eigen::VectorXd> RobotModel::inverse(const world::Pose& target, co
   std::mt19937_64 random(random_seed);
   KDL::JntArray start(static_cast<unsigned>(dof()));
   KDL::JntArray result(static_cast<unsigned>(dof()));
+  const std::lock_guard lock(impl_->ik_mutex);
   for (int attempt = 0; attempt <= restarts; ++attempt) {
     if (attempt == 0) {
       start.data = seed;

@@ -80,6 +80,33 @@ TEST(RobotModel, NumericInverseKinematicsReachesReachablePoses) {
   EXPECT_GE(solved, 48);
 }
 
+TEST(RobotModel, ForwardKinematicsOnSeveralThreadsAtOnceMatchesTheDhModel) {
+  // KDL's joints cache their last pose: on a shared chain, one thread could take another's.
+  // Two threads alternate between the same two configurations, out of phase.
+  const RobotModel robot = ur5();
+  const Eigen::VectorXd configurations[2] = {kHome, joints({1.0, -1.2, 1.5, -0.3, 0.8, 2.0})};
+  const auto work = [&](int phase, int& wrong) {
+    std::vector<world::Pose> poses;
+    for (int trial = 0; trial < 30000; ++trial) {
+      const Eigen::VectorXd& q = configurations[(trial + phase) % 2];
+      robot.linkPoses(q, poses);
+      const world::Pose expected = dhForward(q);
+      const world::Pose actual = robot.forward(q);
+      if ((actual.translation() - expected.translation()).norm() > 1e-9 ||
+          world::rotationAngle(actual, expected) > 1e-9) {
+        ++wrong;
+      }
+    }
+  };
+  int wrong_here = 0;
+  int wrong_there = 0;
+  std::thread other(work, 1, std::ref(wrong_there));
+  work(0, wrong_here);
+  other.join();
+  EXPECT_EQ(wrong_here, 0);
+  EXPECT_EQ(wrong_there, 0);
+}
+
 class Collisions : public ::testing::Test {
  protected:
   /// Two 26 x 8 x 40 mm finger pads whose inner faces are `opening` apart, 14 cm along the tool.
