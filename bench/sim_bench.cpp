@@ -21,9 +21,9 @@ std::unique_ptr<sim::Simulation> assembly() {
   return sim::Simulation::create(sim::loadScene(dataRoot() / "sim/scenes/assembly.json"));
 }
 
-/// A cell's simulation (workcells/NAME.json: its arm, gripper and cell) with its scene, the
-/// assembly's.
-std::unique_ptr<sim::Simulation> cellAssembly(const std::string& name) {
+/// A cell's simulation (workcells/NAME.json: its arm, gripper and cell) with `scene` (default:
+/// the cell's, the assembly's).
+std::unique_ptr<sim::Simulation> cellAssembly(const std::string& name, const std::string& scene = {}) {
   const workcell::SimCellDescription cell = workcell::loadSimCellDescription(workcell::simCellFile(name));
   const workcell::GripperModel& gripper = workcell::gripperModel(cell.gripper);
   sim::SimulationOptions options;
@@ -32,7 +32,7 @@ std::unique_ptr<sim::Simulation> cellAssembly(const std::string& name) {
   options.cell_model = cell.cell_model;
   options.gripper_model = dataRoot() / gripper.mjcf;
   options.adaptive_gripper = gripper.adaptive;
-  return sim::Simulation::create(sim::loadScene(cell.scene), options);
+  return sim::Simulation::create(sim::loadScene(scene.empty() ? cell.scene : dataRoot() / scene), options);
 }
 
 /// Swings the arm between its home and `away` at full speed within `limits`, for ever.
@@ -110,6 +110,14 @@ BENCHMARK(BM_PhysicsArmHolding_Iiwa3f)->Unit(benchmark::kMillisecond);
 
 void BM_PhysicsArmMoving_Iiwa3f(benchmark::State& state) { iiwaPhysics(state, "iiwa-3f-sim", true); }
 BENCHMARK(BM_PhysicsArmMoving_Iiwa3f)->Unit(benchmark::kMillisecond);
+
+// The wire-bending scene (sim/scenes/wire_bending.json, docs/WIRE_BENDING.md) on the 3-finger
+// iiwa: the jig, its pins and the wire's chain of capsules on two hinges each, plastic.
+void BM_PhysicsWire_Iiwa3f(benchmark::State& state) {
+  const auto simulation = cellAssembly("iiwa-3f-sim", "sim/scenes/wire_bending.json");
+  simulateSeconds(state, *simulation);
+}
+BENCHMARK(BM_PhysicsWire_Iiwa3f)->Unit(benchmark::kMillisecond);
 
 /// One frame as a plan's DetectObjects takes its last one: colour and depth, noise on 2 threads.
 /// "CPU" is the main thread's; the /process_time variant counts every thread (Mesa's

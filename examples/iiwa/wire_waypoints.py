@@ -4,7 +4,12 @@ jog keys: the wire's free end taken from above, swung clockwise around pin B in 
 steps to 90 degrees and a few past it (the springback), back to 90, then the whole end swung
 counter-clockwise around pin A likewise. The numbers are sim/scenes/wire_bending.json's jig.
 
-  python3 examples/iiwa/wire_waypoints.py --over-b 4.5 --over-a 3.5 > examples/iiwa/wire_waypoints.json
+  python3 examples/iiwa/wire_waypoints.py > examples/iiwa/wire_waypoints.json
+  python3 examples/iiwa/wire_waypoints.py --tcp-z 0.03 --over-b 2.5 --wrap 0.009 > examples/iiwa/wire_waypoints_2f.json
+
+(the 3-finger gripper's TCP is 7 mm below its pinching fingertips' middle; the 2-finger
+gripper's is between its pads, and they hold the wire firmly enough that it springs back less
+at B).
 """
 import argparse
 import json
@@ -13,7 +18,6 @@ import math
 JIG = (0.40, -0.12)  # the clamp's mouth on the table (m); the jig's yaw is 0
 PIN_A = (0.065, 0.00975)  # in the jig's frame (m)
 PIN_B = (0.13, -0.00975)
-WRAP = 0.008 + 0.001  # a pin's radius and the wire's: the wire's axis wraps at this radius
 STEP = 10  # degrees between waypoints of a swing
 
 
@@ -34,6 +38,8 @@ def main():
     parser.add_argument("--tcp-z", type=float, default=0.023, help="the TCP's height while bending (m)")
     parser.add_argument("--over-b", type=float, default=4.5, help="degrees bent past 90 at pin B")
     parser.add_argument("--over-a", type=float, default=3.5, help="degrees bent past 90 at pin A")
+    parser.add_argument("--wrap", type=float, default=0.00925,
+                        help="the radius the wire's axis wraps a pin at (m): the pin's 8 mm, the wire's 1 mm, and play")
     args = parser.parse_args()
 
     waypoints = []
@@ -52,8 +58,10 @@ def main():
     def swing_b(phi):
         tangent = (math.cos(-phi), math.sin(-phi))
         normal = (math.sin(phi), math.cos(phi))
-        free = free_b - WRAP * phi
-        return (PIN_B[0] + WRAP * normal[0] + free * tangent[0], PIN_B[1] + WRAP * normal[1] + free * tangent[1]), -phi
+        free = free_b - args.wrap * phi
+        point = (PIN_B[0] + args.wrap * normal[0] + free * tangent[0],
+                 PIN_B[1] + args.wrap * normal[1] + free * tangent[1])
+        return point, -phi
 
     angles = range(STEP, 91, STEP)
     for a in angles:
@@ -67,8 +75,8 @@ def main():
 
     def swing_a(psi):
         normal = rotate((0, -1), psi)
-        touch = (PIN_A[0] + WRAP * normal[0], PIN_A[1] + WRAP * normal[1])
-        arm = rotate((held[0] - start[0] - WRAP * psi, held[1] - start[1]), psi)
+        touch = (PIN_A[0] + args.wrap * normal[0], PIN_A[1] + args.wrap * normal[1])
+        arm = rotate((held[0] - start[0] - args.wrap * psi, held[1] - start[1]), psi)
         return (touch[0] + arm[0], touch[1] + arm[1]), -math.pi / 2 + psi
 
     for a in angles:
