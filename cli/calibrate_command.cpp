@@ -230,6 +230,7 @@ void addCellOptions(CLI::App* command, CalibrateOptions& options) {
   command->add_option("--scene", options.scene, "scene file (default sim/scenes/assembly.json)")
       ->check(CLI::ExistingFile);
   command->add_option("--seed", options.seed, "seed of the cell (placement, noise, the camera's move)")
+      ->check(wholeNumber())
       ->each([&options](const std::string&) { options.seed_given = true; });
   command->add_option("--camera-move", options.camera_move,
                       "simulation: the camera moved from its drawn mounting, DISTANCE_M,ANGLE_DEG in a seeded random "
@@ -279,7 +280,9 @@ void addCalibrateCommand(CLI::App& app, int& exit_code) {
   eval->add_option("--setups", eval_options->eval.setups, "number of set-ups")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
-  eval->add_option("--seed", eval_options->eval.seed, "seed of the first set-up")->capture_default_str();
+  eval->add_option("--seed", eval_options->eval.seed, "seed of the first set-up")
+      ->check(wholeNumber())
+      ->capture_default_str();
   eval->add_option("--camera-move", eval_options->camera_move, "DISTANCE_M,ANGLE_DEG")->capture_default_str();
   eval->add_option("--methods", eval_options->methods,
                    "comma-separated hand-eye methods to run the marker calibration with in each set-up (default: "

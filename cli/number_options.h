@@ -7,7 +7,9 @@
 #include <CLI/CLI.hpp>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -56,6 +58,23 @@ inline CLI::Validator numberIn(double low, double high, bool low_open = false, c
         return {};
       },
       "NUMBER " + description);
+}
+
+/// A validator for a whole number from 0 to the largest `Unsigned` (a seed): CLI11 would read
+/// "-1" as the largest and let 2^64 wrap around.
+template <typename Unsigned = std::uint64_t>
+CLI::Validator wholeNumber() {
+  const std::string description = "a whole number from 0 to " + std::to_string(std::numeric_limits<Unsigned>::max());
+  return CLI::Validator(
+      [description](std::string& text) -> std::string {
+        Unsigned value = 0;
+        const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+        if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
+          return "must be " + description + ", not " + typed(text);
+        }
+        return {};
+      },
+      "SEED");
 }
 
 /// --camera-move "DISTANCE_M,ANGLE_DEG" (or "DISTANCE_M": no turn), from 0 to 0.5 m and 45 degrees.

@@ -291,6 +291,7 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::Range(1, 60));
   collect_command->add_option("--seed", collect_options->seed, "seed of the placements and sensor noise")
+      ->check(wholeNumber())
       ->capture_default_str();
   collect_command->callback([collect_options, &exit_code] { exit_code = collect(*collect_options); });
 
@@ -316,6 +317,7 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
                    "examples per label used (random subset; 0: all)")
       ->capture_default_str();
   train_command->add_option("--seed", train_options->svm.seed, "seed of the subset and the folds")
+      ->check(wholeNumber<unsigned>())
       ->capture_default_str();
   train_command->callback([train_options, &exit_code] { exit_code = train(*train_options); });
 
@@ -330,6 +332,7 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::Range(1, 100000));
   eval_command->add_option("--seed", eval_options->eval.seed, "seed of the scenes, pushes and sensor noise")
+      ->check(wholeNumber())
       ->capture_default_str();
   eval_command->add_option("--json", eval_options->json, "write the summary as JSON to this file");
   eval_command->add_option("--out", eval_options->eval.pictures,
@@ -368,7 +371,8 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
   detect_command->add_option("scene", detect_options->scene, "scene file (e.g. sim/scenes/assembly.json)")
       ->required()
       ->check(CLI::ExistingFile);
-  detect_command->add_option("--seed", detect_options->seed, "seed of the part placement and the sensor noise");
+  detect_command->add_option("--seed", detect_options->seed, "seed of the part placement and the sensor noise")
+      ->check(wholeNumber());
   detect_command->add_option("--out", detect_options->out, "write the picture to this PNG file");
   detect_command->add_option("--frames", detect_options->frames, "frames per DetectObjects (median filter's N)")
       ->capture_default_str()

@@ -88,7 +88,8 @@ void addWorkcellOptions(CLI::App* command, workcell::WorkcellOptions& options) {
   command->add_option("-w,--workcell", options.name, "workcell to run on: " + known)->capture_default_str();
   command->add_option("--scene", options.scene, "simulated workcells: scene file (default sim/scenes/assembly.json)")
       ->check(CLI::ExistingFile);
-  command->add_option("--seed", options.seed, "simulated workcells: seed of part placement and sensor noise");
+  command->add_option("--seed", options.seed, "simulated workcells: seed of part placement and sensor noise")
+      ->check(wholeNumber());
   command->add_option("--waypoints", options.waypoints,
                       "waypoint file (default " + workcell::defaultWaypointFile("<workcell>").string() + ")");
 }

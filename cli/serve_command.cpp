@@ -17,7 +17,8 @@ void addServeCommand(CLI::App& app, int& exit_code) {
   }
   serve->add_option("-w,--workcell", options->workcell.name, "workcell to run on: " + known)->capture_default_str();
   serve->add_option("--scene", options->workcell.scene, "simulated workcells: scene file")->check(CLI::ExistingFile);
-  serve->add_option("--seed", options->workcell.seed, "simulated workcells: seed of part placement and sensor noise");
+  serve->add_option("--seed", options->workcell.seed, "simulated workcells: seed of part placement and sensor noise")
+      ->check(wholeNumber());
   serve->add_option("--waypoints", options->workcell.waypoints,
                     "waypoint file (default " + workcell::defaultWaypointFile("<workcell>").string() + ")");
   serve

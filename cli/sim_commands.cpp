@@ -170,6 +170,7 @@ void addSimCommands(CLI::App& app, int& exit_code) {
   snap->add_option("--width", options->width, "image width (at most 1280)")->check(CLI::Range(16, 1280));
   snap->add_option("--height", options->height, "image height (at most 960)")->check(CLI::Range(16, 960));
   snap->add_option("--seed", options->seed, "placement seed (default: the scene's)")
+      ->check(wholeNumber())
       ->each([options](const std::string&) { options->seed_given = true; });
   snap->add_option("-w,--workcell", options->workcell,
                    "the simulated cell (workcells/NAME.json; default: the UR5 on its own, or ur5-sim with --plan)");

@@ -211,6 +211,7 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   command->add_option("--seed", options->trials.seed, "seed of the first trial (trial i: seed + i)")
+      ->check(wholeNumber())
       ->capture_default_str();
   command->add_option("-j,--jobs", options->trials.jobs, "trials run at once")
       ->check(CLI::Range(1, 64))

@@ -94,7 +94,9 @@ std::string faultGrammar() {
 }
 
 FaultSpec parseFault(std::string_view text) {
-  const std::string quoted = "fault '" + std::string(text) + "'";
+  // The spec as typed, cut to 60 characters: a message never repeats 400 digits.
+  const std::string quoted =
+      "fault '" + (text.size() <= 60 ? std::string(text) : std::string(text.substr(0, 57)) + "...") + "'";
   const auto fail = [&quoted](const std::string& problem) -> FaultSpecError {
     return FaultSpecError(quoted + ": " + problem + " (expected " + faultGrammar() + ")");
   };

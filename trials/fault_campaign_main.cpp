@@ -39,7 +39,9 @@ int main(int argc, char** argv) {
   std::string json;
   CLI::App app("Runs the paper's three plans with one injected fault each and judges every run");
   app.add_option("-n,--n", options.count, "runs (faults)")->check(CLI::Range(1, 1000000))->capture_default_str();
-  app.add_option("--seed", options.seed, "seed of the first run (run i: seed + i)")->capture_default_str();
+  app.add_option("--seed", options.seed, "seed of the first run (run i: seed + i)")
+      ->check(costar::cli::wholeNumber())
+      ->capture_default_str();
   app.add_option("-j,--jobs", options.jobs, "runs at once")->check(CLI::Range(1, 64))->capture_default_str();
   app.add_option("--window", options.window_s, "timed faults: moment in [0, WINDOW) simulated s")
       ->check(costar::cli::numberIn(0.0, costar::kMaxDurationSeconds, true, " s"))

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 
+#include "core/files.h"
 #include "trials/trials.h"
 
 namespace costar::trials {
@@ -126,12 +128,21 @@ void writePlot(const Summary& summary, const std::filesystem::path& png) {
     text(cr, left + 20, top + height / 2, "no successful trial", 14);
   }
 
-  const cairo_status_t status = cairo_surface_write_to_png(surface, png.c_str());
+  // Encoded in memory, then written checked (core/files.h): a full disk is named as such.
+  std::string encoded;
+  const cairo_status_t status = cairo_surface_write_to_png_stream(
+      surface,
+      [](void* closure, const unsigned char* data, unsigned int length) {
+        static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
+        return CAIRO_STATUS_SUCCESS;
+      },
+      &encoded);
   cairo_destroy(cr);
   cairo_surface_destroy(surface);
   if (status != CAIRO_STATUS_SUCCESS) {
     throw std::runtime_error("cannot write plot '" + png.string() + "': " + cairo_status_to_string(status));
   }
+  writeOutputFile(png, encoded);
 }
 
 }  // namespace costar::trials

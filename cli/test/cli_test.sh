@@ -99,6 +99,10 @@ for bad in nan inf -1 1e10 5junk; do
   check "run --time-limit $bad" 2 "--time-limit: must be a number from 0 s and at most 1e\+09, not $bad" \
     -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit "$bad"
 done
+for bad in -1 18446744073709551616 1.5; do
+  check "run --seed $bad" 2 "--seed: must be a whole number from 0 to 18446744073709551615, not $bad" \
+    -- "$costar" run examples/test_workcell/demo.xml -w test --seed "$bad"
+done
 check "run --rate nan"        2 "--rate: must be a number from 0.1 Hz and at most 10000, not nan" \
   -- "$costar" run examples/test_workcell/demo.xml -w test --rate nan
 check "inject at t=1e10s"     2 "fault 'nan:arm-driver@t=1e10s': t= needs a time in seconds from 0 to 1e9" \

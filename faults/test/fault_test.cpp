@@ -63,6 +63,13 @@ TEST(FaultSpec, AMomentBeyondTheClocksRangeIsRefused) {
   }
   expectError("die:arm@random=1e10s", "random= needs a window in seconds above 0 and at most 1e9");
   EXPECT_EQ(parseFault("nan:arm-driver@t=1e9s").when.seconds, 1e9);
+  try {
+    parseFault("nan:arm-driver@t=" + std::string(400, '9'));
+    ADD_FAILURE() << "400 digits accepted";
+  } catch (const FaultSpecError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("fault 'nan:arm-driver@t=" + std::string(40, '9') + "...': t= needs", 0), 0u)
+        << e.what();
+  }
 }
 
 }  // namespace

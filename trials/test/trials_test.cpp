@@ -143,6 +143,13 @@ TEST(Trials, OutputFilesAreCheckedBeforehandAndWrittenAfterwards) {
   EXPECT_TRUE(std::filesystem::is_character_file("/dev/null"));
   EXPECT_THROW(writeJson(summary, folder / "missing" / "results.json"), std::runtime_error);
   EXPECT_THROW(writePlot(summary, folder / "missing" / "plot.png"), std::runtime_error);
+  // Issue 27: a full disk was "error while writing to output stream"; every output names the system's words.
+  try {
+    writePlot(summary, "/dev/full");
+    ADD_FAILURE() << "a plot on a full disk";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "cannot write '/dev/full': No space left on device");
+  }
   std::filesystem::remove_all(folder);
 }
 
