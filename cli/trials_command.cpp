@@ -1,8 +1,10 @@
 #include "cli/trials_command.h"
 
+#include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <iostream>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -87,6 +89,10 @@ void checkOutputs(const Options& options) {
   }
   if (!options.plot.empty()) {
     checkOutputFile(options.plot, "--plot");
+  }
+  if (!options.trials.trace_dir.empty()) {  // the first trial's file in it: each trial writes one
+    const std::uint64_t first = options.trials.seed + static_cast<std::uint64_t>(options.trials.shard_index);
+    checkOutputFile(options.trials.trace_dir / ("trial_" + std::to_string(first) + ".jsonl"), "--trace");
   }
 }
 

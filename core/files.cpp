@@ -44,6 +44,17 @@ void closeKeepingErrno(int fd) {
   errno = error;
 }
 
+/// open(2) for writing that never waits: a pipe with no reader is an error (ENXIO, "No such
+/// device or address") instead of blocking the program before it starts. The descriptor is made
+/// blocking again, so that writes wait for a slow reader rather than fail.
+int openForWriting(const std::filesystem::path& path, int flags) {
+  const int fd = ::open(path.c_str(), flags | O_NONBLOCK, 0644);
+  if (fd >= 0) {
+    ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+  }
+  return fd;
+}
+
 std::string sizeText(std::uintmax_t bytes) {
   return bytes >= (1U << 20) ? std::to_string(bytes >> 20) + " MiB" : std::to_string(bytes) + " bytes";
 }
@@ -97,7 +108,7 @@ void writeOutputFile(const std::filesystem::path& path, std::string_view content
   if (S_ISDIR(info.st_mode)) {
     throw std::runtime_error("cannot write '" + path.string() + "': it is a folder");
   }
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  const int fd = openForWriting(path, O_WRONLY | O_CLOEXEC);
   if (fd < 0) {
     fail("cannot write", path);
   }
@@ -134,7 +145,7 @@ void checkOutputFile(const std::filesystem::path& file, const std::string& what)
 
 AppendingFile::AppendingFile(std::filesystem::path path, Mode mode) : path_(std::move(path)) {
   const int flags = O_WRONLY | O_CREAT | O_CLOEXEC | (mode == Mode::kAppend ? O_APPEND : O_TRUNC);
-  fd_ = ::open(path_.c_str(), flags, 0644);
+  fd_ = openForWriting(path_, flags);
   if (fd_ < 0) {
     fail("cannot write", path_);
   }

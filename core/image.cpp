@@ -2,47 +2,40 @@
 
 #include <png.h>
 
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-#include <memory>
 #include <stdexcept>
 #include <string>
 
+#include "core/files.h"
+
 namespace costar {
-
-namespace {
-
-struct FileCloser {
-  void operator()(std::FILE* file) const { std::fclose(file); }
-};
-
-}  // namespace
 
 void writePng(const std::filesystem::path& path, const RgbImage& image) {
   if (image.width <= 0 || image.height <= 0 ||
       image.pixels.size() != static_cast<std::size_t>(image.width) * image.height * 3) {
     throw std::runtime_error("cannot write '" + path.string() + "': the image is empty or inconsistent");
   }
-  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "wb"));
-  if (!file) {
-    throw std::runtime_error("cannot write '" + path.string() + "': " + std::strerror(errno));
-  }
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  // Encoded in memory, then written checked (writeOutputFile): a full disk, a missing folder or
+  // a pipe nobody reads is named as such, and a regular file is replaced whole. libpng's errors
+  // come back through setjmp below; its own handler would print "libpng error: ..." as well.
+  png_structp png = png_create_write_struct(
+      PNG_LIBPNG_VER_STRING, nullptr, [](png_structp failed, png_const_charp) { png_longjmp(failed, 1); },
+      [](png_structp, png_const_charp) {});
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (png == nullptr || info == nullptr) {
     png_destroy_write_struct(&png, &info);
     throw std::runtime_error("libpng could not start writing '" + path.string() + "'");
   }
-  errno = 0;
+  std::string encoded;
   if (setjmp(png_jmpbuf(png))) {
-    // libpng stops at a failed fwrite ("Write Error"): errno says why.
-    const int error = errno;
     png_destroy_write_struct(&png, &info);
-    throw std::runtime_error("cannot write '" + path.string() +
-                             "': " + (error != 0 ? std::strerror(error) : "libpng failed"));
+    throw std::runtime_error("cannot write '" + path.string() + "': libpng could not encode the image");
   }
-  png_init_io(png, file.get());
+  png_set_write_fn(
+      png, &encoded,
+      [](png_structp writer, png_bytep data, png_size_t length) {
+        static_cast<std::string*>(png_get_io_ptr(writer))->append(reinterpret_cast<const char*>(data), length);
+      },
+      nullptr);
   png_set_IHDR(png, info, static_cast<png_uint_32>(image.width), static_cast<png_uint_32>(image.height), 8,
                PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
@@ -51,12 +44,7 @@ void writePng(const std::filesystem::path& path, const RgbImage& image) {
   }
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
-  // The stream's buffer holds the end of the image: a full disk shows only when it is written.
-  const bool flushed = std::fflush(file.get()) == 0 && std::ferror(file.get()) == 0;
-  const int error = errno;
-  if (std::fclose(file.release()) != 0 || !flushed) {
-    throw std::runtime_error("cannot write '" + path.string() + "': " + std::strerror(flushed ? errno : error));
-  }
+  writeOutputFile(path, encoded);
 }
 
 RgbImage readPng(const std::filesystem::path& path) {

@@ -127,6 +127,12 @@ check "run --trace /dev/full" 2 "^error: cannot write '/dev/full': No space left
   -- "$costar" run examples/test_workcell/demo.xml -w test -q --trace /dev/full
 check "run --trace in a missing folder" 2 "^error: cannot write '$tmp/no/t.jsonl': No such file or directory" \
   -- "$costar" run examples/test_workcell/demo.xml -w test -q --trace "$tmp/no/t.jsonl"
+mkfifo "$tmp/nobody_reads"
+check "run --trace to a pipe nobody reads" 2 "^error: cannot write '$tmp/nobody_reads': No such device or address" \
+  -- timeout 20 "$costar" run examples/test_workcell/demo.xml -w test -q --trace "$tmp/nobody_reads"
+check "nodes -o a pipe nobody reads" 2 "^error: cannot write '$tmp/nobody_reads': No such device or address" \
+  -- timeout 20 "$costar" nodes -w test -o "$tmp/nobody_reads"
+rm "$tmp/nobody_reads"
 check "calibrate --json in a missing folder" 2 "^error: cannot write --json '$tmp/no/c.json': there is no folder" \
   -- "$costar" calibrate --json "$tmp/no/c.json"
 check "calibrate --calibration in a missing folder" 2 \
@@ -137,6 +143,11 @@ check "perception eval --json /dev/full is written to" 2 "error: cannot write --
 check "sim snapshot to /dev/full" 2 "cannot write '/dev/full': No space left on device" \
   -- "$costar" sim snapshot sim/scenes/one_node.json --out /dev/full --width 16 --height 16
 claims_nothing "sim snapshot to /dev/full"
+if grep -q 'libpng' "$tmp/out"; then echo "FAIL sim snapshot to /dev/full: libpng's own message"; failures=$((failures + 1)); fi
+mkfifo "$tmp/nobody_reads"
+check "sim snapshot to a pipe nobody reads" 2 "cannot write '$tmp/nobody_reads': No such device or address" \
+  -- timeout 20 "$costar" sim snapshot sim/scenes/one_node.json --out "$tmp/nobody_reads" --width 16 --height 16
+rm "$tmp/nobody_reads"
 check "sim snapshot after a plan in a cell" 0 \
   '^wire: 2[45][0-9]\.[0-9] mm out of the clamp, E 1[12][0-9] GPa, yield strength [6-9][0-9] MPa; bends -?0\.[0-9] \(drawing 90, .*held 0, let go 0, pulled out 0 times' \
   -- "$costar" sim snapshot sim/scenes/wire_bending.json -w iiwa-3f-sim --plan cli/test/fixtures/pinch_open.xml \
@@ -195,6 +206,10 @@ check "trials --json to a folder" 2 "error: cannot write --json '$tmp': it is a 
 no_trial "trials --json to a folder"
 check "trials --json in a missing folder" 2 "error: cannot write --json '$tmp/no/r.json': there is no folder '$tmp/no'" \
   -- "$costar" "${trials[@]}" --json "$tmp/no/r.json"
+mkdir -p "$tmp/blocked/trial_1.jsonl"
+check "trials --trace where the first trial's file is a folder" 2 \
+  "error: cannot write --trace '$tmp/blocked/trial_1.jsonl': it is a folder" -- "$costar" "${trials[@]}" --trace "$tmp/blocked"
+no_trial "trials --trace where the first trial's file is a folder"
 printf '{"parts": [{"class": "node", "count": 4294967297}]}\n' >"$tmp/count.json"
 check "trials: scene count out of range" 2 \
   "error: scene '$tmp/count.json': parts\[0\]\.count: must be a whole number from 1 to 100, not 4294967297" \

@@ -89,6 +89,15 @@ TEST_F(FilesTest, AppendingToAFullDeviceIsAnError) {
   EXPECT_EQ(error([&] { out.append("line\n"); }), "cannot write '/dev/full': No space left on device");
 }
 
+TEST_F(FilesTest, WritingToAPipeNobodyReadsIsAnErrorNotAWaitForever) {
+  const std::filesystem::path pipe = folder_ / "pipe";
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  EXPECT_EQ(error([&] { writeOutputFile(pipe, "{}"); }),
+            "cannot write '" + pipe.string() + "': No such device or address");
+  EXPECT_EQ(error([&] { AppendingFile out(pipe, AppendingFile::Mode::kTruncate); }),
+            "cannot write '" + pipe.string() + "': No such device or address");
+}
+
 TEST_F(FilesTest, ReadingADeviceAPipeOrAFolderIsRefusedAtOnce) {
   EXPECT_EQ(error([] { readFile("/dev/zero"); }),
             "cannot read '/dev/zero': not a regular file (a device, pipe or socket)");

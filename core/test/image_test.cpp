@@ -1,8 +1,10 @@
 #include "core/image.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <filesystem>
+#include <string>
 
 namespace costar {
 namespace {
@@ -45,6 +47,21 @@ TEST(Png, APictureOnAFullDiskIsAnErrorNotAFileWritten) {
       EXPECT_EQ(std::string(e.what()), "cannot write '/dev/full': No space left on device") << size << " px";
     }
   }
+}
+
+// Found by scripts/hostile_cli.sh: `sim snapshot --out FIFO` waited forever for a reader.
+TEST(Png, APictureToAPipeNobodyReadsIsAnErrorNotAWaitForever) {
+  const auto pipe = std::filesystem::temp_directory_path() /
+                    ("costar_image_test_pipe_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  std::filesystem::remove(pipe);
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  try {
+    writePng(pipe, RgbImage(2, 2));
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "cannot write '" + pipe.string() + "': No such device or address");
+  }
+  std::filesystem::remove(pipe);
 }
 
 }  // namespace
