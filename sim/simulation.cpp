@@ -429,6 +429,11 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   impl->arm_joint_names = robot.joint_names;
   impl->arm_joints = robot.jointCount();
   for (int i = 0; i < impl->arm_joints; ++i) {
+    if (mj_name2id(m, mjOBJ_JOINT, robot.joint_names[i].c_str()) < 0) {  // a description edited by hand
+      throw std::runtime_error("robot description '" + robot.file.string() + "': joints[" + std::to_string(i) +
+                               "]: the simulator's model '" + robot.mjcf.string() + "' has no joint '" +
+                               robot.joint_names[i] + "'");
+    }
     const int joint = impl->id(mjOBJ_JOINT, robot.joint_names[i].c_str());
     impl->arm_qpos[i] = m->jnt_qposadr[joint];
     impl->arm_dof[i] = m->jnt_dofadr[joint];

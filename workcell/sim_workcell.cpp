@@ -1,8 +1,15 @@
 #include "workcell/sim_workcell.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <numbers>
+#include <string>
+#include <vector>
 
 #include "arm/arm_component.h"
 #include "arm/motion_planner.h"
@@ -77,6 +84,92 @@ planning::RobotModel planningModel(const arm::RobotDescription& robot, const Gri
                                         robot.urdf_base_link, gripper.tcp_link);
 }
 
+/// `file` relative to the data root when under it (as typed in the repository), else whole.
+std::string relativeToDataRoot(const std::filesystem::path& file) {
+  std::error_code error;
+  const std::filesystem::path relative = std::filesystem::relative(file, dataRoot(), error);
+  return !error && !relative.empty() && *relative.begin() != ".." ? relative.string() : file.string();
+}
+
+/// A number in a message: 4 significant digits.
+std::string shortNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", value);
+  return text;
+}
+
+std::string joinNames(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) {
+    text += (text.empty() ? "'" : ", '") + name + "'";
+  }
+  return "[" + text + "]";
+}
+
+/// Checks that the robot description's kinematics and limits are those of the model the planner
+/// and the simulator use (the arm's URDF with the gripper's on its flange): an edited
+/// description would otherwise be applied in part (the IK solves for the edited arm, the
+/// simulator and the collision checks move the model's). The generated models carry the
+/// fingerprint of their description (arm/robot_description.h); a description beside hand-made
+/// models (the UR5's) has only this check. Forward kinematics are compared at the home
+/// configuration and at 8 fixed ones spread over the limits.
+/// @throws std::runtime_error naming the description, the model and the difference.
+void checkDescriptionMatchesModel(const arm::RobotDescription& robot, const arm::Kinematics& kinematics,
+                                  const world::Pose& tcp_in_flange, const planning::RobotModel& model) {
+  const std::string file = relativeToDataRoot(robot.file);
+  const std::string urdf = relativeToDataRoot(robot.urdf);
+  const auto fail = [&](const std::string& problem) {
+    throw std::runtime_error("robot description '" + file + "' does not match its model '" + urdf + "': " + problem +
+                             " (was either edited?)");
+  };
+  if (model.jointNames() != robot.joint_names) {
+    fail("the joints are " + joinNames(model.jointNames()) + " in the model, " + joinNames(robot.joint_names) +
+         " in the description");
+  }
+  const arm::JointLimits& limits = robot.limits;
+  constexpr double kTolerance = 1e-6;
+  for (int j = 0; j < robot.jointCount(); ++j) {
+    const std::string joint = "joint " + std::to_string(j + 1) + " ('" + robot.joint_names[j] + "')";
+    if (limits.min_position[j] < model.lowerLimits()[j] - kTolerance ||
+        limits.max_position[j] > model.upperLimits()[j] + kTolerance) {
+      fail(joint + " turns through [" + shortNumber(limits.min_position[j]) + ", " +
+           shortNumber(limits.max_position[j]) + "] rad, beyond the model's [" + shortNumber(model.lowerLimits()[j]) +
+           ", " + shortNumber(model.upperLimits()[j]) + "]");
+    }
+    if (limits.max_velocity[j] > model.velocityLimits()[j] + kTolerance) {
+      fail(joint + " is allowed " + shortNumber(limits.max_velocity[j]) + " rad/s, the model " +
+           shortNumber(model.velocityLimits()[j]));
+    }
+  }
+  std::vector<arm::JointVector> configurations{robot.home};
+  for (int k = 1; k <= 8; ++k) {
+    arm::JointVector q(robot.jointCount());
+    for (int j = 0; j < robot.jointCount(); ++j) {
+      const double low = std::max(limits.min_position[j], -std::numbers::pi);
+      const double high = std::min(limits.max_position[j], std::numbers::pi);
+      const double fraction = std::fmod(0.618034 * k + 0.414214 * j, 1.0);  // spread, not random
+      q[j] = low + fraction * (high - low);
+    }
+    configurations.push_back(q);
+  }
+  for (const arm::JointVector& q : configurations) {
+    const world::Pose described = kinematics.forward(q) * tcp_in_flange;
+    const world::Pose modelled = model.forward(q.eigen());
+    const double apart = (described.translation() - modelled.translation()).norm();
+    const double turned = world::rotationAngle(described, modelled);
+    if (apart > 1e-4 || turned > 1e-4) {
+      std::string joints;
+      for (int j = 0; j < q.size(); ++j) {
+        joints += (j == 0 ? "" : ", ") + shortNumber(q[j]);
+      }
+      char difference[64];
+      std::snprintf(difference, sizeof difference, "%.1f mm and %.2f degrees", apart * 1000.0,
+                    turned * 180.0 / std::numbers::pi);
+      fail("at joints [" + joints + "] rad the tool is " + difference + " apart");
+    }
+  }
+}
+
 /// The gripper's links that may touch a part being grasped, after the robot's, each once.
 std::vector<std::string> gripperLinks(const arm::RobotDescription& robot, const GripperModel& gripper) {
   std::vector<std::string> links = robot.gripper_links;
@@ -146,6 +239,7 @@ class SimWorkcell final : public Workcell {
     arm_config.joint_names = robot_description_.joint_names;
     arm_config.joint_labels = robot_description_.joint_labels;
     const std::shared_ptr<const arm::Kinematics> kinematics = arm::makeKinematics(robot_description_);
+    checkDescriptionMatchesModel(robot_description_, *kinematics, arm_config.tcp_in_flange, robot_);
     auto arm = std::make_shared<arm::ArmComponent>(
         arm_driver, clock(), collisions_, waypoints_,
         [this](const std::string& frame) { return components().world().worldPose(frame); }, kinematics, arm_config);

@@ -4,7 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <random>
+#include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "bt/builder.h"
 #include "bt/executor.h"
@@ -137,6 +144,75 @@ TEST(Ur5SimWorkcell, StoppingARunDeceleratesTheArmToRest) {
     speed = std::max(speed, std::abs(v));
   }
   EXPECT_LT(speed, 0.01);  // ... and at rest soon after
+}
+
+// Issue 27: the UR5's description sits beside hand-made models; an edit of it was applied in part
+// (the IK solved for the edited arm, the simulator moved the model's). The cell is refused,
+// naming both files and the difference, until they agree again.
+class EditedUr5Description : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = std::filesystem::temp_directory_path() /
+              ("costar_edited_ur5_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+               ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(folder_);
+    for (const char* folder : {"data", "sim", "robots", "workcells"}) {
+      std::filesystem::copy(dataRoot() / folder, folder_ / folder, std::filesystem::copy_options::recursive);
+    }
+    std::ifstream in(folder_ / "robots/ur5/ur5.json");
+    description_ = nlohmann::json::parse(in);
+    ::setenv("COSTAR_DATA_DIR", folder_.c_str(), 1);
+  }
+  void TearDown() override {
+    ::unsetenv("COSTAR_DATA_DIR");
+    std::filesystem::remove_all(folder_);
+  }
+
+  /// The error making the ur5-sim cell with `description` as robots/ur5/ur5.json.
+  std::string problem(const nlohmann::json& description) {
+    std::ofstream(folder_ / "robots/ur5/ur5.json") << description.dump(2);
+    try {
+      makeWorkcell({.name = "ur5-sim", .memory_only = true});
+    } catch (const std::exception& e) {
+      return e.what();
+    }
+    return "no error";
+  }
+
+  std::filesystem::path folder_;
+  nlohmann::json description_;
+};
+
+TEST_F(EditedUr5Description, ADescriptionThatIsNotItsModelIsRefusedNamingBoth) {
+  EXPECT_EQ(problem(description_), "no error");
+  const std::string prefix =
+      "robot description 'robots/ur5/ur5.json' does not match its model 'sim/models/ur5_arm.urdf': ";
+  nlohmann::json edited = description_;
+  edited["kinematics"]["d"][0] = 0.2;  // the shoulder 11 cm higher than the model's
+  EXPECT_EQ(problem(edited), prefix +
+                                 "at joints [0, -2.3, 1.9, -1.171, -1.571, 0] rad the tool is 110.8 mm and "
+                                 "0.00 degrees apart (was either edited?)");
+  edited = description_;
+  edited["joints"][2]["max_velocity"] = 4.0;
+  EXPECT_EQ(problem(edited),
+            prefix + "joint 3 ('elbow_joint') is allowed 4 rad/s, the model 3.142 (was either edited?)");
+  edited = description_;
+  edited["joints"][0]["name"] = "base_joint";
+  EXPECT_EQ(problem(edited), "robot description '" + (folder_ / "robots/ur5/ur5.json").string() +
+                                 "': joints[0]: the simulator's model '" +
+                                 (folder_ / "sim/models/ur5_arm.xml").string() + "' has no joint 'base_joint'");
+  // The planner's model edited instead: its joints are named.
+  const auto urdf = folder_ / "sim/models/ur5_arm.urdf";
+  std::ifstream in(urdf);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("\"elbow_joint\""), 13, "\"elbow\"");
+  std::ofstream(urdf) << text;
+  EXPECT_EQ(problem(description_),
+            prefix +
+                "the joints are ['shoulder_pan_joint', 'shoulder_lift_joint', 'elbow', 'wrist_1_joint', "
+                "'wrist_2_joint', 'wrist_3_joint'] in the model, ['shoulder_pan_joint', 'shoulder_lift_joint', "
+                "'elbow_joint', 'wrist_1_joint', 'wrist_2_joint', 'wrist_3_joint'] in the description "
+                "(was either edited?)");
 }
 
 }  // namespace
