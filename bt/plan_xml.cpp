@@ -12,6 +12,7 @@
 #include "bt/registry.h"
 #include "bt/xml_writer.h"
 #include "core/files.h"
+#include "core/text.h"
 
 namespace costar::bt {
 
@@ -32,31 +33,6 @@ constexpr int kMaxElementDepth = 500;
 const char* leadingText(const pugi::xml_node& element) {
   const pugi::xml_node first = element.first_child();
   return first.type() == pugi::node_pcdata || first.type() == pugi::node_cdata ? first.value() : nullptr;
-}
-
-/// The length of the UTF-8 character `text` starts with, or 0 when its first bytes are not one
-/// (RFC 3629: no overlong forms, no UTF-16 surrogates, nothing above U+10FFFF).
-std::size_t utf8Length(std::string_view text) {
-  const auto byte = [&text](std::size_t i) { return i < text.size() ? static_cast<unsigned char>(text[i]) : 0u; };
-  const auto in = [](unsigned value, unsigned low, unsigned high) { return value >= low && value <= high; };
-  const unsigned first = byte(0);
-  if (first < 0x80) {
-    return 1;
-  }
-  if (in(first, 0xC2, 0xDF)) {
-    return in(byte(1), 0x80, 0xBF) ? 2 : 0;
-  }
-  if (in(first, 0xE0, 0xEF)) {
-    const unsigned low = first == 0xE0 ? 0xA0 : 0x80;
-    const unsigned high = first == 0xED ? 0x9F : 0xBF;  // ED A0..BF: surrogates
-    return in(byte(1), low, high) && in(byte(2), 0x80, 0xBF) ? 3 : 0;
-  }
-  if (in(first, 0xF0, 0xF4)) {
-    const unsigned low = first == 0xF0 ? 0x90 : 0x80;
-    const unsigned high = first == 0xF4 ? 0x8F : 0xBF;  // F4 90 and above: beyond U+10FFFF
-    return in(byte(1), low, high) && in(byte(2), 0x80, 0xBF) && in(byte(3), 0x80, 0xBF) ? 4 : 0;
-  }
-  return 0;
 }
 
 /// The characters XML 1.0 allows (its production Char).

@@ -11,6 +11,7 @@
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
 #include "core/image.h"
+#include "core/text.h"
 #include "sim/simulation.h"
 #include "workcell/workcell.h"
 
@@ -142,6 +143,13 @@ bool handle(workcell::Workcell& cell, const std::string& line) {
   if (w.empty() || w[0].starts_with("#")) {
     return true;
   }
+  // Names end up in the waypoint file (JSON, UTF-8): say so here, not as an error in the plan
+  // the command becomes.
+  if (const auto bad = invalidUtf8At(line)) {
+    std::printf("error: the command is not UTF-8 text (byte %zu of the line, 0x%02X): names are UTF-8\n", *bad + 1,
+                static_cast<unsigned>(static_cast<unsigned char>(line[*bad])));
+    return true;
+  }
   const std::string& command = w[0];
   if (command == "quit" || command == "exit") {
     return false;
@@ -238,6 +246,13 @@ void addSmartMoveCommands(CLI::App& app, int& exit_code) {
   teach->add_option("--scene", options->scene, "simulated workcells: scene file")->check(CLI::ExistingFile);
   teach->add_option("--waypoints", options->waypoints, "waypoint file")->check(CLI::ExistingFile);
   teach->callback([=, &exit_code] {
+    for (const std::string* name : {object_class.get(), grasp.get(), at.get()}) {
+      if (invalidUtf8At(*name)) {  // it ends up in the grasp file (JSON, UTF-8)
+        std::cerr << "error: '" << *name << "' is not UTF-8 text: names are UTF-8\n";
+        exit_code = 2;
+        return;
+      }
+    }
     std::unique_ptr<workcell::Workcell> cell;
     try {
       cell = workcell::makeWorkcell(*options);

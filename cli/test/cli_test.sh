@@ -15,7 +15,7 @@ check() {  # check NAME EXPECTED_EXIT PATTERN -- COMMAND...
   if [[ $code -ne $expected ]]; then
     echo "FAIL $name: exit $code, expected $expected"; cat "$tmp/out"; failures=$((failures + 1)); return
   fi
-  if ! grep -qE -- "$pattern" "$tmp/out"; then
+  if ! grep -aqE -- "$pattern" "$tmp/out"; then
     echo "FAIL $name: output lacks /$pattern/"; cat "$tmp/out"; failures=$((failures + 1)); return
   fi
   echo "ok   $name"
@@ -167,6 +167,19 @@ if [[ $(grep -c '^ok' "$tmp/teach.out") -eq 5 ]] && grep -q "failed: unknown way
 else
   echo "FAIL teach"; cat "$tmp/teach.out"; failures=$((failures + 1))
 fi
+
+# Issue 27: a name that is not UTF-8 is refused where it is typed, the waypoint file untouched.
+printf 'teach a\xffb\nquit\n' |
+  "$costar" teach --scene sim/scenes/one_node.json --waypoints "$tmp/waypoints.json" >"$tmp/teach.out" 2>&1
+if grep -q "^error: the command is not UTF-8 text (byte 8 of the line, 0xFF): names are UTF-8" "$tmp/teach.out" &&
+   python3 -c 'import json, sys; assert [w["name"] for w in json.load(open(sys.argv[1]))["waypoints"]] == ["lifted"]' \
+     "$tmp/waypoints.json"; then
+  echo "ok   teach: a name that is not UTF-8"
+else
+  echo "FAIL teach: a name that is not UTF-8"; cat "$tmp/teach.out"; failures=$((failures + 1))
+fi
+check "smartmove teach: a name that is not UTF-8" 2 "p' is not UTF-8 text: names are UTF-8$" \
+  -- "$costar" smartmove teach node "to$(printf '\xff')p" --at lifted --waypoints "$tmp/waypoints.json"
 
 # The blind pick-and-place on the simulated UR5.
 check "blind pick and place" 0 '^SUCCESS in' -- "$costar" run examples/ur5/blind_pick_place.xml -q \
