@@ -12,8 +12,10 @@
 #include "cli/plan_commands.h"
 #include "cli/robot_binary.h"
 #include "cli/robot_commands.h"
+#include "cli/stop_signals.h"
 
 int main(int argc, char** argv) {
+  costar::cli::ignoreBrokenPipes();
   costar::cli::rememberCommandLine(argc, argv);
   CLI::App app{costar::cli::kAppDescription};
   app.set_version_flag("--version", costar::cli::kVersion);

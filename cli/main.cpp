@@ -10,10 +10,12 @@
 #include "cli/plan_commands.h"
 #include "cli/serve_command.h"
 #include "cli/sim_commands.h"
+#include "cli/stop_signals.h"
 #include "cli/teach_command.h"
 #include "cli/trials_command.h"
 
 int main(int argc, char** argv) {
+  costar::cli::ignoreBrokenPipes();
   CLI::App app{
       "costar: build task plans as behavior trees of robot operations (DetectObjects, SmartMove, Close "
       "gripper, ...) and run them on a workcell (CoSTAR, ICRA 2017)."};

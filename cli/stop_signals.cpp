@@ -17,6 +17,8 @@ void onStopSignal(int signal) {
 
 }  // namespace
 
+void ignoreBrokenPipes() { std::signal(SIGPIPE, SIG_IGN); }
+
 StopSignals::StopSignals() {
   g_stop.store(false);
   g_signal.store(0);
@@ -26,11 +28,13 @@ StopSignals::StopSignals() {
   action.sa_flags = SA_RESTART;
   sigaction(SIGINT, &action, &previous_int_);
   sigaction(SIGTERM, &action, &previous_term_);
+  sigaction(SIGHUP, &action, &previous_hup_);
 }
 
 StopSignals::~StopSignals() {
   sigaction(SIGINT, &previous_int_, nullptr);
   sigaction(SIGTERM, &previous_term_, nullptr);
+  sigaction(SIGHUP, &previous_hup_, nullptr);
 }
 
 const std::atomic<bool>& StopSignals::stopRequested() { return g_stop; }
@@ -43,6 +47,8 @@ std::string StopSignals::name(int signal) {
       return "SIGINT (Ctrl-C)";
     case SIGTERM:
       return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP (the terminal closed)";
     default:
       return "signal " + std::to_string(signal);
   }

@@ -5,6 +5,7 @@
 // 2 for a bad option or file, or an output that could not be written.
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
@@ -34,6 +35,9 @@ int summarize(const std::string& file) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A standard output nobody reads any more (| head) makes writes fail instead of ending the
+  // campaign before --json is written.
+  std::signal(SIGPIPE, SIG_IGN);
   costar::trials::CampaignOptions options;
   options.count = 1000;
   std::string json;

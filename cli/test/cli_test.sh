@@ -281,6 +281,18 @@ if [[ $code -eq 143 ]] && grep -q 'STOPPED by SIGTERM' "$tmp/out" && trace_ok "$
 else
   echo "FAIL sigterm: exit $code"; cat "$tmp/out"; failures=$((failures + 1))
 fi
+# SIGHUP (the terminal or the ssh session closed) stops it the same way; it ended the process.
+"$costar" run "$tmp/long.xml" -w none -q --trace "$tmp/hup.jsonl" >"$tmp/out" 2>&1 &
+pid=$!
+wait_for_trace "$tmp/hup.jsonl"
+kill -HUP $pid
+wait $pid
+code=$?
+if [[ $code -eq 129 ]] && grep -q 'STOPPED by SIGHUP (the terminal closed)' "$tmp/out" && trace_ok "$tmp/hup.jsonl" 1; then
+  echo "ok   sighup: exit 129, trace complete"
+else
+  echo "FAIL sighup: exit $code"; cat "$tmp/out"; failures=$((failures + 1))
+fi
 "$costar" run "$tmp/long.xml" -w none -q --trace "$tmp/kill.jsonl" >"$tmp/out" 2>&1 &
 pid=$!
 wait_for_trace "$tmp/kill.jsonl"
@@ -319,6 +331,15 @@ then
   echo "ok   trials: sigterm keeps the finished trials"
 else
   echo "FAIL trials: sigterm: exit $code"; cat "$tmp/out"; failures=$((failures + 1))
+fi
+# A standard output nobody reads any more (| head -1) no longer ends the batch before --json.
+"$costar" trials examples/ur5/blind_pick_place.xml --judge blind_place --scene sim/scenes/one_node.json \
+  --waypoints examples/ur5/blind_waypoints.json -n 3 --json "$tmp/piped.json" | head -1 >/dev/null
+code=${PIPESTATUS[0]}
+if [[ $code -eq 0 ]] && python3 -c 'import json, sys; assert len(json.load(open(sys.argv[1]))["results"]) == 3' "$tmp/piped.json"; then
+  echo "ok   trials | head -1: the batch finishes, --json written"
+else
+  echo "FAIL trials | head -1: exit $code"; failures=$((failures + 1))
 fi
 check "trials merge refuses an interrupted shard" 2 "are of an interrupted run" -- "$costar" trials merge "$tmp/int.json"
 
