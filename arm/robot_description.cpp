@@ -2,10 +2,14 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <set>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/files.h"
 #include "core/json_fields.h"
@@ -71,6 +75,27 @@ std::vector<double> numbers(const json& value, const std::string& field, std::si
     fail(field, "must be " + what + ", not " + shown(value));
   }
   return numbers(value, field);
+}
+
+/// The solver's parameters (kinematics.KEY: lists of lengths in m or angles in rad): finite, and
+/// at most 10 in size, as no arm is 10 m long (1e308 would reach the IK as inf).
+std::map<std::string, std::vector<double>> solverParameters(const json& kinematics) {
+  std::map<std::string, std::vector<double>> parameters;
+  for (const auto& [key, value] : kinematics.items()) {
+    if (key == "solver") {
+      continue;
+    }
+    const std::string field = "kinematics." + key;
+    std::vector<double> values = numbers(value, field);
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (std::abs(values[i]) > 10.0) {
+        fail(field + "[" + std::to_string(i) + "]",
+             "must be from -10 to 10 (m or rad: no arm is 10 m long), not " + shown(value[i]));
+      }
+    }
+    parameters[key] = std::move(values);
+  }
+  return parameters;
 }
 
 std::filesystem::path modelFile(const json& models, const std::string& key, const std::filesystem::path& root) {
@@ -165,11 +190,7 @@ RobotDescription parse(const json& root_object, const std::filesystem::path& dat
 
   const json& kinematics = objectAt(root_object, "", "kinematics");
   robot.solver = text(kinematics, "kinematics", "solver");
-  for (const auto& [key, value] : kinematics.items()) {
-    if (key != "solver") {
-      robot.solver_parameters[key] = numbers(value, "kinematics." + key);
-    }
-  }
+  robot.solver_parameters = solverParameters(kinematics);
 
   const json& models = objectAt(root_object, "", "models");
   onlyKnown(models, "models", {"mjcf", "urdf", "urdf_base_link", "urdf_tool_link"});
@@ -258,11 +279,7 @@ RobotDescription parseGenerated(const json& root_object) {
   robot.label = text(root_object, "", "label");
   const json& kinematics = objectAt(root_object, "", "kinematics");
   robot.solver = text(kinematics, "kinematics", "solver");
-  for (const auto& [key, value] : kinematics.items()) {
-    if (key != "solver") {
-      robot.solver_parameters[key] = numbers(value, "kinematics." + key);
-    }
-  }
+  robot.solver_parameters = solverParameters(kinematics);
   readJoints(root_object,
              {"lower_deg",
               "upper_deg",

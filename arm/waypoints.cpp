@@ -8,8 +8,10 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -73,6 +75,32 @@ std::vector<double> numbers(const json& value, const std::string& field, std::si
   return out;
 }
 
+/// Sizes no cell has (1e308 was read as a joint angle or a position): refused at load.
+constexpr double kMaxJointAngle = 4 * std::numbers::pi;
+constexpr double kMaxDistance = 10.0;
+
+/// "[I]: must be WHAT, not VALUE" for the first of `values` beyond `limit` in size; "" when none is.
+std::string rangeProblem(const double* values, std::size_t count, double limit, const std::string& what) {
+  for (std::size_t i = 0; i < count; ++i) {
+    if (!(std::abs(values[i]) <= limit)) {
+      char number[32];
+      std::snprintf(number, sizeof number, "%g", values[i]);
+      return "[" + std::to_string(i) + "]: must be " + what + ", not " + number;
+    }
+  }
+  return {};
+}
+
+constexpr const char* kJointRange = "an angle from -4 pi to 4 pi rad (two turns either way)";
+constexpr const char* kPositionRange = "from -10 to 10 m (no cell is larger)";
+
+void inRange(const std::vector<double>& values, const std::string& field, double limit, const std::string& what) {
+  if (const std::string problem = rangeProblem(values.data(), values.size(), limit, what); !problem.empty()) {
+    const std::size_t colon = problem.find(':');
+    fail(field + problem.substr(0, colon), problem.substr(colon + 2));
+  }
+}
+
 std::string stringField(const json& value, const std::string& field) {
   if (!value.is_string()) {
     fail(field, "must be a string, not " + shown(value));
@@ -115,6 +143,7 @@ Waypoint fromJson(const json& item, const std::string& field, int joint_count) {
       fail(field + ".joints", "must be " + expected + ", not " + shown(list));
     }
     const auto joints = numbers(list, field + ".joints", count, expected);
+    inRange(joints, field + ".joints", kMaxJointAngle, kJointRange);
     waypoint.joints = JointVector(static_cast<int>(joints.size()));
     std::copy(joints.begin(), joints.end(), waypoint.joints.begin());
     return waypoint;
@@ -133,6 +162,7 @@ Waypoint fromJson(const json& item, const std::string& field, int joint_count) {
     }
   }
   const auto p = numbers(item.at("position"), field + ".position", 3, "[x, y, z] (m)");
+  inRange(p, field + ".position", kMaxDistance, kPositionRange);
   const auto q = numbers(item.at("orientation"), field + ".orientation", 4, "a unit quaternion [w, x, y, z]");
   const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
   // A zero quaternion is no rotation at all (normalizing it gives nan); one far from unit
@@ -306,6 +336,16 @@ void WaypointStore::put(const Waypoint& waypoint) {
     throw std::invalid_argument("waypoint '" + waypoint.name + "' has " + std::to_string(waypoint.joints.size()) +
                                 " joint angles, the arm " +
                                 (joint_count_ > 0 ? std::to_string(joint_count_) : std::string("at least one")));
+  }
+  // What the file could not be read back with (a put of 1e308 would break it for every reader).
+  const std::string problem =
+      waypoint.kind == Waypoint::Kind::kJoints
+          ? rangeProblem(waypoint.joints.begin(), static_cast<std::size_t>(waypoint.joints.size()), kMaxJointAngle,
+                         kJointRange)
+          : rangeProblem(waypoint.pose.translation().data(), 3, kMaxDistance, kPositionRange);
+  if (!problem.empty()) {
+    throw std::invalid_argument("waypoint '" + waypoint.name +
+                                "': " + (waypoint.kind == Waypoint::Kind::kJoints ? "joints" : "position") + problem);
   }
   update([&waypoint](Map& waypoints) {
     waypoints[waypoint.name] = waypoint;

@@ -138,6 +138,10 @@ TEST_F(BadRobotFile, EachProblemNamesItsField) {
   j = good_;
   j["joints"] = json::array();
   EXPECT_EQ(problem(j), "joints: must be a list of 1 to 8 joints, not []");
+  // Issue 27 (found by scripts/hostile_cli.sh): 1e308 reached the closed form as a length.
+  j = good_;
+  j["kinematics"]["d"][0] = 1e308;
+  EXPECT_EQ(problem(j), "kinematics.d[0]: must be from -10 to 10 (m or rad: no arm is 10 m long), not 1e+308");
   EXPECT_EQ(problem(std::string("{\"name\": ")).rfind("not valid JSON: ", 0), 0u);
   EXPECT_EQ(problem(std::string("[1, 2]")),
             "(top level): must be an object {\"name\": ..., \"joints\": [...], ...}, not [1,2]");

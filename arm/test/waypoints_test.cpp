@@ -157,6 +157,28 @@ std::set<std::string> names(const WaypointStore& store) {
   return out;
 }
 
+// Issue 27 (found by scripts/hostile_cli.sh): a joint angle or a position of 1e308 was read.
+TEST_F(WaypointFile, SizesNoCellHasAreRefused) {
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "j", "joints": [0, 1e308, 0, 0, 0, 0]}]})"),
+            "waypoints[0].joints[1]: must be an angle from -4 pi to 4 pi rad (two turns either way), not 1e+308");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "j", "joints": [0, 0, 0, 0, 0, -13]}]})"),
+            "waypoints[0].joints[5]: must be an angle from -4 pi to 4 pi rad (two turns either way), not -13");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "j", "joints": [0, 0, 0, 0, 0, 12.5]}]})"), "no error");
+  EXPECT_EQ(problem(R"({"waypoints": [{"name": "p", "position": [0.4, -1e308, 0], "orientation": [1, 0, 0, 0]}]})"),
+            "waypoints[0].position[1]: must be from -10 to 10 m (no cell is larger), not -1e+308");
+  // Nor are they written, which would break the file for every reader.
+  WaypointStore store(folder_ / "written.json", /*persist=*/true, 6);
+  try {
+    store.put(joints("far", 1e308));
+    ADD_FAILURE() << "put 1e308";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(),
+                 "waypoint 'far': joints[0]: must be an angle from -4 pi to 4 pi rad (two turns either way), not "
+                 "1e+308");
+  }
+  EXPECT_FALSE(store.find("far").has_value());
+}
+
 // Issue 27: the editor's server and `costar teach` each kept the whole file in memory and wrote
 // it back whole, so each deleted what the other had taught, and a reader kept offering a
 // waypoint no longer in the file. Two stores of one file stand for the two writers.
@@ -197,7 +219,7 @@ TEST_F(WaypointFile, TwoProcessesInterleavingChangesLoseNothing) {
     WaypointStore store(file, /*persist=*/true, 6);
     for (int i = 0; i < kEach; ++i) {
       const std::string name = who + "_" + std::to_string(i);
-      store.put(joints(name, i));
+      store.put(joints(name, 0.1 * i));
       if (i % 4 == 1) {
         store.rename(name, name + "_renamed");
       } else if (i % 4 == 2) {
