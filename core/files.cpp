@@ -66,21 +66,21 @@ void writeFileAtomically(const std::filesystem::path& path, std::string_view con
   temporary += ".tmp." + std::to_string(::getpid());
   const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) {
-    fail("cannot create", temporary);
+    fail("cannot write", path);  // named as the caller named it, not the temporary
   }
   if (!writeAll(fd, content)) {
     closeKeepingErrno(fd);
     ::unlink(temporary.c_str());
-    fail("cannot write", temporary);
+    fail("cannot write", path);
   }
   if (::fsync(fd) != 0) {
     closeKeepingErrno(fd);
     ::unlink(temporary.c_str());
-    fail("cannot sync", temporary);
+    fail("cannot write", path);
   }
   if (::close(fd) != 0) {
     ::unlink(temporary.c_str());
-    fail("cannot write", temporary);
+    fail("cannot write", path);
   }
   if (::rename(temporary.c_str(), path.c_str()) != 0) {
     const int error = errno;

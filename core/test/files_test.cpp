@@ -58,6 +58,16 @@ TEST_F(FilesTest, AnOutputInAFolderThatCannotBeWrittenIsAnError) {
   EXPECT_NE(message.find("Permission denied"), std::string::npos) << message;
 }
 
+// Found by scripts/hostile_cli.sh: the error named the temporary file ('r.json.tmp.1234'), not
+// the file the user asked for.
+TEST_F(FilesTest, AnOutputInAMissingFolderNamesTheFileAsGiven) {
+  const auto file = folder_ / "missing" / "r.json";
+  EXPECT_EQ(error([&] { writeOutputFile(file, "{}"); }),
+            "cannot write '" + file.string() + "': No such file or directory");
+  EXPECT_EQ(error([&] { writeFileAtomically(file, "{}"); }),
+            "cannot write '" + file.string() + "': No such file or directory");
+}
+
 TEST_F(FilesTest, AnOutputThatIsAFolderIsRefused) {
   EXPECT_EQ(error([&] { writeOutputFile(folder_, "{}"); }), "cannot write '" + folder_.string() + "': it is a folder");
 }
