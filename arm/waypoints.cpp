@@ -83,9 +83,9 @@ constexpr double kMaxDistance = 10.0;
 std::string rangeProblem(const double* values, std::size_t count, double limit, const std::string& what) {
   for (std::size_t i = 0; i < count; ++i) {
     if (!(std::abs(values[i]) <= limit)) {
-      char number[32];
-      std::snprintf(number, sizeof number, "%g", values[i]);
-      return "[" + std::to_string(i) + "]: must be " + what + ", not " + number;
+      char text[160];
+      std::snprintf(text, sizeof text, "[%zu]: must be %s, not %g", i, what.c_str(), values[i]);
+      return text;
     }
   }
   return {};
