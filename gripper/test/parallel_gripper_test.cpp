@@ -189,11 +189,11 @@ TEST_F(GripperTest, TheReportCarriesTheFingersOpening) {
   run("Close", {{"speed", component::Value(0.15)}});
   world::WorldState world;
   world.update("gripper", gripper.report());
-  const world::Symbol* fingers = world.symbol("gripper_fingers");
-  ASSERT_NE(fingers, nullptr);
-  ASSERT_NE(fingers->joints(), nullptr);
-  EXPECT_EQ(fingers->joints()->joint_names, std::vector<std::string>{"opening"});
-  EXPECT_NEAR(fingers->joints()->positions.at(0), 0.0, 1e-3);
+  const world::Symbol* reading = world.symbol("gripper_fingers");
+  ASSERT_NE(reading, nullptr);
+  ASSERT_NE(reading->joints(), nullptr);
+  EXPECT_EQ(reading->joints()->joint_names, std::vector<std::string>{"opening"});
+  EXPECT_NEAR(reading->joints()->positions.at(0), 0.0, 1e-3);
 }
 
 TEST_F(GripperTest, FingersThatNeverSettleFailAfterTheTimeout) {
