@@ -1,5 +1,7 @@
 #include "arm/arm_component.h"
 
+#include "arm/arm_motion.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -12,101 +14,6 @@ using component::ParamSpec;
 using component::ValueType;
 
 namespace {
-
-std::string format(const char* pattern, double value) {
-  char text[96];
-  std::snprintf(text, sizeof text, pattern, value);
-  return text;
-}
-
-/// Decelerates the motion being followed along its path, if it is not over.
-void stopMotion(ArmMotion& motion, ArmDriver& driver, const Clock& clock, const JointLimits& limits) {
-  ++motion.counter;
-  if (!motion.trajectory) {
-    return;
-  }
-  const TimePoint now = clock.now();
-  if (now - motion.start < motion.trajectory->duration()) {
-    const TrajectoryPoint state = motion.trajectory->sample(now - motion.start);
-    auto stop = std::make_shared<JointTrajectory>(JointTrajectory::stopFrom(state, limits));
-    driver.execute(stop, now);
-    motion.trajectory = std::move(stop);
-    motion.start = now;
-  }
-}
-
-/// A motion being executed by the driver.
-class MotionOperation final : public component::RunningOperation {
- public:
-  MotionOperation(ArmDriver& driver, const Clock& clock, MotionPlan plan, std::shared_ptr<ArmMotion> motion,
-                  const ArmConfig& config, std::shared_ptr<const Kinematics> kinematics, std::string what)
-      : driver_(driver),
-        clock_(clock),
-        plan_(std::move(plan)),
-        motion_(std::move(motion)),
-        id_(++motion_->counter),
-        config_(config),
-        kinematics_(std::move(kinematics)),
-        what_(std::move(what)),
-        start_(clock.now()) {
-    motion_->trajectory = plan_.trajectory;
-    motion_->start = start_;
-    driver_.execute(plan_.trajectory, start_);
-  }
-
-  OperationResult poll() override {
-    if (motion_->counter != id_) {
-      return OperationResult::failure("the arm was stopped, or another motion took over, before " + what_ +
-                                      " finished");
-    }
-    const TimePoint now = clock_.now();
-    // Every poll checks the driver's reading: a driver that fails, reads NaN or stopped
-    // updating stops the motion at once.
-    ArmState state;
-    std::string problem;
-    try {
-      state = driver_.read();
-      problem = readingProblem(state, now, config_.state_timeout, config_.joint_names);
-    } catch (const std::exception& e) {
-      problem = e.what();
-    }
-    if (!problem.empty()) {
-      stopMotion(*motion_, driver_, clock_, kinematics_->limits());
-      return OperationResult::failure(what_ + ": " + problem + "; the arm was stopped");
-    }
-    const TimePoint end = start_ + plan_.trajectory->duration();
-    if (now < end) {
-      return OperationResult::running();
-    }
-    const double error = maxAbsDifference(state.position, plan_.goal);
-    const double speed = maxAbs(state.velocity);
-    if (error < config_.arrival_tolerance && speed < 0.05) {
-      return OperationResult::success({{"duration", toSeconds(plan_.trajectory->duration())}});
-    }
-    if (now > end + config_.settle_time) {
-      return OperationResult::failure(what_ + ": the arm stopped " + format("%.3f", error) +
-                                      " rad from its goal (blocked, or the controller cannot follow)");
-    }
-    return OperationResult::running();
-  }
-
-  void cancel() override {
-    if (motion_->counter == id_) {
-      stopMotion(*motion_, driver_, clock_, kinematics_->limits());
-    }
-  }
-
- private:
-  ArmDriver& driver_;
-  const Clock& clock_;
-  MotionPlan plan_;
-  std::shared_ptr<ArmMotion> motion_;
-  std::uint64_t id_;
-  const ArmConfig& config_;
-  std::shared_ptr<const Kinematics> kinematics_;
-  std::string what_;
-  TimePoint start_;
-};
 
 std::unique_ptr<component::RunningOperation> finished(OperationResult result) {
   return std::make_unique<component::FinishedOperation>(std::move(result));
@@ -126,13 +33,14 @@ ParamSpec speedParam(double default_speed) {
 
 ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, const planning::CollisionWorld& collisions,
                            WaypointStore& waypoints, FrameLookup frames, std::shared_ptr<const Kinematics> kinematics,
-                           ArmConfig config)
+                           ArmConfig config, ForceControl force)
     : driver_(driver),
       clock_(clock),
       waypoints_(waypoints),
       frames_(std::move(frames)),
       kinematics_(std::move(kinematics)),
-      config_(std::move(config)) {
+      config_(std::move(config)),
+      force_(force) {
   if (kinematics_ == nullptr) {
     throw std::invalid_argument("ArmComponent '" + config_.name + "': no kinematics");
   }
@@ -155,6 +63,9 @@ ArmComponent::ArmComponent(ArmDriver& driver, const Clock& clock, const planning
     }
   }
   planner_.emplace(driver_, clock_, collisions, kinematics_, config_);
+  if (force_.sensor != nullptr) {
+    force_.sensor->tare();  // as a sensor is biased when it starts, with the arm at rest
+  }
   declareOperations();
 }
 
@@ -251,12 +162,23 @@ void ArmComponent::declareOperations() {
                          {"arm_joints", world::SymbolKind::kJoints, "the joint configuration"}};
   description.predicates = {{"arm_moving", 0, "a joint is turning"},
                             {"at_waypoint", 1, "at_waypoint(w): the tool is at waypoint w"}};
+  declareForceOperations(description, operations);
   declare(std::move(description), std::move(operations));
 }
 
 world::Pose ArmComponent::endpoint() const { return planner_->endpoint(); }
 
-void ArmComponent::stop() { stopMotion(*motion_, driver_, clock_, kinematics_->limits()); }
+void ArmComponent::stop() {
+  if (motion_->cartesian && force_.controller != nullptr) {
+    if (const CartesianState state = force_.controller->state(); state.following && state.force_limit_stop) {
+      // The controller holds the tool where it gave way to what it pushed, compliant, without
+      // pressing (arm/cartesian_controller.h); the joints held where they are would keep the force.
+      ++motion_->counter;
+      return;
+    }
+  }
+  stopMotion(*motion_, driver_, clock_, kinematics_->limits());
+}
 
 std::optional<world::Pose> ArmComponent::waypointPose(const Waypoint& waypoint) const {
   if (waypoint.frame == "world") {
@@ -396,7 +318,7 @@ std::unique_ptr<component::RunningOperation> ArmComponent::followJointPath(const
   try {
     const JointVector now = checkedRead().position;
     if (const double gap = maxAbsDifference(path.front(), now); gap > kPathStartTolerance) {
-      return finished(OperationResult::failure(label + ": the path starts " + format("%.3f", gap) +
+      return finished(OperationResult::failure(label + ": the path starts " + formatNumber("%.3f", gap) +
                                                " rad from where the arm is (planned from elsewhere?)"));
     }
   } catch (const std::exception&) {
@@ -417,6 +339,7 @@ world::Report ArmComponent::report() const {
   if (maxAbs(state.velocity) > 0.01) {
     report.predicates.push_back({"arm_moving", {}, true, ""});
   }
+  reportForce(report);
   for (const Waypoint& waypoint : waypoints_.all()) {
     if (waypoint.kind == Waypoint::Kind::kJoints) {
       report.symbols.push_back({waypoint.name, "", now,

@@ -19,6 +19,13 @@
 // Symbols: endpoint (the tool centre point in the world), arm_joints, and every waypoint
 // (pose waypoints as frames relative to their frame, joint waypoints as configurations).
 // Predicates: arm_moving, at_waypoint(w).
+//
+// With a wrist force/torque sensor (ForceControl): the symbol `wrench` (what the tool pushes
+// its surroundings with, in the tool frame about the tool centre point), the predicate
+// `in_contact` and the operation Tare; the component zeroes the sensor once when it starts.
+// With the controller's Cartesian impedance mode as well: MoveUntilContact, PressAndFollow,
+// ReleaseContact and ForgetPressed, and the predicate pressed_at(w) (docs/FORCE.md:
+// arm/force_operations.cpp).
 
 #include <functional>
 #include <memory>
@@ -28,6 +35,9 @@
 
 #include "arm/arm_config.h"
 #include "arm/arm_driver.h"
+#include "arm/arm_motion.h"
+#include "arm/cartesian_controller.h"
+#include "arm/force_torque.h"
 #include "arm/kinematics.h"
 #include "arm/motion_planner.h"
 #include "arm/trajectory.h"
@@ -37,11 +47,11 @@
 
 namespace costar::arm {
 
-/// The motion the driver follows, shared by the component and the motion's operation.
-struct ArmMotion {
-  std::uint64_t counter = 0;  // bumped by every new motion and every stop
-  std::shared_ptr<const JointTrajectory> trajectory;
-  TimePoint start{};
+/// The force sensing and compliant motion an arm may have (both optional): the wrist
+/// force/torque sensor and the controller's Cartesian impedance mode.
+struct ForceControl {
+  ForceTorqueSensor* sensor = nullptr;
+  CartesianController* controller = nullptr;
 };
 
 class ArmComponent final : public component::TableComponent {
@@ -56,7 +66,7 @@ class ArmComponent final : public component::TableComponent {
   /// angle per joint.
   ArmComponent(ArmDriver& driver, const Clock& clock, const planning::CollisionWorld& collisions,
                WaypointStore& waypoints, FrameLookup frames, std::shared_ptr<const Kinematics> kinematics,
-               ArmConfig config);
+               ArmConfig config, ForceControl force = {});
 
   world::Report report() const override;
 
@@ -107,6 +117,12 @@ class ArmComponent final : public component::TableComponent {
   const Kinematics& kinematics() const { return *kinematics_; }
   const JointLimits& limits() const { return kinematics_->limits(); }
 
+  /// The contact threshold of in_contact (N, the force's magnitude).
+  static constexpr double kContactForce = 4.0;
+  /// The force-controlled operations' ranges (also their parameters' min and max).
+  static constexpr double kMaxContactForce = 60.0;  // N: the most MoveUntilContact or PressAndFollow presses with
+  static constexpr double kMaxForceLimit = 150.0;   // N: the highest max_force
+
  private:
   /// Declares the operations, each with its handler.
   void declareOperations();
@@ -121,6 +137,15 @@ class ArmComponent final : public component::TableComponent {
   std::unique_ptr<component::RunningOperation> teach(const component::ParamMap& params);
   std::unique_ptr<component::RunningOperation> renameOrDelete(bool rename, const component::ParamMap& params);
   std::unique_ptr<component::RunningOperation> followJointPath(const component::ParamMap& params);
+  // The force-controlled operations (arm/force_operations.cpp).
+  void declareForceOperations(component::ComponentDescription& description, component::OperationTable& operations);
+  void reportForce(world::Report& report) const;
+  std::unique_ptr<component::RunningOperation> tare();
+  std::unique_ptr<component::RunningOperation> moveUntilContact(const component::ParamMap& params);
+  std::unique_ptr<component::RunningOperation> pressAndFollow(const component::ParamMap& params);
+  std::unique_ptr<component::RunningOperation> releaseContact(const component::ParamMap& params);
+  /// The wrist's wrench in the tool frame about the tool centre point.
+  Wrench toolWrench(const Wrench& sensor) const;
 
   ArmDriver& driver_;
   const Clock& clock_;
@@ -130,6 +155,12 @@ class ArmComponent final : public component::TableComponent {
   ArmConfig config_;
   std::optional<MotionPlanner> planner_;  // set once the configuration is checked
   std::shared_ptr<ArmMotion> motion_ = std::make_shared<ArmMotion>();
+  ForceControl force_;
+  /// What the force-controlled operations remember (arm/force_operations.cpp): which waypoints
+  /// the tool pressed through, where an interrupted PressAndFollow stopped, which controller
+  /// motion is pressing now.
+  struct Pressing;
+  std::shared_ptr<Pressing> pressing_;
 };
 
 }  // namespace costar::arm

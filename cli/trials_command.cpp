@@ -77,7 +77,11 @@ int report(const trials::Summary& summary, const Options& options, int code = 0)
     write(options.json, [&] { trials::writeJson(summary, options.json); });
   }
   if (!options.plot.empty()) {
-    write(options.plot, [&] { trials::writePlot(summary, options.plot); });
+    std::vector<std::filesystem::path> written;
+    write(options.plot, [&] { written = trials::writePlot(summary, options.plot); });
+    for (std::size_t i = 1; i < written.size(); ++i) {
+      std::printf("wrote %s\n", written[i].c_str());  // a polishing trial's force and coverage pictures
+    }
   }
   return code;
 }
@@ -257,7 +261,9 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
                    "write every trial's status transitions to DIR/trial_SEED.jsonl (JSON lines, as costar run "
                    "--trace: the reasons of failures a retry recovered too)")
       ->check(CLI::ExistingDirectory);
-  command->add_option("--plot", options->plot, "write a PNG: success rate, failures, cycle times");
+  command->add_option("--plot", options->plot,
+                      "write a PNG: success rate, failures, cycle times (and, in a scene with a workpiece, "
+                      "PLOT_force.png and PLOT_coverage.png of the first trial: the pad's force, the area worked)");
   command->add_option("--require", options->require, "exit 1 when the success rate is below this (0..1)")
       ->check(numberIn(0.0, 1.0, false, ""));
   command->add_option("--shard", options->shard,

@@ -53,6 +53,9 @@ struct PredicateDecl {
   /// Number of arguments (symbol names).
   std::size_t arity = 0;
   std::string description;
+  /// Its arguments are numbers (force_above(15): newtons), not symbol names: plans are checked
+  /// for a finite number of 0 or more.
+  bool numeric_arguments = false;
 };
 
 /// Everything a component declares about itself.

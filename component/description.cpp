@@ -18,7 +18,8 @@ ValueType valueTypeNamed(const std::string& name) {
 
 world::SymbolKind symbolKindNamed(const std::string& name) {
   for (const world::SymbolKind kind :
-       {world::SymbolKind::kFrame, world::SymbolKind::kJoints, world::SymbolKind::kObjectClass}) {
+       {world::SymbolKind::kFrame, world::SymbolKind::kJoints, world::SymbolKind::kObjectClass,
+        world::SymbolKind::kWrench, world::SymbolKind::kNumber}) {
     if (name == world::toString(kind)) {
       return kind;
     }
@@ -100,8 +101,12 @@ nlohmann::json toJson(const ComponentDescription& description) {
   }
   nlohmann::json predicates = nlohmann::json::array();
   for (const PredicateDecl& predicate : description.predicates) {
-    predicates.push_back(
-        {{"name", predicate.name}, {"arity", predicate.arity}, {"description", predicate.description}});
+    nlohmann::json item = {
+        {"name", predicate.name}, {"arity", predicate.arity}, {"description", predicate.description}};
+    if (predicate.numeric_arguments) {
+      item["numeric_arguments"] = true;
+    }
+    predicates.push_back(std::move(item));
   }
   return {{"name", description.name},      {"type", description.type},           {"implements", description.implements},
           {"inputs", description.inputs},  {"outputs", description.outputs},     {"operations", std::move(operations)},
@@ -139,7 +144,8 @@ ComponentDescription descriptionFromJson(const nlohmann::json& json) {
     }
     for (const auto& item : optionalField<nlohmann::json>(json, "predicates", nlohmann::json::array())) {
       description.predicates.push_back({field<std::string>(item, "name"), field<std::size_t>(item, "arity"),
-                                        optionalField<std::string>(item, "description", "")});
+                                        optionalField<std::string>(item, "description", ""),
+                                        optionalField<bool>(item, "numeric_arguments", false)});
     }
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("component '" + description.name + "': " + e.what());

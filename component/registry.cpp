@@ -174,6 +174,14 @@ void ComponentRegistry::registerNodes(bt::NodeRegistry& nodes) {
       return "predicate '" + it->first + "' takes " + std::to_string(it->second.arity) + " argument(s), " +
              std::to_string(count) + " given";
     }
+    if (it->second.numeric_arguments) {
+      for (const std::string& arg : list) {
+        const auto number = parseValue(ValueType::kDouble, arg);
+        if (!number || !(number->asDouble() >= 0.0)) {
+          return "predicate '" + it->first + "' takes a number of 0 or more (e.g. 15 for 15 N), not '" + arg + "'";
+        }
+      }
+    }
     return {};
   };
   check.build = [this](const bt::NodeArgs& args) {

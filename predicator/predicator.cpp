@@ -54,7 +54,21 @@ Predicator::Predicator(world::WorldState& world, std::vector<world::ObjectClass>
                                  relationHolds(relation, *subject, *reference, viewpointAxes(), config_.geometry);
                         });
   }
-  ParamSpec sub_component{"sub_component", ValueType::kString, "which predicates", {}, {"geometry", "contact"}};
+  // The force sub-component: force_above(N) from the arm's wrist sensor (its `wrench` symbol).
+  description.predicates.push_back({"force_above", 1,
+                                    "force_above(N): the wrist sensor's force (the wrench symbol) is above N newtons",
+                                    /*numeric_arguments=*/true});
+  world_.setEvaluator("force_above", [this](const world::WorldState& state, std::span<const std::string> args) {
+    if (args.size() != 1 || !active("force")) {
+      return false;
+    }
+    const world::Symbol* symbol = state.symbol("wrench");
+    const world::WrenchValue* wrench = symbol != nullptr ? symbol->wrench() : nullptr;
+    const auto threshold = component::parseValue(ValueType::kDouble, args[0]);
+    return wrench != nullptr && threshold && wrench->force.norm() > threshold->asDouble();
+  });
+  ParamSpec sub_component{
+      "sub_component", ValueType::kString, "which predicates", {}, {"geometry", "contact", "force"}};
   component::OperationTable operations;
   operations.add({"ActivatePredicates",
                   "Switches a group of the predicator's predicates on or off.",

@@ -8,6 +8,8 @@
 //             each configured reference (default: table_center), and on demand relative to any
 //             symbol
 //   contact   near, on — between objects
+//   force     force_above(N) — the arm's wrist force (its `wrench` symbol) above N newtons,
+//             evaluated on demand (N is a number, not a symbol)
 // Objects are the symbols that some component classifies with is_a(object, class); their
 // extent comes from the class's shape (data/objects).
 //

@@ -115,6 +115,19 @@ std::string composeCellModel(const CellModelPieces& pieces) {
     }
   }
   mergeSections(cell, gripper);
+  if (!pieces.force_torque_site.empty()) {
+    pugi::xml_node site = flange.prepend_child("site");
+    site.append_attribute("name").set_value(pieces.force_torque_site.c_str());
+    site.append_attribute("size").set_value("0.005");
+    site.append_attribute("group").set_value("5");
+    pugi::xml_node sensors = section(cell, "sensor");
+    pugi::xml_node force = sensors.append_child("force");
+    force.append_attribute("name").set_value(pieces.force_sensor.c_str());
+    force.append_attribute("site").set_value(pieces.force_torque_site.c_str());
+    pugi::xml_node torque = sensors.append_child("torque");
+    torque.append_attribute("name").set_value(pieces.torque_sensor.c_str());
+    torque.append_attribute("site").set_value(pieces.force_torque_site.c_str());
+  }
 
   std::ostringstream out;
   cell_doc.save(out, "  ");

@@ -12,6 +12,9 @@
 //   robot base body without pos and quat (a generated model) is put at `robot_base`, one that
 //   has them keeps them (Simulation checks that they agree with the workcell);
 // - the children of the gripper's body "mount" become children of the robot's flange body;
+// - a wrist force/torque sensor at the flange (force_torque_site): a site of that name at the
+//   flange body's origin and a force and a torque sensor on it (sim/force_torque.h), which
+//   read the interaction between the flange body (the gripper and what it touches) and its parent;
 // - everything else in the robot's and gripper's documents (compiler, option, keyframe ...) is
 //   the cell's business and is ignored.
 // Textures and meshes are read from the cell model's folder. Element order is kept, so a model composed from the pieces
@@ -33,6 +36,11 @@ struct CellModelPieces {
   std::string flange_body;
   /// Where the robot's base stands in the world (see above).
   std::optional<world::Pose> robot_base;
+  /// The flange's force/torque site's name; empty: no sensor. Its sensors are named
+  /// `force_sensor` and `torque_sensor`.
+  std::string force_torque_site;
+  std::string force_sensor;
+  std::string torque_sensor;
 };
 
 /// The composed MJCF text. @throws std::runtime_error naming the file and the problem (a file

@@ -75,6 +75,41 @@ Region parseRegion(const json& value, const std::string& field) {
   return region;
 }
 
+WorkpieceRequest parseWorkpiece(const json& value, const std::string& field) {
+  onlyKnownFields(object(value, field), field, {"at", "size", "marked"});
+  WorkpieceRequest workpiece;
+  for (const char* key : {"at", "size", "marked"}) {
+    if (!value.contains(key)) {
+      fail(field + "." + key,
+           "missing (a workpiece has \"at\": [x, y, yaw_deg], \"size\": [sx, sy, sz], \"marked\": [mx, my])");
+    }
+  }
+  const auto at = numbers(value.at("at"), field + ".at", 3, 3, "[x, y, yaw_deg]");
+  workpiece.at = {at[0], at[1], at[2]};
+  const auto size = numbers(value.at("size"), field + ".size", 3, 3, "[sx, sy, sz] in m");
+  workpiece.size = {size[0], size[1], size[2]};
+  if ((workpiece.size.array() < 0.02).any() || (workpiece.size.head<2>().array() > 0.6).any() ||
+      workpiece.size.z() > 0.2) {
+    fail(field + ".size", "must be from 0.02 to 0.6 m across and at most 0.2 m high, not " + shown(value.at("size")));
+  }
+  const auto marked = numbers(value.at("marked"), field + ".marked", 2, 2, "[mx, my] in m");
+  workpiece.marked = {marked[0], marked[1]};
+  if ((workpiece.marked.array() <= 0.0).any() || (workpiece.marked.array() > workpiece.size.head<2>().array()).any()) {
+    fail(field + ".marked", "must be above 0 and at most the workpiece's top, not " + shown(value.at("marked")));
+  }
+  const Footprint footprint{workpiece.at.head<2>(), workpiece.size.head<2>() / 2, workpiece.at.z() * M_PI / 180.0};
+  for (const double sx : {-1.0, 1.0}) {
+    for (const double sy : {-1.0, 1.0}) {
+      const Eigen::Vector2d corner =
+          footprint.centre + footprint.axes() * Eigen::Vector2d(sx, sy).cwiseProduct(footprint.half_size);
+      if (!inside(tableTop(), corner)) {
+        fail(field + ".at", "puts the workpiece off the table top (" + describeTable() + ")");
+      }
+    }
+  }
+  return workpiece;
+}
+
 std::string knownRegions(const std::map<std::string, Region>& regions) {
   std::string list;
   for (const auto& [name, region] : regions) {
@@ -200,7 +235,8 @@ Scene parseScene(const std::string& text, const std::string& label) {
   try {
     const json file = core::parseJson(text);
     onlyKnownFields(object(file, "the file"), "",
-                    {"description", "seed", "min_gap", "camera_offset", "regions", "parts", "jig", "wire"});
+                    {"description", "seed", "min_gap", "camera_offset", "regions", "parts", "jig", "wire", "workpiece",
+                     "power_tool"});
     Scene scene;
     scene.label = label;
     if (file.contains("description")) {
@@ -217,6 +253,15 @@ Scene parseScene(const std::string& text, const std::string& label) {
     }
     if (file.contains("camera_offset")) {
       scene.camera_offset = parseCameraOffset(file.at("camera_offset"), "camera_offset");
+    }
+    if (file.contains("workpiece")) {
+      scene.workpiece = parseWorkpiece(file.at("workpiece"), "workpiece");
+    }
+    if (file.contains("power_tool")) {
+      if (!file.at("power_tool").is_boolean()) {
+        fail("power_tool", "must be true or false, not " + shown(file.at("power_tool")));
+      }
+      scene.power_tool = file.at("power_tool").get<bool>();
     }
     scene.regions = defaultRegions();
     if (file.contains("regions")) {
@@ -307,6 +352,13 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
                              "' (known: " + known + ")");
   };
 
+  // The workpiece is fixed: random placements keep clear of it, a part placed on it is refused.
+  std::optional<Footprint> workpiece;
+  if (scene.workpiece) {
+    workpiece = Footprint{scene.workpiece->at.head<2>(), scene.workpiece->size.head<2>() / 2,
+                          scene.workpiece->at.z() * M_PI / 180.0};
+    footprints.push_back(*workpiece);
+  }
   // Parts placed with "at" first: two that overlap (physics would throw them apart) are refused,
   // and random placements keep clear of every one, wherever it comes in the list.
   struct Fixed {
@@ -337,6 +389,11 @@ std::vector<PartPlacement> placeParts(const Scene& scene, const std::vector<worl
                                  ") overlap: the simulation would throw them apart (move one, or give it a \"height\" "
                                  "to lie on the other)");
       }
+    }
+    if (workpiece && closerThan(part.footprint, *workpiece, -0.001)) {
+      throw std::runtime_error("scene '" + scene.label + "': parts[" + std::to_string(r) + "] (" +
+                               request.object_class + " at " + format(request.at->x()) + ", " +
+                               format(request.at->y()) + ") lies on the workpiece");
     }
     fixed.push_back(part);
     footprints.push_back(part.footprint);
@@ -503,6 +560,15 @@ std::string sceneFileText(const Scene& scene) {
       value["rpy_deg"] = {offset.rpy_deg.x(), offset.rpy_deg.y(), offset.rpy_deg.z()};
     }
     file["camera_offset"] = value;
+  }
+  if (scene.workpiece) {
+    const WorkpieceRequest& workpiece = *scene.workpiece;
+    file["workpiece"] = {{"at", {workpiece.at.x(), workpiece.at.y(), workpiece.at.z()}},
+                         {"size", {workpiece.size.x(), workpiece.size.y(), workpiece.size.z()}},
+                         {"marked", {workpiece.marked.x(), workpiece.marked.y()}}};
+  }
+  if (scene.power_tool) {
+    file["power_tool"] = true;
   }
   json parts = json::array();
   for (const PartRequest& part : scene.parts) {

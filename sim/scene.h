@@ -12,7 +12,11 @@
 // Two parts placed with "at" that overlap by more than 1 mm (and are not one above the other)
 // are refused naming both: the physics would throw them apart at the first step.
 // A bending jig and the wire it holds: "jig" and "wire" (sim/wire.h). Optional: "min_gap" (m,
-// 0 to 0.5, default 0.02) between randomly placed parts. Custom
+// 0 to 0.5, default 0.02) between randomly placed parts. A workpiece to polish: "workpiece":
+// {"at": [x, y, yaw_deg], "size": [sx, sy, sz], "marked": [mx, my]} (a block fixed on the table,
+// its top's middle mx by my marked for polishing; sizes in m), which random placements keep
+// clear of; "power_tool": true puts the cell's power tool on its stand (workcells/NAME.json
+// "power_tool", sim/power_tool.h). Custom
 // regions add to (or replace) the default ones. A field the format does not know, a value of
 // the wrong type or out of range (a count of 4294967297, a negative min_gap, a region or an
 // "at" off the table) is an error naming the file and the field, e.g.
@@ -74,6 +78,13 @@ struct CameraOffset {
 /// names its own.
 world::Pose cameraOffsetPose(const CameraOffset& offset, std::uint64_t seed);
 
+/// A block fixed on the table whose top is polished (sim/power_tool.h records its marked area).
+struct WorkpieceRequest {
+  Eigen::Vector3d at = Eigen::Vector3d::Zero();  // x, y (m) of its centre and yaw (degrees)
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();
+  Eigen::Vector2d marked = Eigen::Vector2d::Zero();  // the marked rectangle in the middle of its top
+};
+
 struct Scene {
   std::string label;  // the file it came from
   std::string description;
@@ -87,6 +98,9 @@ struct Scene {
   /// A bending jig on the table, and the wire clamped in it (sim/wire.h).
   std::optional<JigSpec> jig;
   std::optional<WireSpec> wire;
+  std::optional<WorkpieceRequest> workpiece;
+  /// The cell's power tool sits on its stand.
+  bool power_tool = false;
 };
 
 /// The table top (x, y in m), as sim/models/table_cell.xml has it; regions and fixed

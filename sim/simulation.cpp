@@ -16,6 +16,7 @@
 #include "sim/adaptive_gripper_sim.h"
 #include "sim/cell_model.h"
 #include "sim/gl_context.h"
+#include "sim/impedance_controller.h"
 #include "sim/wire_sim.h"
 
 namespace costar::sim {
@@ -97,6 +98,11 @@ struct Simulation::Impl {
   std::unique_ptr<SimAdaptiveGripper> adaptive;
   // The scene's bending jig and wire, when it has them.
   std::unique_ptr<SimJig> jig;
+  // The wrist force/torque sensor and the controller's Cartesian impedance mode.
+  std::unique_ptr<SimForceTorqueSensor> force_torque;
+  std::unique_ptr<SimCartesianController> cartesian;
+  // The power tool, its stand and the workpiece, when the cell or the scene has them.
+  std::unique_ptr<SimPowerTool> power_tool;
   int table_geom = 0;          // the box the arm collides with
   int table_surface_geom = 0;  // the plane parts rest on
   int tcp_site = 0;
@@ -133,6 +139,9 @@ struct Simulation::Impl {
     }
     renderer.reset();
     jig.reset();
+    power_tool.reset();
+    cartesian.reset();
+    force_torque.reset();
     adaptive.reset();
     if (data != nullptr) {
       mj_deleteData(data);
@@ -211,6 +220,22 @@ struct Simulation::Impl {
   }
 
   void control() {
+    if (cartesian->active()) {
+      cartesian->control();
+    } else {
+      jointControl();
+    }
+    if (adaptive) {
+      adaptive->control();
+      return;
+    }
+    // Gripper: the servo setpoint moves toward the target at the commanded speed.
+    const double step = finger_speed * model->opt.timestep;
+    finger_command += std::clamp(finger_target - finger_command, -step, step);
+    data->ctrl[finger_actuator] = finger_command;
+  }
+
+  void jointControl() {
     // Arm: computed torque, tau = M (qdd_d + Kp e + Kd de) + bias, clamped by the actuators.
     const TimePoint t = now();
     ArmSetpoint setpoint = setpoint_source ? setpoint_source(t) : held;
@@ -230,14 +255,6 @@ struct Simulation::Impl {
     for (int i = 0; i < arm_joints; ++i) {
       data->ctrl[i] = torque[arm_dof[i]] + data->qfrc_bias[arm_dof[i]];
     }
-    if (adaptive) {
-      adaptive->control();
-      return;
-    }
-    // Gripper: the servo setpoint moves toward the target at the commanded speed.
-    const double step = finger_speed * model->opt.timestep;
-    finger_command += std::clamp(finger_target - finger_command, -step, step);
-    data->ctrl[finger_actuator] = finger_command;
   }
 
   void countTableContacts() {
@@ -265,6 +282,45 @@ struct Simulation::Impl {
     if (jig) {
       jig->afterStep(toSeconds(now()));
     }
+    force_torque->sample();
+    if (power_tool) {
+      power_tool->step();
+    }
+  }
+
+  /// Which finger of the gripper a geom belongs to (kPalm and up: the palm), -1: not the gripper.
+  int handPart(int geom) const {
+    constexpr int kPalmPart = 100;
+    if (adaptive) {
+      if (!adaptive->isGripperGeom(geom)) {
+        return -1;
+      }
+      const int finger = adaptive->fingerOfGeom(geom);
+      return finger >= 0 ? finger : kPalmPart;
+    }
+    const int body = model->geom_bodyid[geom];
+    const char* name = mj_id2name(model, mjOBJ_BODY, body);
+    const std::string label = name != nullptr ? name : "";
+    if (label == "left_finger") {
+      return 0;
+    }
+    if (label == "right_finger") {
+      return 1;
+    }
+    for (int b = body; b > 0; b = model->body_parentid[b]) {
+      if (b == tool_body) {
+        return kPalmPart;
+      }
+    }
+    return -1;
+  }
+
+  double armSpeed() const {
+    double fastest = 0.0;
+    for (int i = 0; i < arm_joints; ++i) {
+      fastest = std::max(fastest, std::abs(data->qvel[arm_dof[i]]));
+    }
+    return fastest;
   }
 
   /// The finger a geom belongs to for the jig's watch on the wire: the adaptive gripper's
@@ -369,8 +425,9 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   if (!options.adaptive_gripper.empty()) {
     adaptive = gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile(options.adaptive_gripper, root));
   }
-  std::string xml = composeCellModel({under_root(options.cell_model), robot.mjcf, under_root(options.gripper_model),
-                                      robot.urdf_tool_link, options.robot_base});
+  std::string xml =
+      composeCellModel({under_root(options.cell_model), robot.mjcf, under_root(options.gripper_model),
+                        robot.urdf_tool_link, options.robot_base, kForceTorqueSite, kForceSensor, kTorqueSensor});
   std::string assets;
   for (const auto& object : impl->classes) {
     for (const auto& [color_name, rgb] : object.colors) {
@@ -405,6 +462,15 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
     jig_draw =
         drawJig(*scene.jig, scene.wire, material ? &*material : nullptr, options.placement_seed.value_or(scene.seed));
     bodies += jigMjcf(*scene.jig, scene.wire, material ? &*material : nullptr, *jig_draw, modelTimestep(xml));
+  }
+  if (scene.power_tool && !options.power_tool) {
+    throw std::runtime_error("scene '" + scene.label +
+                             "' puts the power tool on its stand, but this workcell has no power tool");
+  }
+  if (options.power_tool || scene.workpiece) {
+    assets += powerToolAssets();
+    bodies += powerToolBodies(options.power_tool ? &*options.power_tool : nullptr, scene.power_tool,
+                              scene.workpiece ? &*scene.workpiece : nullptr);
   }
   replaceMarker(xml, "<!--PART_ASSETS-->", assets);
   replaceMarker(xml, "<!--PARTS-->", bodies);
@@ -449,6 +515,28 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
     impl->finger_actuator = impl->id(mjOBJ_ACTUATOR, "fingers");
     impl->left_pad = impl->id(mjOBJ_GEOM, "left_pad");
     impl->right_pad = impl->id(mjOBJ_GEOM, "right_pad");
+  }
+  {
+    Impl* raw = impl.get();
+    impl->force_torque =
+        std::make_unique<SimForceTorqueSensor>(m, impl->data, options.placement_seed.value_or(scene.seed),
+                                               options.force_torque_noise, [raw] { return raw->now(); });
+    std::vector<int> dofs;
+    std::vector<int> qpos;
+    for (int i = 0; i < impl->arm_joints; ++i) {
+      dofs.push_back(impl->arm_dof[i]);
+      qpos.push_back(impl->arm_qpos[i]);
+    }
+    impl->cartesian = std::make_unique<SimCartesianController>(m, impl->data, "tcp", std::move(dofs), std::move(qpos),
+                                                               *impl->force_torque, [raw] { return raw->now(); });
+  }
+  if (options.power_tool || scene.workpiece) {
+    Impl* raw = impl.get();
+    impl->power_tool = std::make_unique<SimPowerTool>(
+        m, impl->data, options.power_tool, scene.workpiece, scene.power_tool,
+        [raw](int geom) { return raw->handPart(geom); },
+        [raw](int geom) { return raw->isArmBody(raw->model->geom_bodyid[geom]); }, [raw] { return raw->armSpeed(); },
+        [raw] { return raw->now(); });
   }
   impl->table_geom = impl->id(mjOBJ_GEOM, "table");
   impl->table_surface_geom = impl->id(mjOBJ_GEOM, "table_surface");
@@ -558,8 +646,19 @@ ArmJoints Simulation::armVelocities() const {
 }
 
 void Simulation::setArmSetpointSource(std::function<ArmSetpoint(TimePoint)> source) {
+  if (impl_->cartesian->active()) {
+    // The joint controller takes over from where the arm is.
+    impl_->held = {armPositions(), ArmJoints::zero(impl_->arm_joints), ArmJoints::zero(impl_->arm_joints)};
+    impl_->cartesian->release();
+  }
   impl_->setpoint_source = std::move(source);
 }
+
+arm::ForceTorqueSensor& Simulation::forceTorqueSensor() { return *impl_->force_torque; }
+
+arm::CartesianController& Simulation::cartesianController() { return *impl_->cartesian; }
+
+arm::Wrench Simulation::trueFlangeWrench() const { return impl_->force_torque->truth(); }
 
 world::Pose Simulation::tcpPose() const {
   const mjData* d = impl_->data;
@@ -607,6 +706,8 @@ void Simulation::commandFingers(double opening, double speed, double force) {
 }
 
 gripper::AdaptiveGripperDriver* Simulation::adaptiveGripper() { return impl_->adaptive.get(); }
+
+SimPowerTool* Simulation::powerTool() { return impl_->power_tool.get(); }
 
 const camera::Intrinsics& Simulation::rgbdIntrinsics() const { return impl_->intrinsics; }
 

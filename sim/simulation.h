@@ -27,6 +27,8 @@
 #include <string>
 #include <vector>
 
+#include "arm/cartesian_controller.h"
+#include "arm/force_torque.h"
 #include "arm/joints.h"
 #include "arm/robot_description.h"
 #include "camera/rgbd.h"
@@ -34,6 +36,8 @@
 #include "core/image.h"
 #include "gripper/adaptive_gripper_driver.h"
 #include "sim/depth_noise.h"
+#include "sim/force_torque.h"
+#include "sim/power_tool.h"
 #include "sim/scene.h"
 #include "sim/wire.h"
 #include "world/object_class.h"
@@ -76,6 +80,12 @@ struct SimulationOptions {
   /// Seed of the random part placement (default: the scene's seed).
   std::optional<std::uint64_t> placement_seed;
   DepthNoiseOptions depth_noise;
+  /// The wrist force/torque sensor's bias and noise (drawn from the placement seed).
+  ForceTorqueNoise force_torque_noise;
+  /// The cell's power tool and its stand (sim/power_tool.h); the scene says whether the tool sits
+  /// on the stand ("power_tool": true). Absent: the cell has none (a scene that asks for it is
+  /// refused).
+  std::optional<PowerToolSetup> power_tool;
   /// Physics time to let parts settle before time 0.
   double settle_seconds = 0.3;
   /// Where the RGB-D camera really is, relative to where the cell's drawings put it (the
@@ -139,6 +149,15 @@ class Simulation {
   world::Pose tcpPose() const;
   /// Number of physics steps in which an arm or gripper geom touched the table so far.
   std::uint64_t armTableContactSteps() const;
+  /// The wrist force/torque sensor at the flange (sim/force_torque.h): its driver, readings
+  /// stamped with the simulated time. It lives as long as the simulation.
+  arm::ForceTorqueSensor& forceTorqueSensor();
+  /// The controller's Cartesian impedance mode (sim/impedance_controller.h); a joint setpoint
+  /// source (setArmSetpointSource) takes the arm back from it. It lives as long as the simulation.
+  arm::CartesianController& cartesianController();
+  /// The true wrench at the flange sensor (no bias, no noise, never tared; what the flange
+  /// pushes the tool side with, in the flange frame), for tests and the trial judge.
+  arm::Wrench trueFlangeWrench() const;
 
   // --- gripper ---------------------------------------------------------------------------
   /// The 2-finger gripper's fingers. @throws std::logic_error when the cell has the adaptive
@@ -150,6 +169,12 @@ class Simulation {
   /// The 3-finger adaptive gripper's driver (readings stamped with the simulated time), or
   /// nullptr when the cell has the 2-finger gripper. It lives as long as the simulation.
   gripper::AdaptiveGripperDriver* adaptiveGripper();
+
+  // --- power tool ------------------------------------------------------------------------
+  /// The power tool's driver and its ground truth (the workpiece's worked texels, its log), or
+  /// nullptr when the cell has no power tool and the scene no workpiece. It lives as long as the
+  /// simulation.
+  SimPowerTool* powerTool();
   static constexpr double kMaxOpening = 0.085;
 
   // --- camera ----------------------------------------------------------------------------

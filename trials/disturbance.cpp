@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include "sim/power_tool.h"
 #include "sim/scene.h"
 #include "sim/simulation.h"
 #include "smartmove/footprint.h"
@@ -60,9 +61,31 @@ DisturbanceSpec parseDisturbance(std::string_view text) {
     spec.kind = DisturbanceKind::kDropFrame;
   } else if (kind == "add") {
     spec.kind = DisturbanceKind::kAdd;
+  } else if (kind == "take-tool") {
+    spec.kind = DisturbanceKind::kTakeTool;
   } else {
     throw std::invalid_argument(where + "unknown kind '" + std::string(kind) +
-                                "' (known: nudge, take-away, drop-frame, add)");
+                                "' (known: nudge, take-away, drop-frame, add, take-tool)");
+  }
+  if (at != std::string_view::npos && spec.kind == DisturbanceKind::kTakeTool) {
+    const std::string_view when = text.substr(at + 1);
+    constexpr std::string_view kAt = "at=";
+    if (when.substr(0, kAt.size()) != kAt) {
+      throw std::invalid_argument(where + "expected @at=SECONDS after take-tool, not '@" + std::string(when) + "'");
+    }
+    const std::string number(when.substr(kAt.size()));
+    std::size_t used = 0;
+    double value = -1.0;
+    try {
+      value = std::stod(number, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (number.empty() || used != number.size() || !(value >= 0.0 && value <= 1e4)) {
+      throw std::invalid_argument(where + "at=SECONDS needs a number of seconds from 0 to 10000, not '" + number + "'");
+    }
+    spec.at_seconds = value;
+    return spec;
   }
   if (at != std::string_view::npos) {
     const std::string_view when = text.substr(at + 1);
@@ -97,6 +120,8 @@ std::string disturbanceGrammar() {
          "  drop-frame  one camera frame of a DetectObjects comes empty\n"
          "  add         a part (node or link, drawn) is put on the table at a free place as the gripper goes down to "
          "another\n"
+         "  take-tool   the power tool is taken (from the gripper or its stand) 4-40 s into the trial (@at=S: at S s) "
+         "and given back onto its stand 2-8 s later\n"
          "  @grasp=N    the N-th approach to a part (default: the 1st to 3rd, drawn)";
 }
 
@@ -109,14 +134,29 @@ Disturber::Disturber(std::vector<DisturbanceSpec> specs, std::uint64_t seed)
       continue;
     }
     Pending pending;
-    pending.approach = spec.grasp > 0 ? spec.grasp : std::uniform_int_distribution<int>(1, 3)(random_);
+    if (spec.kind == DisturbanceKind::kTakeTool) {
+      pending.take_at = spec.at_seconds.value_or(std::uniform_real_distribution<double>(4.0, 40.0)(random_));
+      pending.away_for = std::uniform_real_distribution<double>(2.0, 8.0)(random_);
+    } else {
+      pending.approach = spec.grasp > 0 ? spec.grasp : std::uniform_int_distribution<int>(1, 3)(random_);
+    }
     pending.spec = std::move(spec);
     pending_.push_back(std::move(pending));
   }
 }
 
 void Disturber::watch(sim::Simulation& simulation) {
-  if (pending_.empty()) {
+  bool approaches = false;
+  for (Pending& pending : pending_) {
+    if (pending.spec.kind == DisturbanceKind::kTakeTool) {
+      if (!pending.done) {
+        takeTool(simulation, pending);
+      }
+    } else {
+      approaches = true;
+    }
+  }
+  if (!approaches) {
     return;
   }
   const world::Pose tcp = simulation.tcpPose();
@@ -137,7 +177,7 @@ void Disturber::watch(sim::Simulation& simulation) {
   if (!approached.empty() && approached != approaching_) {
     ++approaches_;
     for (Pending& pending : pending_) {
-      if (!pending.done && pending.approach == approaches_) {
+      if (!pending.done && pending.spec.kind != DisturbanceKind::kTakeTool && pending.approach == approaches_) {
         pending.done = true;
         if (pending.spec.kind == DisturbanceKind::kNudge) {
           nudge(simulation, pending, approached);
@@ -255,9 +295,36 @@ void Disturber::add(sim::Simulation& simulation, Pending& pending) {
   pending.event = format("add %s: no free place on the table (approach %d)", spare.name.c_str(), pending.approach);
 }
 
+void Disturber::takeTool(sim::Simulation& simulation, Pending& pending) {
+  const double now = toSeconds(simulation.time().time_since_epoch());
+  sim::SimPowerTool* tool = simulation.powerTool();
+  if (tool == nullptr || !tool->hasTool()) {
+    pending.done = true;
+    pending.event = "take-tool: not applied: the scene has no power tool";
+    return;
+  }
+  if (!pending.taken && now >= pending.take_at) {
+    const tool::PowerToolReading reading = tool->read();
+    const char* from = reading.held ? "out of the gripper" : reading.docked ? "off its stand" : "from where it was";
+    tool->take();
+    pending.taken = true;
+    pending.take_at = now;
+    pending.event = format("take-tool: taken %s (%s) at %.1f s", from, reading.powered ? "running" : "off", now);
+  } else if (pending.taken && now >= pending.take_at + pending.away_for) {
+    tool->giveBack();
+    pending.done = true;
+    pending.event += format(", given back onto its stand at %.1f s", now);
+  }
+}
+
 std::vector<std::string> Disturber::events() const {
   std::vector<std::string> lines;
   for (const Pending& pending : pending_) {
+    if (pending.spec.kind == DisturbanceKind::kTakeTool && !pending.done) {
+      lines.push_back(pending.taken ? pending.event + " and kept until the trial ended"
+                                    : format("take-tool: not applied: the trial ended before %.1f s", pending.take_at));
+      continue;
+    }
     lines.push_back(pending.done
                         ? pending.event
                         : pending.spec.text + ": not applied: no approach " + std::to_string(pending.approach) + " (" +

@@ -12,11 +12,15 @@
 //   add         a part is put on the table at a free place, as the gripper starts down toward
 //               another (its class drawn from the seed among the cell's spare parts, parked
 //               off the table from the start: the simulator's bodies are fixed once loaded)
+//   take-tool   the power tool is taken (out of the gripper, or off its stand: wherever it is)
+//               at a moment drawn from the seed (4 to 40 s into the trial; "@at=S": S seconds)
+//               and given back onto its stand 2 to 8 s later (sim/power_tool.h)
 // "@grasp=N" picks the N-th approach to a part (default: 1 to 3, drawn from the seed).
 // An approach is the tool going down over a part resting on the table with the fingers open
 // and empty, within 3 cm of its centre, 4 to 9 cm above it (just past the pre-grasp pose).
 
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -29,16 +33,18 @@ class Simulation;
 
 namespace costar::trials {
 
-enum class DisturbanceKind { kNudge, kTakeAway, kDropFrame, kAdd };
+enum class DisturbanceKind { kNudge, kTakeAway, kDropFrame, kAdd, kTakeTool };
 
 struct DisturbanceSpec {
   DisturbanceKind kind = DisturbanceKind::kNudge;
   /// The approach disturbed (1-based); 0: drawn from the seed in 1..3.
   int grasp = 0;
+  /// take-tool: when (simulated seconds); absent: drawn from the seed.
+  std::optional<double> at_seconds;
   std::string text;  // as written
 };
 
-/// Parses "nudge", "take-away@grasp=2", "drop-frame". @throws std::invalid_argument naming the
+/// Parses "nudge", "take-away@grasp=2", "drop-frame", "take-tool@at=20". @throws std::invalid_argument naming the
 /// spec and the problem.
 DisturbanceSpec parseDisturbance(std::string_view text);
 /// The grammar in a few lines, for --help.
@@ -70,7 +76,12 @@ class Disturber {
     int approach = 1;
     bool done = false;
     std::string event;
+    // take-tool: when it is taken, how long it stays away, and whether it is away now.
+    double take_at = 0.0;
+    double away_for = 0.0;
+    bool taken = false;
   };
+  void takeTool(sim::Simulation& simulation, Pending& pending);
   void nudge(sim::Simulation& simulation, Pending& pending, const std::string& part);
   void takeAway(sim::Simulation& simulation, Pending& pending, const std::string& part);
   void add(sim::Simulation& simulation, Pending& pending);

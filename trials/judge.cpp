@@ -1,7 +1,9 @@
 #include "trials/judge.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <stdexcept>
 
 #include "trials/wire_judge.h"
@@ -104,6 +106,100 @@ Verdict blindPlace(sim::Simulation& simulation, const std::vector<sim::PartState
   return {false, "there is no node_0"};
 }
 
+constexpr double kPolishForce = kPolishingForce;
+constexpr double kPolishBand = kPolishingBand;
+constexpr double kTouching = 0.5;  // N: the pad touches the workpiece
+
+std::string percent(double fraction) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f %%", 100.0 * fraction);
+  return text;
+}
+
+Verdict polishing(sim::Simulation& simulation, const std::vector<sim::PartState>&) {
+  const sim::SimPowerTool* tool = simulation.powerTool();
+  if (tool == nullptr || !tool->coverage() || !tool->hasTool()) {
+    return {false, "the scene has no power tool on its stand or no workpiece (sim/scenes/polishing.json)"};
+  }
+  const std::vector<sim::PowerToolSample>& log = tool->log();
+  const double coverage = tool->coverage()->fraction();
+  // The pad's force while it touches the workpiece.
+  int touching = 0;
+  int in_band = 0;
+  for (const sim::PowerToolSample& sample : log) {
+    if (sample.pad_force > kTouching) {
+      ++touching;
+      in_band += std::abs(sample.pad_force - kPolishForce) <= kPolishBand ? 1 : 0;
+    }
+  }
+  const double band = touching > 0 ? static_cast<double>(in_band) / touching : 0.0;
+  // Each time the tool left the gripper without being put on its stand: off and the arm still
+  // within 1 s, and, if it was polishing, polishing again later near where it stopped.
+  int losses = 0;
+  double slowest_stop = 0.0;
+  double farthest_resume = 0.0;
+  for (std::size_t i = 1; i < log.size(); ++i) {
+    if (!(log[i - 1].held && !log[i].held && log[i].away)) {
+      continue;
+    }
+    ++losses;
+    const double lost_at = log[i].time;
+    std::optional<double> stopped;
+    for (std::size_t k = i; k < log.size() && log[k].time <= lost_at + 1.0 + 1e-9; ++k) {
+      if (!log[k].powered && log[k].arm_speed < 0.02) {
+        stopped = log[k].time - lost_at;
+        break;
+      }
+    }
+    if (!stopped) {
+      return {false, "the tool was taken out of the gripper at " + std::to_string(lost_at).substr(0, 6) +
+                         " s, and 1 s later it was still on or the arm still moving"};
+    }
+    slowest_stop = std::max(slowest_stop, *stopped);
+    std::optional<Eigen::Vector2d> last_worked;
+    for (std::size_t k = i; k-- > 0 && log[k].time >= lost_at - 0.5;) {
+      if (log[k].working) {
+        last_worked = log[k].pad;
+        break;
+      }
+    }
+    if (!last_worked) {
+      continue;  // it was not polishing when it was taken
+    }
+    const auto resumed = std::find_if(log.begin() + static_cast<std::ptrdiff_t>(i), log.end(),
+                                      [](const sim::PowerToolSample& sample) { return sample.working; });
+    if (resumed == log.end()) {
+      return {false, "polishing stopped when the tool was taken at " + std::to_string(lost_at).substr(0, 6) +
+                         " s and never resumed"};
+    }
+    farthest_resume = std::max(farthest_resume, (resumed->pad - *last_worked).norm());
+  }
+  char summary[320];
+  std::snprintf(summary, sizeof summary,
+                "coverage %s, force within %.0f +/- %.0f N %s of %.1f s touching, %d loss(es) of the tool: off and "
+                "still after %.2f s at most, resumed %.0f mm from where it stopped at most, arm on the workpiece %llu "
+                "steps",
+                percent(coverage).c_str(), kPolishForce, kPolishBand, percent(band).c_str(), touching * 0.01, losses,
+                slowest_stop, farthest_resume * 1000.0, static_cast<unsigned long long>(tool->armWorkpieceSteps()));
+  std::string problem;
+  if (coverage < 0.95) {
+    problem = "coverage " + percent(coverage) + " is below 95 %";
+  } else if (band < 0.90) {
+    problem = "the pad's force was within " + std::to_string(static_cast<int>(kPolishForce)) + " +/- " +
+              std::to_string(static_cast<int>(kPolishBand)) + " N only " + percent(band) + " of the time it touched";
+  } else if (farthest_resume > 0.02) {
+    problem = "polishing resumed " + millimetres(farthest_resume) + " from where it stopped (more than 20 mm)";
+  } else if (tool->armWorkpieceSteps() > 0) {
+    problem = "the arm touched the workpiece";
+  } else if (!log.empty() && log.back().powered) {
+    problem = "the tool was still on at the end";
+  }
+  if (!problem.empty()) {
+    return {false, problem + " (" + summary + ")"};
+  }
+  return {true, summary};
+}
+
 }  // namespace
 
 std::vector<JudgeInfo> judges() {
@@ -113,7 +209,11 @@ std::vector<JudgeInfo> judges() {
           {"blind_place", "node_0 within 1 cm of (0.45, 0.25), the blind pick-and-place example"},
           {"wire_bending",
            "every bend of the jig's drawing within 5 degrees after release, the wire never pulled "
-           "out of the gripper, no pin moved (examples/iiwa/wire_bending.xml)"}};
+           "out of the gripper, no pin moved (examples/iiwa/wire_bending.xml)"},
+          {"polishing",
+           "the sanding/polishing task (examples/iiwa/polishing.xml): marked area worked >= 95 %, pad force 10 +/- 4 N "
+           ">= 90 % of the time it touches, off and still within 1 s of losing the tool, resumed within 20 mm, the arm "
+           "never on the workpiece"}};
 }
 
 Judge judge(const std::string& name) {
@@ -131,6 +231,9 @@ Judge judge(const std::string& name) {
   }
   if (name == "wire_bending") {
     return wireBending;
+  }
+  if (name == "polishing") {
+    return polishing;
   }
   std::string known;
   for (const auto& info : judges()) {

@@ -30,7 +30,16 @@ struct JudgeInfo {
 ///   (centred within 2 cm), a node rests on the link (centred within 2 cm), all at rest.
 /// "blind_place": node_0 rests within 1 cm of (0.45, 0.25) (examples/ur5/blind_pick_place.xml).
 /// "wire_bending": the scene's wire bent to its jig's drawing (trials/wire_judge.h).
+/// "polishing" (the paper's Fig. 7, examples/iiwa/polishing.xml): from the power tool's record
+///   (sim/power_tool.h): >= 95 % of the marked area worked; the pad's force within 10 +/- 4 N for
+///   >= 90 % of the time it touches the workpiece; each time the tool is taken out of the gripper,
+///   the tool off and the arm still (joints < 0.02 rad/s) within 1 s, and polishing, if it was
+///   under way, resumed within 20 mm of where it stopped; the arm never on the workpiece; the tool
+///   off at the end.
 std::vector<JudgeInfo> judges();
+/// The polishing judge's force and band (N): the plan presses with 10 N.
+inline constexpr double kPolishingForce = 10.0;
+inline constexpr double kPolishingBand = 4.0;
 /// @throws std::invalid_argument naming the known judges.
 Judge judge(const std::string& name);
 

@@ -9,6 +9,8 @@
 #include <string>
 
 #include "core/files.h"
+#include "trials/judge.h"
+#include "trials/tool_plot.h"
 #include "trials/trials.h"
 
 namespace costar::trials {
@@ -29,7 +31,7 @@ std::string shorten(const std::string& s, std::size_t width) {
 
 }  // namespace
 
-void writePlot(const Summary& summary, const std::filesystem::path& png) {
+std::vector<std::filesystem::path> writePlot(const Summary& summary, const std::filesystem::path& png) {
   constexpr int kWidth = 1100;
   constexpr int kHeight = 700;
   cairo_surface_t* surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, kWidth, kHeight);
@@ -44,10 +46,11 @@ void writePlot(const Summary& summary, const std::filesystem::path& png) {
   std::snprintf(line, sizeof line, "%s: %d of %d trials succeeded (%.1f %%)", summary.options.plan.filename().c_str(),
                 ok, n, n > 0 ? 100.0 * ok / n : 0.0);
   text(cr, 30, 40, line, 22, true);
-  std::snprintf(line, sizeof line, "scene %s, judge '%s', seeds %llu..%llu, simulated UR5 with sensor noise",
+  std::snprintf(line, sizeof line, "scene %s, judge '%s', seeds %llu..%llu, simulated cell %s with sensor noise",
                 summary.options.scene.filename().c_str(), summary.options.judge.c_str(),
                 static_cast<unsigned long long>(summary.options.seed),
-                static_cast<unsigned long long>(summary.options.seed + std::max(0, n - 1)));
+                static_cast<unsigned long long>(summary.options.seed + std::max(0, n - 1)),
+                summary.options.workcell.c_str());
   text(cr, 30, 66, line, 14);
 
   // Left: outcomes, success first, then each failure reason.
@@ -143,6 +146,18 @@ void writePlot(const Summary& summary, const std::filesystem::path& png) {
     throw std::runtime_error("cannot write plot '" + png.string() + "': " + cairo_status_to_string(status));
   }
   writeOutputFile(png, encoded);
+  std::vector<std::filesystem::path> written = {png};
+  for (const TrialResult& trial : summary.trials) {
+    if (trial.tool) {
+      const std::filesystem::path stem = png.parent_path() / png.stem();
+      written.push_back(std::filesystem::path(stem.string() + "_force.png"));
+      writeForcePlot(*trial.tool, kPolishingForce, kPolishingBand, written.back());
+      written.push_back(std::filesystem::path(stem.string() + "_coverage.png"));
+      writeCoveragePlot(*trial.tool, written.back());
+      break;
+    }
+  }
+  return written;
 }
 
 }  // namespace costar::trials

@@ -27,6 +27,7 @@
 #include "sim/simulation.h"
 #include "trials/disturbance.h"
 #include "trials/judge.h"
+#include "trials/tool_plot.h"
 #include "workcell/sim_cell_description.h"
 #include "workcell/workcell.h"
 
@@ -163,6 +164,15 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
       if (!verdict.success) {
         result.failure_path = "judge";
       }
+    }
+    if (const sim::SimPowerTool* tool = simulation.powerTool();
+        tool != nullptr && tool->coverage() && index == options.shard_index) {
+      auto tool_trace = std::make_shared<ToolTrace>();
+      tool_trace->seed = result.seed;
+      tool_trace->log = tool->log();
+      tool_trace->coverage = tool->coverage();
+      tool_trace->disturbances = result.disturbances;
+      result.tool = std::move(tool_trace);
     }
   } catch (const std::exception& e) {
     result.failure_path = "error";

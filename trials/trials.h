@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +17,8 @@
 #include <nlohmann/json.hpp>
 
 namespace costar::trials {
+
+struct ToolTrace;  // trials/tool_plot.h
 
 struct TrialOptions {
   std::filesystem::path plan;
@@ -75,6 +78,9 @@ struct TrialResult {
   bool started = true;
   /// The trial's --trace could not be written: "cannot write 'FILE': ERROR" (the trial ran).
   std::string trace_error;
+  /// The power tool's record (sim/power_tool.h) of the batch's first trial in a scene with a
+  /// workpiece, for writePlot's force and coverage pictures; not in the JSON.
+  std::shared_ptr<const ToolTrace> tool;
 };
 
 struct Summary {
@@ -139,8 +145,10 @@ std::filesystem::path effectiveScene(const TrialOptions& options);
 /// error.
 void writeJson(const Summary& summary, const std::filesystem::path& file);
 
-/// A PNG a person can read: success rate, failures by reason, cycle-time histogram.
+/// A PNG a person can read: success rate, failures by reason, cycle-time histogram. When a trial
+/// kept the power tool's record (a polishing scene), also PLOT_force.png and PLOT_coverage.png
+/// beside it (trials/tool_plot.h); returns the files written.
 /// @throws std::runtime_error naming the file when it cannot be written.
-void writePlot(const Summary& summary, const std::filesystem::path& png);
+std::vector<std::filesystem::path> writePlot(const Summary& summary, const std::filesystem::path& png);
 
 }  // namespace costar::trials

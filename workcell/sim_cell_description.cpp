@@ -83,7 +83,7 @@ SimCellDescription parse(const json& root, const std::filesystem::path& data_roo
   }
   onlyKnown(root, "",
             {"name", "label", "notes", "robot", "gripper", "robot_base", "cell_model", "scene", "waypoints", "table",
-             "workspace", "part_area", "calibration"});
+             "workspace", "part_area", "calibration", "power_tool"});
   SimCellDescription cell;
   cell.name = text(root, "", "name");
   cell.label = text(root, "", "label");
@@ -122,6 +122,23 @@ SimCellDescription parse(const json& root, const std::filesystem::path& data_roo
     if ((cell.part_area->min().array() >= cell.part_area->max().array()).any()) {
       fail("part_area", "min must be below max on every axis");
     }
+  }
+  if (root.contains("power_tool")) {
+    const json& power_tool = objectAt(root, "", "power_tool");
+    onlyKnown(power_tool, "power_tool", {"tool", "stand"});
+    SimCellDescription::PowerTool tool;
+    tool.tool = text(power_tool, "power_tool", "tool");
+    std::error_code error;
+    const std::filesystem::path tool_file = data_root / "data" / "tools" / (tool.tool + ".json");
+    if (!std::filesystem::is_regular_file(tool_file, error)) {
+      fail("power_tool.tool", "no such tool '" + tool_file.string() + "'");
+    }
+    const json& stand = objectAt(power_tool, "power_tool", "stand");
+    onlyKnown(stand, "power_tool.stand", {"position", "rpy"});
+    const Eigen::Vector3d at = vec3(stand, "power_tool.stand", "position", kMaxMetres, "m");
+    const Eigen::Vector3d turn = vec3(stand, "power_tool.stand", "rpy", kMaxRadians, "rad");
+    tool.stand = world::poseFromXyzRpy(at.x(), at.y(), at.z(), turn.x(), turn.y(), turn.z());
+    cell.power_tool = tool;
   }
   return cell;
 }

@@ -22,6 +22,9 @@
 //                    (calibration/calibration_component.h), when no part's place is known
 //   calibration      the shipped hand-eye calibration of the gripper's marker (the marker's place
 //                    on the flange: one file per gripper and marker, whichever arm carries it)
+//   power_tool       optional {tool: NAME (data/tools/NAME.json), stand: {position, rpy}}: a
+//                    power tool (tool/power_tool.h) and where its stand stands on the table; the
+//                    scene says whether the tool sits on it (sim/scene.h "power_tool")
 //
 // Paths are relative to the data root (core/paths.h). Unknown fields are refused.
 
@@ -50,6 +53,12 @@ struct SimCellDescription {
   Eigen::Vector3d table_size = Eigen::Vector3d::Zero();
   Eigen::AlignedBox3d workspace;
   std::optional<Eigen::AlignedBox3d> part_area;
+  /// The power tool (data/tools/NAME.json) and its stand's pose (the centre of its base).
+  struct PowerTool {
+    std::string tool;
+    world::Pose stand = world::Pose::Identity();
+  };
+  std::optional<PowerTool> power_tool;
 };
 
 /// Reads a workcell description. @throws std::runtime_error "workcell description 'FILE':

@@ -29,6 +29,7 @@
 #include "sim/simulation.h"
 #include "smartmove/smartmove.h"
 #include "testing/test_components.h"
+#include "tool/power_tool.h"
 #include "workcell/grippers.h"
 #include "workcell/sim_cell_description.h"
 
@@ -242,7 +243,8 @@ class SimWorkcell final : public Workcell {
     checkDescriptionMatchesModel(robot_description_, *kinematics, arm_config.tcp_in_flange, robot_);
     auto arm = std::make_shared<arm::ArmComponent>(
         arm_driver, clock(), collisions_, waypoints_,
-        [this](const std::string& frame) { return components().world().worldPose(frame); }, kinematics, arm_config);
+        [this](const std::string& frame) { return components().world().worldPose(frame); }, kinematics, arm_config,
+        arm::ForceControl{&simulation_->forceTorqueSensor(), &simulation_->cartesianController()});
     // The cell's motion service: what SmartMove asks (IK, collisions, plans); it moves the arm
     // through the arm's operations.
     motion_ = std::make_unique<arm::MotionPlanner>(arm_driver, clock(), collisions_, kinematics, arm_config);
@@ -260,6 +262,26 @@ class SimWorkcell final : public Workcell {
     add(calibration_);
     add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
         {"table_center", tableCenter()}, {"robot_base", cell_.robot_base}}));
+    // The power tool on its driver (the simulator's); its shape is an object class SmartGrasp
+    // picks it up by. The stand and the workpiece are obstacles the planner knows.
+    std::vector<world::ObjectClass> classes = simulation_->objectClasses();
+    if (sim::SimPowerTool* tool = simulation_->powerTool(); tool != nullptr && tool->setup()) {
+      const sim::PowerToolSetup& setup = *tool->setup();
+      tool::PowerToolOptions tool_options;
+      tool_options.docked_pose = setup.dockedPose();
+      add(std::make_shared<tool::PowerTool>(*tool, clock(), setup.tool, tool_options));
+      classes.push_back(setup.tool.objectClass());
+      if (scene_.power_tool) {
+        collisions_.setBox("tool_stand", setup.stand * Eigen::Translation3d(0, 0, setup.tool.stand_size.z() / 2),
+                           setup.tool.stand_size);
+      }
+    }
+    if (scene_.workpiece) {
+      collisions_.setBox(
+          "workpiece",
+          sim::workpieceTop(*scene_.workpiece) * Eigen::Translation3d(0, 0, -scene_.workpiece->size.z() / 2),
+          scene_.workpiece->size);
+    }
     if (options.test_oracle_perception) {
       add(std::make_shared<testing::OraclePerception>([simulation = simulation_.get()] {
         std::vector<testing::TruePart> parts;
@@ -280,12 +302,11 @@ class SimWorkcell final : public Workcell {
     smartmove_config.gripper_links = gripperLinks(robot_description_, gripper_model_);
     smartmove_config.gripper = gripper_model_.geometry;
     smartmove_config.finger_link = gripper_model_.finger_link;
-    smartmove_ =
-        std::make_shared<smartmove::SmartMoveComponent>(*motion_, *arm, *gripper, components().world(), collisions_,
-                                                        simulation_->objectClasses(), grasps_, smartmove_config);
+    smartmove_ = std::make_shared<smartmove::SmartMoveComponent>(*motion_, *arm, *gripper, components().world(),
+                                                                 collisions_, classes, grasps_, smartmove_config);
     add(smartmove_);
     // Last: it derives its predicates from what the others report.
-    add(std::make_shared<predicator::Predicator>(components().world(), simulation_->objectClasses()));
+    add(std::make_shared<predicator::Predicator>(components().world(), classes));
     if (faults_) {
       faults_->checkTargets();
     }
@@ -418,6 +439,10 @@ class SimWorkcell final : public Workcell {
     sim_options.robot_base = cell.robot_base;
     sim_options.placement_seed = options.seed;
     sim_options.spare_classes = options.spare_parts;
+    if (cell.power_tool) {
+      sim_options.power_tool = sim::PowerToolSetup{
+          tool::loadPowerToolDescription(tool::powerToolFile(cell.power_tool->tool)), cell.power_tool->stand};
+    }
     if (options.camera_move) {
       sim::CameraOffset offset;
       offset.random = true;

@@ -14,6 +14,10 @@ const char* toString(SymbolKind kind) {
       return "joints";
     case SymbolKind::kObjectClass:
       return "class";
+    case SymbolKind::kWrench:
+      return "wrench";
+    case SymbolKind::kNumber:
+      return "number";
   }
   return "?";
 }

@@ -1,7 +1,8 @@
 #pragma once
 // The world state a task plan sees: exactly the union of the symbols and predicates that
 // the components report (the paper, Sec. III-A). Symbols are 6-DOF frames, joint
-// configurations and object classes; predicates are named relations over symbol names.
+// configurations, object classes and measurements (a wrench, a tool's speed); predicates are
+// named relations over symbol names.
 
 #include <cstdint>
 #include <functional>
@@ -36,14 +37,28 @@ struct ObjectClassValue {
   std::string description;
 };
 
-enum class SymbolKind { kFrame, kJoints, kObjectClass };
+/// A force and a torque (N, N m) in the axes of `frame`, the torque about its origin: the arm's
+/// `wrench`, what the tool pushes its surroundings with, in the tool frame at the tool centre point.
+struct WrenchValue {
+  std::string frame;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();
+};
+
+/// One measured quantity with its unit (a power tool's speed in rpm).
+struct NumberValue {
+  double value = 0.0;
+  std::string unit;
+};
+
+enum class SymbolKind { kFrame, kJoints, kObjectClass, kWrench, kNumber };
 const char* toString(SymbolKind kind);
 
 struct Symbol {
   std::string name;
   std::string source;  // the component that reports it
   TimePoint stamp{};
-  std::variant<FrameValue, JointsValue, ObjectClassValue> value;
+  std::variant<FrameValue, JointsValue, ObjectClassValue, WrenchValue, NumberValue> value;
   /// The colour seen on the object a frame stands for (perception: the mean RGB of its points,
   /// in [0, 1]); absent for other symbols.
   std::optional<Eigen::Vector3d> color;
@@ -51,6 +66,8 @@ struct Symbol {
   SymbolKind kind() const { return static_cast<SymbolKind>(value.index()); }
   const FrameValue* frame() const { return std::get_if<FrameValue>(&value); }
   const JointsValue* joints() const { return std::get_if<JointsValue>(&value); }
+  const WrenchValue* wrench() const { return std::get_if<WrenchValue>(&value); }
+  const NumberValue* number() const { return std::get_if<NumberValue>(&value); }
 };
 
 struct Predicate {

@@ -299,9 +299,10 @@ TEST(Scene, BadValuesAreErrorsNamingTheField) {
             prefix + "parts[0].height: must be within 0 .. 0.5 m above the table, got -0.1");
   EXPECT_EQ(problem(R"({"parts": [{"class": "node", "region": "left", "height": 0.05}]})"),
             prefix + "parts[0].height: only a part placed with \"at\" has a height");
-  EXPECT_EQ(
-      problem(R"({"regoins": {}, "parts": []})"),
-      prefix + "regoins: unknown field (known: description, seed, min_gap, camera_offset, regions, parts, jig, wire)");
+  EXPECT_EQ(problem(R"({"regoins": {}, "parts": []})"),
+            prefix +
+                "regoins: unknown field (known: description, seed, min_gap, camera_offset, regions, parts, jig, wire, "
+                "workpiece, power_tool)");
   EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5]}]})"),
             prefix + "parts[0].at: must be [x, y] or [x, y, yaw] (m, m, degrees), not [0.5]");
   EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, null]}]})"),
