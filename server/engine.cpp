@@ -1,9 +1,10 @@
-// The Engine's thread and run control: the loop (idle ticks between runs, paced), starting,
-// executing, pausing, stepping and stopping runs, and the observer that records each node's
-// status. The work network threads hand it comes through task_queue.h; the lists the editor
-// offers are in engine_lists.cpp (the palette in palette.cpp), what the stream shows in
-// engine_views.cpp (the cell's state in cell_state.cpp), the simulator's views in
-// engine_sim_views.cpp; runs are logged by run_log_writer.h.
+// The Engine's thread: the loop (idle ticks between runs, paced), starting and executing runs,
+// holding a paused one. The work network threads hand it comes through task_queue.h; a run's
+// state and JSON are run_state.h's, its observer run_observer.h's, its pause, step and stop
+// run_controls.h's; the lists the editor offers are in engine_lists.cpp (the palette in
+// palette.cpp), what the stream shows in engine_views.cpp (the cell's state in
+// cell_state.cpp), the simulator's views in engine_sim_views.cpp; runs are logged by
+// run_log_writer.h.
 
 #include "server/engine_parts.h"
 
@@ -12,6 +13,7 @@
 #include "server/cell_state.h"
 #include "server/guard.h"
 #include "server/plan_json.h"
+#include "server/run_observer.h"
 #include "workcell/workcell.h"
 
 namespace costar::server {
@@ -54,7 +56,7 @@ void Engine::shutdown() {
     return;
   }
   stopping_ = true;
-  stop_requested_ = true;
+  controls_.requestStop();
   tasks_.notify();
   if (thread_.joinable()) {
     thread_.join();
@@ -136,17 +138,17 @@ void Engine::executePending() {
   pending_tree_.reset();
   pending_run_.reset();
 
-  observer_ = std::make_unique<Observer>(*this);
-  tree.addObserver(observer_.get());
+  RunObserver observer(*run, mutex_, log_.get(), options_.max_logged_transitions);
+  tree.addObserver(&observer);
   bt::ExecutorOptions executor_options;
   executor_options.tick_period = options_.tick_period;
   bt::Executor executor(tree, cell_->clock(), executor_options);
-  paused_ = start_paused_;
+  controls_.setPaused(start_paused_);
   next_logged_state_ = cell_->clock().now();
   executor.setBeforeTick([this, &executor, &run] {
     hook(true);
     logState(*run);
-    if (applyControls(executor)) {
+    if (controls_.apply(executor)) {
       return;
     }
     holdWhilePaused(executor);
@@ -167,8 +169,7 @@ void Engine::executePending() {
     result.failure_path = tree.mainTreeId();
     result.failure_reason = std::string("the engine failed: ") + error.what();
   }
-  tree.removeObserver(observer_.get());
-  observer_.reset();
+  tree.removeObserver(&observer);
   pacer_.setFactor(options_.pace > 0 ? options_.pace : 1.0);
   cell_->beforeTick();
   next_logged_state_ = TimePoint::min();  // the cell as the run left it
@@ -186,11 +187,9 @@ void Engine::executePending() {
     run->cpu_seconds = threadCpuSeconds() - cpu_start;
     run->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     if (!run->dirty.empty()) {
-      events_.push_back(statusesJson(*run, true).dump(-1, ' ', false, json::error_handler_t::replace));
+      events_.push_back(jsonText(statusesJson(*run, true)));
     }
-    json ended = runJson(*run, false);
-    events_.push_back(
-        json{{"type", "run_ended"}, {"run", std::move(ended)}}.dump(-1, ' ', false, json::error_handler_t::replace));
+    events_.push_back(jsonText({{"type", "run_ended"}, {"run", runJson(*run, controls_.paused(), false)}}));
     finished_.push_front(run);
     while (finished_.size() > options_.remembered_runs) {
       finished_.pop_back();
@@ -205,10 +204,7 @@ void Engine::executePending() {
     record.truncated = run->truncated;
   }
   active_run_ = 0;
-  paused_ = false;
-  stop_requested_ = false;
-  pause_requested_ = 0;
-  steps_requested_ = 0;
+  controls_.reset(false);
   if (!run->operation && log_) {
     log_->end(std::move(record));
   }
@@ -216,30 +212,14 @@ void Engine::executePending() {
   takeSnapshot();
 }
 
-bool Engine::applyControls(bt::Executor& executor) {
-  if (stop_requested_.exchange(false)) {
-    executor.requestStop();
-    paused_ = false;
-    return true;
-  }
-  if (const int pause = pause_requested_.exchange(0); pause != 0) {
-    paused_ = pause > 0;
-  }
-  if (steps_requested_.load() > 0) {
-    paused_ = true;  // a step while running pauses after it
-  }
-  return false;
-}
-
 void Engine::holdWhilePaused(bt::Executor& executor) {
-  if (!paused_) {
+  if (!controls_.paused()) {
     return;
   }
   bool held = false;
   while (true) {
-    if (steps_requested_.load() > 0) {
-      --steps_requested_;  // this tick; the executor then lets one tick period pass
-      break;
+    if (controls_.takeStep()) {
+      break;  // this tick; the executor then lets one tick period pass
     }
     // The clock stands still: a wall-clock period of waiting (answering the network), the
     // world refreshed and shown as it is.
@@ -256,7 +236,7 @@ void Engine::holdWhilePaused(bt::Executor& executor) {
       const std::lock_guard lock(mutex_);
       ++stats_.ticks;
     }
-    if (applyControls(executor) || !paused_ || stopping_) {
+    if (controls_.apply(executor) || !controls_.paused() || stopping_) {
       break;
     }
   }
@@ -274,76 +254,13 @@ void Engine::logState(const RunState& run) {
     return;
   }
   next_logged_state_ = now + fromSeconds(1.0 / options_.logged_state_hz);
-  json state = cellState(*cell_, active_run_.load(), paused_);
+  json state = cellState(*cell_, active_run_.load(), controls_.paused());
   state.erase("waypoints");
   state.erase("frames");
   StateRecord record;
   record.t = toSeconds(now - run.start_time);
-  record.state = state.dump(-1, ' ', false, json::error_handler_t::replace);
+  record.state = jsonText(state);
   log_->addState(run.id, std::move(record));
-}
-
-void Engine::onTransition(TimePoint time, const bt::TreeNode& node, bt::Status from, bt::Status to) {
-  RunState* run = current_.get();  // set before the run starts; only this thread replaces it
-  if (run == nullptr || node.uid() >= run->statuses.size()) {
-    return;
-  }
-  json data;
-  if (bt::isCompleted(to)) {
-    if (const auto* operation = dynamic_cast<const component::OperationNode*>(&node)) {
-      const json& result_data = operation->lastResult().data;
-      if (!result_data.is_null() && !result_data.empty()) {
-        data = result_data;
-      }
-    }
-  }
-  TransitionRecord record;
-  record.t = toSeconds(time - run->start_time);
-  record.uid = node.uid();
-  record.from = bt::toString(from);
-  record.to = bt::toString(to);
-  if (to == bt::Status::kFailure) {
-    record.reason = std::string(node.failureReason());
-    record.origin = node.failureOrigin().path();
-  }
-  bool keep = false;
-  {
-    const std::lock_guard lock(mutex_);
-    RunState::Node& state = run->statuses[node.uid()];
-    state.current = to;
-    if (to == bt::Status::kIdle) {
-      if (from == bt::Status::kRunning) {
-        state.last = "HALTED";
-      }
-    } else {
-      state.last = bt::toString(to);
-    }
-    if (to == bt::Status::kRunning) {
-      state.reason.clear();
-      state.origin.clear();
-    } else if (to == bt::Status::kFailure) {
-      state.reason = record.reason;
-      state.origin = record.origin;
-    }
-    if (!data.is_null()) {
-      state.data = data;
-    }
-    if (!state.dirty) {
-      state.dirty = true;
-      run->dirty.push_back(node.uid());
-    }
-    record.seq = ++run->transitions;
-    keep = !run->operation && log_ && record.seq <= options_.max_logged_transitions;
-    if (!run->operation && record.seq > options_.max_logged_transitions) {
-      run->truncated = true;
-    }
-  }
-  if (keep) {
-    if (!data.is_null()) {
-      record.data = data.dump(-1, ' ', false, json::error_handler_t::replace);
-    }
-    log_->addTransition(run->id, std::move(record));
-  }
 }
 
 std::vector<bt::Diagnostic> Engine::problems(const bt::Plan& plan) {
@@ -422,11 +339,8 @@ StartResult Engine::start(RunRequest run_request) {
     run->statuses.resize(run->nodes.size());
     run->start_time = cell_->clock().now();
     run->started_at = unixNow();
-    stop_requested_ = false;
-    pause_requested_ = 0;
-    steps_requested_ = 0;
+    controls_.reset(request.start_paused);
     start_paused_ = request.start_paused;
-    paused_ = request.start_paused;
     {
       const std::lock_guard lock(mutex_);
       // Plan runs are numbered 1, 2, 3 ... as the run log numbers them; single operations (a
@@ -434,8 +348,7 @@ StartResult Engine::start(RunRequest run_request) {
       run->id = run->operation ? next_operation_id_-- : next_run_id_++;
       current_ = run;
       ++stats_.runs;
-      events_.push_back(json{{"type", "run_started"}, {"run", runJson(*run, true)}}.dump(
-          -1, ' ', false, json::error_handler_t::replace));
+      events_.push_back(jsonText({{"type", "run_started"}, {"run", runJson(*run, controls_.paused(), true)}}));
     }
     active_run_ = run->id;
     if (!run->operation && log_) {
@@ -496,20 +409,7 @@ bool Engine::control(RunControl control) {
   if (active_run_ == 0) {
     return false;
   }
-  switch (control) {
-    case RunControl::kStop:
-      stop_requested_ = true;
-      break;
-    case RunControl::kPause:
-      pause_requested_ = 1;
-      break;
-    case RunControl::kResume:
-      pause_requested_ = -1;
-      break;
-    case RunControl::kStep:
-      ++steps_requested_;
-      break;
-  }
+  controls_.request(control);
   tasks_.notify();
   return true;
 }

@@ -36,7 +36,9 @@
 #include "server/backend.h"
 #include "server/pacing.h"
 #include "server/palette.h"
+#include "server/run_controls.h"
 #include "server/run_log_writer.h"
+#include "server/run_state.h"
 #include "server/store.h"
 #include "server/task_queue.h"
 
@@ -121,7 +123,7 @@ class Engine final : public Backend {
 
   /// The fatal-error path (fatal.h): asks the engine thread to stop the active run (which
   /// cancels its operations: the arm decelerates and stops). Async-signal-safe.
-  void requestStop() noexcept { stop_requested_ = true; }
+  void requestStop() noexcept { controls_.requestStop(); }
   /// Whether a run or an operation is active. Async-signal-safe.
   bool runActive() const noexcept { return active_run_.load() != 0; }
 
@@ -130,9 +132,6 @@ class Engine final : public Backend {
   void setPace(double pace);
 
  private:
-  struct RunState;
-  class Observer;
-
   /// Runs `task` on the engine thread and waits for its result.
   template <typename F>
   auto call(F task) -> decltype(task());
@@ -144,8 +143,6 @@ class Engine final : public Backend {
   std::vector<bt::Diagnostic> problems(const bt::Plan& plan);
   void loop();
   void hook(bool running);
-  /// Applies stop, pause and resume requests to a run; true when it is to stop.
-  bool applyControls(bt::Executor& executor);
   /// Holds a paused run (the clock stands still) until it resumes, a step is asked for (then
   /// true: tick once) or it is stopped.
   void holdWhilePaused(bt::Executor& executor);
@@ -154,9 +151,6 @@ class Engine final : public Backend {
   void waitWall(std::chrono::steady_clock::duration duration);
   void executePending();
   void takeSnapshot();
-  void onTransition(TimePoint time, const bt::TreeNode& node, bt::Status from, bt::Status to);
-  nlohmann::json runJson(const RunState& run, bool with_nodes) const;
-  nlohmann::json statusesJson(RunState& run, bool all);
 
   std::unique_ptr<workcell::Workcell> owned_cell_;  // a cell made by the engine (reset), or given to it
   workcell::Workcell* cell_;                        // the cell now (engine thread only, after construction)
@@ -172,15 +166,11 @@ class Engine final : public Backend {
 
   // Control of the active run, set by network threads, applied by the engine thread.
   std::atomic<std::int64_t> active_run_{0};
-  std::atomic<bool> stop_requested_{false};
-  std::atomic<int> pause_requested_{0};  // +1 pause, -1 resume
-  std::atomic<int> steps_requested_{0};
-  std::atomic<bool> paused_{false};
+  RunControls controls_;
 
   // Engine-thread only.
   std::optional<bt::Tree> pending_tree_;
   std::shared_ptr<RunState> pending_run_;
-  std::unique_ptr<Observer> observer_;
   Pacer pacer_;
   std::atomic<double> pace_request_{-1};
   std::chrono::steady_clock::time_point next_snapshot_{};

@@ -1,6 +1,6 @@
 #pragma once
 // Private to the Engine's parts (engine.cpp, engine_lists.cpp, engine_views.cpp,
-// engine_sim_views.cpp): the state of one run as the browser sees it, the tree observer, and
+// engine_sim_views.cpp, cell_state.cpp): JSON of poses, the engine thread's CPU time, and
 // Engine::call, which hands a task to the engine thread and waits for its answer. Not for
 // other parts of the server.
 
@@ -45,52 +45,6 @@ using engine_detail::poseJson;
 using engine_detail::rounded;
 using engine_detail::threadCpuSeconds;
 using nlohmann::json;
-
-// One run (a plan or a single operation) as the browser sees it.
-struct Engine::RunState {
-  struct Node {
-    bt::Status current = bt::Status::kIdle;
-    std::string last = "IDLE";  // last status other than IDLE; HALTED when stopped while RUNNING
-    std::string reason;
-    std::string origin;
-    json data;  // an operation's result data (SmartMove candidates, ...)
-    bool dirty = false;
-  };
-  std::int64_t id = 0;
-  bool operation = false;
-  std::string plan_name;
-  int version = 0;
-  std::string label;  // the main tree's ID, or the operation's node type
-  std::string workcell;
-  std::string xml;
-  json plan_json;  // a plan run's plan as the editor's JSON (any page can show what runs)
-  std::vector<RunNode> nodes;
-  std::vector<Node> statuses;
-  std::vector<std::uint32_t> dirty;
-  bool active = true;
-  bool stopped = false;
-  std::string result;
-  std::string failure_path;
-  std::string failure_reason;
-  double started_at = 0;
-  double clock_seconds = 0;
-  double wall_seconds = 0;
-  double cpu_seconds = 0;  // the engine thread's CPU time during the run
-  TimePoint start_time{};
-  std::uint64_t transitions = 0;
-  bool truncated = false;
-};
-
-class Engine::Observer final : public bt::TreeObserver {
- public:
-  explicit Observer(Engine& engine) : engine_(engine) {}
-  void onTransition(TimePoint time, const bt::TreeNode& node, bt::Status from, bt::Status to) override {
-    engine_.onTransition(time, node, from, to);
-  }
-
- private:
-  Engine& engine_;
-};
 
 template <typename F>
 auto Engine::call(F task) -> decltype(task()) {
