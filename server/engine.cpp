@@ -1,18 +1,17 @@
 // The Engine's thread: the loop (idle ticks between runs, paced), starting and executing runs,
-// holding a paused one. The work network threads hand it comes through task_queue.h; a run's
-// state and JSON are run_state.h's, its observer run_observer.h's, its pause, step and stop
-// run_controls.h's; the lists the editor offers are in engine_lists.cpp (the palette in
-// palette.cpp), what the stream shows in engine_views.cpp (the cell's state in
-// cell_state.cpp), the simulator's views in engine_sim_views.cpp; runs are logged by
-// run_log_writer.h.
+// holding a paused one. The work network threads hand it comes through task_queue.h; a run is
+// prepared and ended by run_lifecycle.h, its state and JSON are run_state.h's, its observer
+// run_observer.h's, its pause, step and stop run_controls.h's, the pace pacing.h's; the lists
+// the editor offers are in engine_lists.cpp (the palette in palette.cpp), what the stream
+// shows in engine_views.cpp (the cell's state in cell_state.cpp), the simulator's views in
+// engine_sim_views.cpp; runs are logged by run_log_writer.h.
 
 #include "server/engine_parts.h"
 
 #include "bt/builder.h"
-#include "component/nodes.h"
 #include "server/cell_state.h"
 #include "server/guard.h"
-#include "server/plan_json.h"
+#include "server/run_lifecycle.h"
 #include "server/run_observer.h"
 #include "workcell/workcell.h"
 
@@ -24,9 +23,7 @@ Engine::Engine(std::unique_ptr<workcell::Workcell> cell, Store* store, EngineOpt
 }
 
 Engine::Engine(workcell::Workcell& cell, Store* store, EngineOptions options)
-    : cell_(&cell), options_(std::move(options)), palette_(describePalette(cell)) {
-  const double pace = options_.pace;
-  pacer_.setFactor(pace > 0 ? pace : 1.0);
+    : cell_(&cell), options_(std::move(options)), palette_(describePalette(cell)), pace_(options_.pace) {
   if (store != nullptr) {
     next_run_id_ = store->maxRunId() + 1;
     log_ = std::make_unique<RunLogWriter>(*store);
@@ -80,12 +77,12 @@ void Engine::waitWall(std::chrono::steady_clock::duration duration) {
 void Engine::loop() {
   while (!stopping_) {
     tasks_.runPending();
-    if (pending_tree_) {
+    if (pending_) {
       executePending();
       continue;
     }
     try {
-      hook(false);
+      hook();
       Clock& clock = cell_->clock();
       clock.sleepUntil(clock.now() + options_.tick_period);
     } catch (const std::exception& error) {
@@ -100,15 +97,9 @@ void Engine::loop() {
   tasks_.runPending();
 }
 
-void Engine::hook(bool running) {
+void Engine::hook() {
   tasks_.runPending();
-  if (const double pace = pace_request_.exchange(-1); pace >= 0) {
-    {
-      const std::lock_guard lock(mutex_);
-      options_.pace = pace;
-    }
-    pacer_.setFactor(running && pace <= 0 ? 0.0 : (pace > 0 ? pace : 1.0));
-  }
+  pace_.apply();
   cell_->beforeTick();
   const auto now = std::chrono::steady_clock::now();
   if (now >= next_snapshot_) {
@@ -123,7 +114,7 @@ void Engine::hook(bool running) {
     ++stats_.ticks;
   }
   if (cell_->clock().simulated()) {
-    const auto delay = pacer_.delay(cell_->clock().now(), std::chrono::steady_clock::now());
+    const auto delay = pace_.delay(cell_->clock().now(), std::chrono::steady_clock::now());
     if (delay > std::chrono::steady_clock::duration::zero()) {
       waitWall(delay);
       const std::lock_guard lock(mutex_);
@@ -133,10 +124,9 @@ void Engine::hook(bool running) {
 }
 
 void Engine::executePending() {
-  std::shared_ptr<RunState> run = std::move(pending_run_);
-  bt::Tree tree = std::move(*pending_tree_);
-  pending_tree_.reset();
-  pending_run_.reset();
+  std::shared_ptr<RunState> run = std::move(pending_->run);
+  bt::Tree tree = std::move(pending_->tree);
+  pending_.reset();
 
   RunObserver observer(*run, mutex_, log_.get(), options_.max_logged_transitions);
   tree.addObserver(&observer);
@@ -146,14 +136,14 @@ void Engine::executePending() {
   controls_.setPaused(start_paused_);
   next_logged_state_ = cell_->clock().now();
   executor.setBeforeTick([this, &executor, &run] {
-    hook(true);
+    hook();
     logState(*run);
     if (controls_.apply(executor)) {
       return;
     }
     holdWhilePaused(executor);
   });
-  pacer_.setFactor(options_.pace);
+  pace_.runBegins();
 
   bt::RunResult result;
   const double cpu_start = threadCpuSeconds();
@@ -170,22 +160,15 @@ void Engine::executePending() {
     result.failure_reason = std::string("the engine failed: ") + error.what();
   }
   tree.removeObserver(&observer);
-  pacer_.setFactor(options_.pace > 0 ? options_.pace : 1.0);
+  pace_.runEnds();
   cell_->beforeTick();
   next_logged_state_ = TimePoint::min();  // the cell as the run left it
   logState(*run);
 
-  RunRecord record;
   {
     const std::lock_guard lock(mutex_);
-    run->active = false;
-    run->stopped = result.stopped;
-    run->result = result.stopped ? "STOPPED" : bt::toString(result.status);
-    run->failure_path = result.failure_path;
-    run->failure_reason = result.failure_reason;
-    run->clock_seconds = toSeconds(result.elapsed);
-    run->cpu_seconds = threadCpuSeconds() - cpu_start;
-    run->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    endRun(*run, result, threadCpuSeconds() - cpu_start,
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count());
     if (!run->dirty.empty()) {
       events_.push_back(jsonText(statusesJson(*run, true)));
     }
@@ -194,19 +177,11 @@ void Engine::executePending() {
     while (finished_.size() > options_.remembered_runs) {
       finished_.pop_back();
     }
-    record.id = run->id;
-    record.result = run->result;
-    record.ended_at = unixNow();
-    record.clock_seconds = run->clock_seconds;
-    record.failure_path = run->failure_path;
-    record.failure_reason = run->failure_reason;
-    record.transitions = run->transitions;
-    record.truncated = run->truncated;
   }
   active_run_ = 0;
   controls_.reset(false);
   if (!run->operation && log_) {
-    log_->end(std::move(record));
+    log_->end(runRecord(*run));
   }
   cell_->beforeTick();
   takeSnapshot();
@@ -241,7 +216,7 @@ void Engine::holdWhilePaused(bt::Executor& executor) {
     }
   }
   if (held) {
-    pacer_.reset();  // the clock stood still on purpose: no burst to catch up
+    pace_.reset();  // the clock stood still on purpose: no burst to catch up
   }
 }
 
@@ -282,63 +257,19 @@ std::vector<bt::Diagnostic> Engine::checkForCell(const bt::Plan& plan) {
 
 StartResult Engine::start(RunRequest run_request) {
   return call([this, shared = std::make_shared<RunRequest>(std::move(run_request))]() -> StartResult {
-    RunRequest& request = *shared;
+    const RunRequest& request = *shared;
     StartResult out;
-    if (active_run_ != 0 || pending_tree_) {
+    if (active_run_ != 0 || pending_) {
       out.status = 409;
       out.error = "run " + std::to_string(active_run_.load()) + " is active: stop it or wait for it to end";
       return out;
     }
-    const bt::PlanTree* main = nullptr;
-    try {
-      main = request.plan.findTree(request.plan.mainTreeId());
-    } catch (const bt::PlanError& error) {
-      out.status = 422;
-      out.diagnostics = error.diagnostics();
-      return out;
+    auto prepared = prepareRun(request, *cell_, [this](const bt::Plan& plan) { return problems(plan); });
+    if (auto* refusal = std::get_if<StartResult>(&prepared)) {
+      return std::move(*refusal);
     }
-    if (request.operation && main != nullptr) {
-      const bt::NodeSpec* spec = cell_->nodes().find(main->root.id);
-      if (spec != nullptr && spec->kind != bt::NodeKind::kAction && spec->kind != bt::NodeKind::kCondition) {
-        out.status = 422;
-        out.error = "an operation is one action or condition, not a " + std::string(bt::toString(spec->kind));
-        return out;
-      }
-    }
-    try {
-      if (auto diagnostics = problems(request.plan); !diagnostics.empty()) {
-        out.status = 422;
-        out.diagnostics = std::move(diagnostics);
-        return out;
-      }
-      pending_tree_.emplace(bt::buildTree(request.plan, cell_->nodes(), cell_->clock()));
-    } catch (const bt::PlanError& error) {
-      out.status = 422;
-      out.diagnostics = error.diagnostics();
-      return out;
-    } catch (const std::exception& error) {
-      out.status = 422;
-      out.error = error.what();
-      return out;
-    }
-    auto run = std::make_shared<RunState>();
-    run->operation = request.operation;
-    run->plan_name = request.plan_name;
-    run->version = request.version;
-    run->label = request.operation ? (main != nullptr ? main->root.id : "") : pending_tree_->mainTreeId();
-    run->xml = request.xml;
-    run->workcell = cell_->name();
-    if (!request.operation) {
-      run->plan_json = planFileToJson(request.plan.file);
-    }
-    for (const bt::TreeNode* node : pending_tree_->nodes()) {
-      run->nodes.push_back({node->uid(),
-                            node->parent() != nullptr ? static_cast<std::int64_t>(node->parent()->uid()) : -1,
-                            node->id(), node->name(), node->path()});
-    }
-    run->statuses.resize(run->nodes.size());
-    run->start_time = cell_->clock().now();
-    run->started_at = unixNow();
+    pending_.emplace(std::move(std::get<PreparedRun>(prepared)));
+    const std::shared_ptr<RunState>& run = pending_->run;
     controls_.reset(request.start_paused);
     start_paused_ = request.start_paused;
     {
@@ -352,16 +283,8 @@ StartResult Engine::start(RunRequest run_request) {
     }
     active_run_ = run->id;
     if (!run->operation && log_) {
-      RunRecord begin;
-      begin.id = run->id;
-      begin.plan = run->plan_name;
-      begin.version = run->version;
-      begin.xml = run->xml;
-      begin.started_at = run->started_at;
-      begin.workcell = cell_->name();
-      log_->begin(std::move(begin), run->nodes);
+      log_->begin(runRecord(*run), run->nodes);
     }
-    pending_run_ = run;
     out.run_id = run->id;
     return out;
   });
@@ -375,7 +298,7 @@ StartResult Engine::resetScene() {
       out.error = "this cell has no simulated scene to reset";
       return out;
     }
-    if (active_run_ != 0 || pending_tree_) {
+    if (active_run_ != 0 || pending_) {
       out.status = 409;
       out.error = "run " + std::to_string(active_run_.load()) + " is active: stop it before resetting the scene";
       return out;
@@ -394,7 +317,7 @@ StartResult Engine::resetScene() {
       out.error = std::string("the scene could not be made again: ") + error.what();
       return out;
     }
-    pacer_.reset();
+    pace_.reset();
     cell_->beforeTick();
     takeSnapshot();
     {
@@ -420,7 +343,7 @@ EngineStats Engine::stats() const {
 }
 
 void Engine::setPace(double pace) {
-  pace_request_ = std::max(0.0, pace);
+  pace_.request(pace);
   tasks_.notify();
 }
 

@@ -37,6 +37,7 @@
 #include "server/pacing.h"
 #include "server/palette.h"
 #include "server/run_controls.h"
+#include "server/run_lifecycle.h"
 #include "server/run_log_writer.h"
 #include "server/run_state.h"
 #include "server/store.h"
@@ -142,7 +143,9 @@ class Engine final : public Backend {
   /// Every problem of a plan for this cell: the plan's own, then checkAgainstCell (engine thread).
   std::vector<bt::Diagnostic> problems(const bt::Plan& plan);
   void loop();
-  void hook(bool running);
+  /// Before each tick (a run's or the idle loop's): answers the network, applies a pace asked
+  /// for, refreshes the cell, publishes a snapshot when one is due, waits for the pace.
+  void hook();
   /// Holds a paused run (the clock stands still) until it resumes, a step is asked for (then
   /// true: tick once) or it is stopped.
   void holdWhilePaused(bt::Executor& executor);
@@ -168,11 +171,11 @@ class Engine final : public Backend {
   std::atomic<std::int64_t> active_run_{0};
   RunControls controls_;
 
+  // The pace, asked for by any thread, kept by the engine thread.
+  PaceControl pace_;
+
   // Engine-thread only.
-  std::optional<bt::Tree> pending_tree_;
-  std::shared_ptr<RunState> pending_run_;
-  Pacer pacer_;
-  std::atomic<double> pace_request_{-1};
+  std::optional<PreparedRun> pending_;  // started, to execute
   std::chrono::steady_clock::time_point next_snapshot_{};
   bool start_paused_ = false;
   TimePoint next_logged_state_{};

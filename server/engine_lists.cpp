@@ -150,7 +150,7 @@ std::optional<json> Engine::robot() {
 json Engine::info() {
   json out = palette_.info;
   const std::lock_guard lock(mutex_);
-  out["pace"] = options_.pace;
+  out["pace"] = pace_.pace();
   out["active_run"] = active_run_.load();
   if (!last_error_.empty()) {
     out["last_error"] = last_error_;

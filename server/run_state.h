@@ -40,7 +40,8 @@ struct RunState {
   std::string result;
   std::string failure_path;
   std::string failure_reason;
-  double started_at = 0;
+  double started_at = 0;  // Unix seconds
+  double ended_at = 0;
   double clock_seconds = 0;
   double wall_seconds = 0;
   double cpu_seconds = 0;  // the engine thread's CPU time during the run
