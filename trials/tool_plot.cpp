@@ -49,21 +49,25 @@ void writeForcePlot(const ToolTrace& trace, double force, double band, const std
   const double top = 90;
   const double width = kWidth - left - 40;
   const double height = 330;
-  const double t_end = trace.log.empty() ? 1.0 : std::max(1.0, trace.log.back().time);
+  const double t_start = trace.log.empty() ? 0.0 : std::floor(trace.log.front().time);
+  const double t_end = trace.log.empty() ? 1.0 : std::max(t_start + 1.0, trace.log.back().time);
   double f_max = force + band + 4.0;
   for (const auto& sample : trace.log) {
     f_max = std::max(f_max, sample.pad_force);
   }
   f_max = std::ceil(f_max / 5.0) * 5.0;
-  const auto x = [&](double t) { return left + width * t / t_end; };
+  const auto x = [&](double t) { return left + width * (t - t_start) / (t_end - t_start); };
   const auto y = [&](double f) { return top + height * (1.0 - f / f_max); };
 
   cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-  text(cr, left, 34, "Polishing: the pad's force on the workpiece (seed " + std::to_string(trace.seed) + ")", 20, true);
+  std::string title = trace.title;
+  if (const std::size_t at = title.find("SEED"); at != std::string::npos) {
+    title.replace(at, 4, std::to_string(trace.seed));
+  }
+  text(cr, left, 34, title, 20, true);
   text(cr, left, 58,
-       formatted("true contact force, 100 Hz; green band: %.0f", force) +
-           formatted(" +/- %.0f N (the judge's); ", band) +
-           "orange: the tool on; grey: the tool in the gripper; red: taken away",
+       formatted("true contact force, 100 Hz; green band: %.0f", force) + formatted(" +/- %.0f N (", band) +
+           trace.band_note + "); " + "orange: the tool on; grey: the tool in the gripper; red: taken away",
        13);
   // Strips under the plot: tool in the gripper, tool on, tool away.
   const double strip = top + height + 30;
@@ -104,9 +108,10 @@ void writeForcePlot(const ToolTrace& trace, double force, double band, const std
   for (double f = 0; f <= f_max + 1e-9; f += 5.0) {
     text(cr, left - 30, y(f) + 4, formatted("%.0f", f), 11);
   }
-  const double t_step = t_end > 60 ? 10.0 : 5.0;
-  for (double t = 0; t <= t_end + 1e-9; t += t_step) {
-    text(cr, x(t) - 8, top + height + 16, formatted("%.0f", t), 11);
+  const double span = t_end - t_start;
+  const double t_step = span > 60 ? 10.0 : span > 10 ? 5.0 : span > 5 ? 1.0 : 0.5;
+  for (double t = t_start; t <= t_end + 1e-9; t += t_step) {
+    text(cr, x(t) - 8, top + height + 16, formatted(t_step < 1.0 ? "%.1f" : "%.0f", t), 11);
   }
   text(cr, left + width - 150, top + height + 80, "simulated time (s)", 12);
   text(cr, 8, top - 10, "force (N)", 12);

@@ -19,9 +19,13 @@ struct ToolTrace {
   std::vector<sim::PowerToolSample> log;
   std::optional<sim::Coverage> coverage;
   std::vector<std::string> disturbances;
+  /// The force plot's title ("SEED" replaced by the seed) and what its band is.
+  std::string title = "Polishing: the pad's force on the workpiece (seed SEED)";
+  std::string band_note = "the judge's";
 };
 
-/// The force over time. @throws std::runtime_error naming the file when it cannot be written.
+/// The force over time, from the log's first sample to its last. @throws std::runtime_error naming the file when it
+/// cannot be written.
 void writeForcePlot(const ToolTrace& trace, double force, double band, const std::filesystem::path& png);
 /// The coverage map. @throws std::runtime_error naming the file when it cannot be written.
 void writeCoveragePlot(const ToolTrace& trace, const std::filesystem::path& png);
