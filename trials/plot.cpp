@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/files.h"
+#include "trials/cairo_png.h"
 #include "trials/judge.h"
 #include "trials/tool_plot.h"
 #include "trials/trials.h"
@@ -16,14 +16,6 @@
 namespace costar::trials {
 
 namespace {
-
-void text(cairo_t* cr, double x, double y, const std::string& s, double size, bool bold = false) {
-  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
-                         bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, size);
-  cairo_move_to(cr, x, y);
-  cairo_show_text(cr, s.c_str());
-}
 
 std::string shorten(const std::string& s, std::size_t width) {
   return s.size() <= width ? s : "..." + s.substr(s.size() - width + 3);
@@ -45,13 +37,13 @@ std::vector<std::filesystem::path> writePlot(const Summary& summary, const std::
   cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
   std::snprintf(line, sizeof line, "%s: %d of %d trials succeeded (%.1f %%)", summary.options.plan.filename().c_str(),
                 ok, n, n > 0 ? 100.0 * ok / n : 0.0);
-  text(cr, 30, 40, line, 22, true);
+  drawText(cr, 30, 40, line, 22, true);
   std::snprintf(line, sizeof line, "scene %s, judge '%s', seeds %llu..%llu, simulated cell %s with sensor noise",
                 summary.options.scene.filename().c_str(), summary.options.judge.c_str(),
                 static_cast<unsigned long long>(summary.options.seed),
                 static_cast<unsigned long long>(summary.options.seed + std::max(0, n - 1)),
                 summary.options.workcell.c_str());
-  text(cr, 30, 66, line, 14);
+  drawText(cr, 30, 66, line, 14);
 
   // Left: outcomes, success first, then each failure reason.
   std::vector<std::pair<std::string, int>> bars{{"success", ok}};
@@ -61,7 +53,7 @@ std::vector<std::filesystem::path> writePlot(const Summary& summary, const std::
       break;
     }
   }
-  text(cr, 30, 110, "Outcomes", 16, true);
+  drawText(cr, 30, 110, "Outcomes", 16, true);
   const double bar_left = 30;
   const double bar_width_max = 480;
   const int most = std::max(
@@ -78,8 +70,8 @@ std::vector<std::filesystem::path> writePlot(const Summary& summary, const std::
     cairo_fill(cr);
     cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
     std::snprintf(line, sizeof line, "%d", bars[i].second);
-    text(cr, bar_left + std::max(w, 2.0) + 6, y + 16, line, 13, true);
-    text(cr, bar_left, y + 38, shorten(bars[i].first, 78), 11);
+    drawText(cr, bar_left + std::max(w, 2.0) + 6, y + 16, line, 13, true);
+    drawText(cr, bar_left, y + 38, shorten(bars[i].first, 78), 11);
     y += 58;
   }
 
@@ -95,7 +87,7 @@ std::vector<std::filesystem::path> writePlot(const Summary& summary, const std::
   const double width = 440;
   const double height = 380;
   cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-  text(cr, left, 110, "Cycle time of successful trials (simulated s)", 16, true);
+  drawText(cr, left, 110, "Cycle time of successful trials (simulated s)", 16, true);
   cairo_set_line_width(cr, 1);
   cairo_move_to(cr, left, top);
   cairo_line_to(cr, left, top + height);
@@ -118,34 +110,20 @@ std::vector<std::filesystem::path> writePlot(const Summary& summary, const std::
     }
     cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
     std::snprintf(line, sizeof line, "%.0f", lo);
-    text(cr, left, top + height + 18, line, 12);
+    drawText(cr, left, top + height + 18, line, 12);
     std::snprintf(line, sizeof line, "%.0f", hi);
-    text(cr, left + width - 20, top + height + 18, line, 12);
+    drawText(cr, left + width - 20, top + height + 18, line, 12);
     std::snprintf(line, sizeof line, "%d", tallest);
-    text(cr, left - 25, top + 10, line, 12);
+    drawText(cr, left - 25, top + 10, line, 12);
     const auto stats = summary.cycleTimes();
     std::snprintf(line, sizeof line, "median %.1f s, 95th percentile %.1f s, mean %.1f s", stats.at("median"),
                   stats.at("p95"), stats.at("mean"));
-    text(cr, left, top + height + 45, line, 14);
+    drawText(cr, left, top + height + 45, line, 14);
   } else {
-    text(cr, left + 20, top + height / 2, "no successful trial", 14);
+    drawText(cr, left + 20, top + height / 2, "no successful trial", 14);
   }
 
-  // Encoded in memory, then written checked (core/files.h): a full disk is named as such.
-  std::string encoded;
-  const cairo_status_t status = cairo_surface_write_to_png_stream(
-      surface,
-      [](void* closure, const unsigned char* data, unsigned int length) {
-        static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-        return CAIRO_STATUS_SUCCESS;
-      },
-      &encoded);
-  cairo_destroy(cr);
-  cairo_surface_destroy(surface);
-  if (status != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error("cannot write plot '" + png.string() + "': " + cairo_status_to_string(status));
-  }
-  writeOutputFile(png, encoded);
+  writeSurfacePng(surface, cr, png);
   std::vector<std::filesystem::path> written = {png};
   for (const TrialResult& trial : summary.trials) {
     if (trial.tool) {

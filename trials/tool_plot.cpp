@@ -9,31 +9,16 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "trials/cairo_png.h"
+
 namespace costar::trials {
 
 namespace {
-
-void text(cairo_t* cr, double x, double y, const std::string& s, double size, bool bold = false) {
-  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
-                         bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, size);
-  cairo_move_to(cr, x, y);
-  cairo_show_text(cr, s.c_str());
-}
 
 std::string formatted(const char* pattern, double value) {
   char line[128];
   std::snprintf(line, sizeof line, pattern, value);
   return line;
-}
-
-void finish(cairo_surface_t* surface, cairo_t* cr, const std::filesystem::path& png) {
-  const cairo_status_t status = cairo_surface_write_to_png(surface, png.c_str());
-  cairo_destroy(cr);
-  cairo_surface_destroy(surface);
-  if (status != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error("cannot write plot '" + png.string() + "': " + cairo_status_to_string(status));
-  }
 }
 
 }  // namespace
@@ -64,11 +49,11 @@ void writeForcePlot(const ToolTrace& trace, double force, double band, const std
   if (const std::size_t at = title.find("SEED"); at != std::string::npos) {
     title.replace(at, 4, std::to_string(trace.seed));
   }
-  text(cr, left, 34, title, 20, true);
-  text(cr, left, 58,
-       formatted("true contact force, 100 Hz; green band: %.0f", force) + formatted(" +/- %.0f N (", band) +
-           trace.band_note + "); " + "orange: the tool on; grey: the tool in the gripper; red: taken away",
-       13);
+  drawText(cr, left, 34, title, 20, true);
+  drawText(cr, left, 58,
+           formatted("true contact force, 100 Hz; green band: %.0f", force) + formatted(" +/- %.0f N (", band) +
+               trace.band_note + "); " + "orange: the tool on; grey: the tool in the gripper; red: taken away",
+           13);
   // Strips under the plot: tool in the gripper, tool on, tool away.
   const double strip = top + height + 30;
   for (std::size_t i = 1; i < trace.log.size(); ++i) {
@@ -92,9 +77,9 @@ void writeForcePlot(const ToolTrace& trace, double force, double band, const std
     }
   }
   cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-  text(cr, 8, strip + 11, "held", 11);
-  text(cr, 8, strip + 27, "on", 11);
-  text(cr, 8, strip + 43, "away", 11);
+  drawText(cr, 8, strip + 11, "held", 11);
+  drawText(cr, 8, strip + 27, "on", 11);
+  drawText(cr, 8, strip + 43, "away", 11);
   // The band and the axes.
   cairo_set_source_rgba(cr, 0.2, 0.7, 0.3, 0.25);
   cairo_rectangle(cr, left, y(force + band), width, y(force - band) - y(force + band));
@@ -106,15 +91,15 @@ void writeForcePlot(const ToolTrace& trace, double force, double band, const std
   cairo_line_to(cr, left + width, top + height);
   cairo_stroke(cr);
   for (double f = 0; f <= f_max + 1e-9; f += 5.0) {
-    text(cr, left - 30, y(f) + 4, formatted("%.0f", f), 11);
+    drawText(cr, left - 30, y(f) + 4, formatted("%.0f", f), 11);
   }
   const double span = t_end - t_start;
   const double t_step = span > 60 ? 10.0 : span > 10 ? 5.0 : span > 5 ? 1.0 : 0.5;
   for (double t = t_start; t <= t_end + 1e-9; t += t_step) {
-    text(cr, x(t) - 8, top + height + 16, formatted(t_step < 1.0 ? "%.1f" : "%.0f", t), 11);
+    drawText(cr, x(t) - 8, top + height + 16, formatted(t_step < 1.0 ? "%.1f" : "%.0f", t), 11);
   }
-  text(cr, left + width - 150, top + height + 80, "simulated time (s)", 12);
-  text(cr, 8, top - 10, "force (N)", 12);
+  drawText(cr, left + width - 150, top + height + 80, "simulated time (s)", 12);
+  drawText(cr, 8, top - 10, "force (N)", 12);
   // The force.
   cairo_set_source_rgb(cr, 0.15, 0.3, 0.7);
   cairo_set_line_width(cr, 1.2);
@@ -135,10 +120,10 @@ void writeForcePlot(const ToolTrace& trace, double force, double band, const std
   double line_y = strip + 70;
   cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
   for (const std::string& event : trace.disturbances) {
-    text(cr, left, line_y, event, 12);
+    drawText(cr, left, line_y, event, 12);
     line_y += 16;
   }
-  finish(surface, cr, png);
+  writeSurfacePng(surface, cr, png);
 }
 
 void writeCoveragePlot(const ToolTrace& trace, const std::filesystem::path& png) {
@@ -156,12 +141,13 @@ void writeCoveragePlot(const ToolTrace& trace, const std::filesystem::path& png)
   cairo_set_source_rgb(cr, 1, 1, 1);
   cairo_paint(cr);
   cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-  text(cr, 30, 34, "Polishing: the marked area, texel by texel (seed " + std::to_string(trace.seed) + ")", 18, true);
-  text(cr, 30, 56,
-       formatted("%.0f", coverage.marked.x() * 100) + formatted(" x %.0f cm, ", coverage.marked.y() * 100) +
-           formatted("%.0f mm texels; worked: ", coverage.texel * 1000) +
-           formatted("%.1f %% (red: not worked)", 100.0 * coverage.fraction()),
-       13);
+  drawText(cr, 30, 34, "Polishing: the marked area, texel by texel (seed " + std::to_string(trace.seed) + ")", 18,
+           true);
+  drawText(cr, 30, 56,
+           formatted("%.0f", coverage.marked.x() * 100) + formatted(" x %.0f cm, ", coverage.marked.y() * 100) +
+               formatted("%.0f mm texels; worked: ", coverage.texel * 1000) +
+               formatted("%.1f %% (red: not worked)", 100.0 * coverage.fraction()),
+           13);
   float most_time = 0.0F;
   float most_force = 0.0F;
   for (std::size_t i = 0; i < coverage.worked_seconds.size(); ++i) {
@@ -171,7 +157,7 @@ void writeCoveragePlot(const ToolTrace& trace, const std::filesystem::path& png)
   const auto draw = [&](int left, const std::vector<float>& values, float most, const std::string& title,
                         const std::string& unit) {
     const int top = 90;
-    text(cr, left, top - 10, title, 14, true);
+    drawText(cr, left, top - 10, title, 14, true);
     for (int row = 0; row < coverage.rows; ++row) {
       for (int column = 0; column < coverage.columns; ++column) {
         const auto index = static_cast<std::size_t>(row * coverage.columns + column);
@@ -187,13 +173,13 @@ void writeCoveragePlot(const ToolTrace& trace, const std::filesystem::path& png)
       }
     }
     cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-    text(cr, left, top + map_height + 20, "0" + unit + " (white) to " + formatted("%.1f", most) + unit + " (dark blue)",
-         12);
-    text(cr, left, top + map_height + 38, "x along the workpiece to the right, y up", 12);
+    drawText(cr, left, top + map_height + 20,
+             "0" + unit + " (white) to " + formatted("%.1f", most) + unit + " (dark blue)", 12);
+    drawText(cr, left, top + map_height + 38, "x along the workpiece to the right, y up", 12);
   };
   draw(30, coverage.worked_seconds, most_time, "time worked", " s");
   draw(60 + map_width, coverage.max_force, most_force, "largest force it was worked with", " N");
-  finish(surface, cr, png);
+  writeSurfacePng(surface, cr, png);
 }
 
 }  // namespace costar::trials

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <limits>
 #include <thread>
@@ -14,6 +15,7 @@
 #include "core/files.h"
 #include "core/paths.h"
 #include "trials/judge.h"
+#include "trials/tool_plot.h"
 
 namespace costar::trials {
 namespace {
@@ -149,6 +151,45 @@ TEST(Trials, OutputFilesAreCheckedBeforehandAndWrittenAfterwards) {
     ADD_FAILURE() << "a plot on a full disk";
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()), "cannot write '/dev/full': No space left on device");
+  }
+  std::filesystem::remove_all(folder);
+}
+
+// The polishing pictures went to cairo's own file writer: a full disk was "error while writing
+// to output stream". They are written checked like every other output.
+TEST(Trials, ThePolishingPicturesAreWrittenChecked) {
+  ToolTrace trace;
+  trace.seed = 5;
+  for (int k = 0; k < 50; ++k) {
+    sim::PowerToolSample sample;
+    sample.time = 0.1 * k;
+    sample.powered = sample.held = sample.working = true;
+    sample.pad_force = 10.0 + std::sin(0.3 * k);
+    trace.log.push_back(sample);
+  }
+  sim::Coverage coverage;
+  coverage.columns = 20;
+  coverage.rows = 10;
+  coverage.worked_seconds.assign(200, 0.1F);
+  coverage.max_force.assign(200, 10.0F);
+  trace.coverage = coverage;
+  const auto folder = std::filesystem::temp_directory_path() / "costar_tool_plot_test";
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  writeForcePlot(trace, 10.0, 4.0, folder / "force.png");
+  writeCoveragePlot(trace, folder / "coverage.png");
+  EXPECT_EQ(contents(folder / "force.png").substr(1, 3), "PNG");
+  EXPECT_EQ(contents(folder / "coverage.png").substr(1, 3), "PNG");
+  for (const auto& write : {std::function<void(const std::filesystem::path&)>(
+                                [&](const std::filesystem::path& png) { writeForcePlot(trace, 10.0, 4.0, png); }),
+                            std::function<void(const std::filesystem::path&)>(
+                                [&](const std::filesystem::path& png) { writeCoveragePlot(trace, png); })}) {
+    try {
+      write("/dev/full");
+      ADD_FAILURE() << "a picture on a full disk";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), "cannot write '/dev/full': No space left on device");
+    }
   }
   std::filesystem::remove_all(folder);
 }
