@@ -613,7 +613,10 @@ Tree buildTree(const Plan& plan, const NodeRegistry& registry, const Clock& cloc
   const std::string id = tree_id.empty() ? plan.mainTreeId() : tree_id;
   const PlanTree* tree = plan.findTree(id);
   if (tree == nullptr) {
-    throw PlanError({{{plan.file.path, 0}, "no BehaviorTree with ID '" + id + "'"}});
+    Diagnostic missing;  // built in place: GCC 12 warns maybe-uninitialized on the braced temporary
+    missing.where = {plan.file.path, 0};
+    missing.message = "no BehaviorTree with ID '" + id + "'";
+    throw PlanError({std::move(missing)});
   }
   Instantiator instantiator(plan, registry);
   TreeNode* root = instantiator.build(tree->root);
