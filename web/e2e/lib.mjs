@@ -141,8 +141,14 @@ export async function waitForRunEnd(page, seconds = 240, after = 0) {
   let sawRunning = false;
   while (Date.now() < deadline) {
     if (await page.$('.tree-node[data-running="true"]')) sawRunning = true;
-    const result = await page.getAttribute('.run-label', 'data-run-result');
-    if (result && (await shownRunId(page)) > after) return { result, label: await page.textContent('.run-label'), sawRunning };
+    // The result and the run it belongs to read at once: read apart, a new run's id could be
+    // paired with the result the label still showed for the run before it.
+    const shown = await page.evaluate(() => {
+      const label = document.querySelector('.run-label');
+      return { result: label?.getAttribute('data-run-result') ?? '', text: label?.textContent ?? '' };
+    });
+    const id = Number(/^(?:Run|Last run:) #(\d+)/.exec(shown.text)?.[1] ?? 0);
+    if (shown.result && id > after) return { result: shown.result, label: shown.text, sawRunning };
     await page.waitForTimeout(100);
   }
   return { result: '', label: await page.textContent('.run-label'), sawRunning };
