@@ -16,7 +16,7 @@
 import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
-import { actionCounter, args, artifacts, costar, groundTruth, launchBrowser, makeLog, openPage, readability, root, startServer, waitForRunEnd } from './lib.mjs';
+import { actionCounter, args, artifacts, costar, groundTruth, launchBrowser, makeLog, openPage, readability, root, runScript, startServer, waitForRunEnd } from './lib.mjs';
 
 const MAX_ACTIONS = 30;
 const scene = 'sim/scenes/assembly.json';
@@ -277,21 +277,4 @@ async function main() {
   check(pageErrors.length === 0, `no errors in the page${pageErrors.length ? ': ' + pageErrors.join('; ') : ''}`);
 }
 
-let failed = false;
-try {
-  await main();
-  log('PASSED');
-} catch (error) {
-  failed = true;
-  console.error('e2e: FAILED -', error.message);
-  try {
-    const pages = browser?.contexts()[0]?.pages() ?? [];
-    if (pages[0]) await pages[0].screenshot({ path: path.join(artifacts, 'editor_failure.png') });
-  } catch {
-    // no screenshot
-  }
-} finally {
-  await browser?.close();
-  server?.stop();
-}
-process.exit(failed ? 1 : 0);
+await runScript('e2e', main, { log, artifacts, shot: 'editor_failure.png', resources: () => ({ browser, server }) });

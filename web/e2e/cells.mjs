@@ -12,7 +12,7 @@
 
 import fs from 'node:fs';
 import path from 'node:path';
-import { api, args, artifacts, launchBrowser, makeLog, openPage, startServer } from './lib.mjs';
+import { api, args, artifacts, launchBrowser, makeLog, openPage, runScript, startServer } from './lib.mjs';
 
 const { log, check } = makeLog('cells');
 const CELLS = { 'ur5-sim': 6, 'iiwa-sim': 7, 'iiwa-3f-sim': 7 };
@@ -139,21 +139,4 @@ async function main() {
   log('drawn tool centre point against the endpoint symbol (mm, degrees):', JSON.stringify(figures));
 }
 
-let failed = false;
-try {
-  await main();
-  log('PASSED');
-} catch (error) {
-  failed = true;
-  console.error('cells: FAILED -', error.message);
-  try {
-    const pages = browser?.contexts().flatMap((c) => c.pages()) ?? [];
-    if (pages[0]) await pages[0].screenshot({ path: path.join(artifacts, 'cells_failure.png') });
-  } catch {
-    // no screenshot
-  }
-} finally {
-  await browser?.close();
-  server?.stop();
-}
-process.exit(failed ? 1 : 0);
+await runScript('cells', main, { log, artifacts, shot: 'cells_failure.png', resources: () => ({ browser, server }) });

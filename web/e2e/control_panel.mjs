@@ -13,9 +13,8 @@
 //
 //   node web/e2e/control_panel.mjs [--costar build/cli/costar] [--artifacts build/test-artifacts]
 
-import fs from 'node:fs';
 import path from 'node:path';
-import { api, artifacts, groundTruth, launchBrowser, makeLog, openPage, startServer } from './lib.mjs';
+import { api, artifacts, groundTruth, launchBrowser, makeLog, openPage, runScript, startServer } from './lib.mjs';
 
 const { log, check } = makeLog('control panel');
 let server;
@@ -212,22 +211,4 @@ async function main() {
   check(errors.length === 0, `no errors in the pages${errors.length ? ': ' + errors.join('; ') : ''}`);
 }
 
-let failed = false;
-try {
-  await main();
-  log('PASSED');
-} catch (error) {
-  failed = true;
-  console.error('control panel: FAILED -', error.message);
-  try {
-    const pages = browser?.contexts()[0]?.pages() ?? [];
-    if (pages[0]) await pages[0].screenshot({ path: path.join(artifacts, 'control_panel_failure.png') });
-  } catch {
-    // no screenshot
-  }
-} finally {
-  await browser?.close();
-  server?.stop();
-  fs.mkdirSync(artifacts, { recursive: true });
-}
-process.exit(failed ? 1 : 0);
+await runScript('control panel', main, { log, artifacts, shot: 'control_panel_failure.png', resources: () => ({ browser, server }) });

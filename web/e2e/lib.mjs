@@ -209,3 +209,30 @@ export function readability() {
   }
   return { smallest, smallestWhat, zoom, problems };
 }
+
+/**
+ * Runs an end-to-end script's `main` and ends the process: PASSED, or FAILED with the reason
+ * and a screenshot of the first page open (`shot`, in `artifacts`); the browser and the server
+ * that `resources()` returns are closed either way.
+ */
+export async function runScript(label, main, { log, artifacts, shot, resources }) {
+  let failed = false;
+  try {
+    await main();
+    log('PASSED');
+  } catch (error) {
+    failed = true;
+    console.error(`${label}: FAILED -`, error.message);
+    try {
+      const pages = resources().browser?.contexts().flatMap((c) => c.pages()) ?? [];
+      if (pages[0]) await pages[0].screenshot({ path: path.join(artifacts, shot) });
+    } catch {
+      // no screenshot
+    }
+  } finally {
+    const { browser, server } = resources();
+    await browser?.close();
+    server?.stop();
+  }
+  process.exit(failed ? 1 : 0);
+}

@@ -11,7 +11,7 @@
 
 import fs from 'node:fs';
 import path from 'node:path';
-import { actionCounter, artifacts, groundTruth, launchBrowser, makeLog, openPage, shownRunId, startServer, waitForRunEnd } from './lib.mjs';
+import { actionCounter, artifacts, groundTruth, launchBrowser, makeLog, openPage, runScript, shownRunId, startServer, waitForRunEnd } from './lib.mjs';
 
 const { log, check } = makeLog('paper tasks');
 const NODE_HALF = 0.025;
@@ -99,21 +99,4 @@ async function main() {
   check(errors.length === 0, `no errors in the page${errors.length ? ': ' + errors.join('; ') : ''}`);
 }
 
-let failed = false;
-try {
-  await main();
-  log('PASSED');
-} catch (error) {
-  failed = true;
-  console.error('paper tasks: FAILED -', error.message);
-  try {
-    const pages = browser?.contexts()[0]?.pages() ?? [];
-    if (pages[0]) await pages[0].screenshot({ path: path.join(artifacts, 'paper_tasks_failure.png') });
-  } catch {
-    // no screenshot
-  }
-} finally {
-  await browser?.close();
-  server?.stop();
-}
-process.exit(failed ? 1 : 0);
+await runScript('paper tasks', main, { log, artifacts, shot: 'paper_tasks_failure.png', resources: () => ({ browser, server }) });
