@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "arm/chain_kinematics.h"
 #include "arm/robot_description.h"
 #include "arm/srs_kinematics.h"
 #include "arm/ur5_kinematics.h"
@@ -57,10 +58,22 @@ std::shared_ptr<const Kinematics> makeSrs(const RobotDescription& robot) {
   return std::make_shared<SrsArmKinematics>(arm.geometry, robot.limits);
 }
 
+/// "chain": any serial chain of revolute joints (the Franka Panda), by Levenberg-Marquardt;
+/// the geometry from the joints and tool of the robot's description file (format
+/// costar-robot-description/1), the limits from the description.
+std::shared_ptr<const Kinematics> makeChain(const RobotDescription& robot) {
+  if (!robot.solver_parameters.empty()) {
+    throw std::runtime_error("kinematics." + robot.solver_parameters.begin()->first +
+                             ": solver 'chain' takes no parameters (its geometry comes from the joints)");
+  }
+  return std::make_shared<ChainKinematics>(readChainGeometry(robot.file), robot.limits);
+}
+
 using Maker = std::shared_ptr<const Kinematics> (*)(const RobotDescription&);
 
 /// Every solver: key, maker. Sorted by key.
 constexpr std::pair<const char*, Maker> kSolvers[] = {
+    {"chain", &makeChain},
     {"srs", &makeSrs},
     {"ur", &makeUr},
 };

@@ -61,7 +61,7 @@ TEST(RobotDescription, ItsKinematicsAreTheUrClosedFormWithItsDhTable) {
     }
     EXPECT_TRUE(kinematics->forward(q).isApprox(reference.forward(q), 0.0)) << "trial " << trial;
   }
-  EXPECT_EQ(kinematicsSolvers(), (std::vector<std::string>{"srs", "ur"}));
+  EXPECT_EQ(kinematicsSolvers(), (std::vector<std::string>{"chain", "srs", "ur"}));
 }
 
 class BadRobotFile : public ::testing::Test {
@@ -128,7 +128,7 @@ TEST_F(BadRobotFile, EachProblemNamesItsField) {
   EXPECT_EQ(problem(j).rfind("models.mjcf: no such file '", 0), 0u) << problem(j);
   j = good_;
   j["kinematics"]["solver"] = "kuka";
-  EXPECT_EQ(problem(j), "kinematics.solver: unknown solver 'kuka' (known: srs, ur)");
+  EXPECT_EQ(problem(j), "kinematics.solver: unknown solver 'kuka' (known: chain, srs, ur)");
   j = good_;
   j["kinematics"]["d"] = {0.1, 0.2};
   EXPECT_EQ(problem(j), "kinematics.d: must be 6 numbers, not 2");
