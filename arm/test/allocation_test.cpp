@@ -6,6 +6,7 @@
 
 #include <random>
 
+#include "arm/chain_kinematics.h"
 #include "arm/trajectory.h"
 #include "arm/ur5_kinematics.h"
 #include "bench/alloc_counter.h"
@@ -50,6 +51,44 @@ TEST(ArmAllocation, NoneInInverseKinematics) {
     total += generic.inverseNearest(pose, seed).has_value();
   }
   EXPECT_EQ(bench::allocations() - before_generic, 0u);
+}
+
+// The general chain solver (6 joints here: the UR5's DH table as a chain), through the
+// interface; its geometry is built before counting.
+TEST(ArmAllocation, NoneInTheChainSolver) {
+  const DhParameters dh = DhParameters::ur5();
+  ChainGeometry chain;
+  world::Pose previous = world::Pose::Identity();
+  for (int i = 0; i < kJointCount; ++i) {
+    chain.joints.push_back({previous, Eigen::Vector3d::UnitZ()});
+    previous = world::Pose::Identity();
+    previous.translate(Eigen::Vector3d(dh.a[i], 0, dh.d[i]));
+    previous.rotate(Eigen::AngleAxisd(dh.alpha[i], Eigen::Vector3d::UnitX()));
+  }
+  chain.flange = previous;
+  const ChainKinematics kinematics(chain, JointLimits::ur5());
+  std::mt19937_64 random(22);
+  std::uniform_real_distribution<double> angle(-3.0, 3.0);
+  std::vector<world::Pose> poses;
+  for (int k = 0; k < 50; ++k) {
+    JointVector q = JointVector::zero(kJointCount);
+    for (double& value : q) {
+      value = angle(random);
+    }
+    poses.push_back(kinematics.forward(q));
+  }
+  const Kinematics& generic = kinematics;
+  IkSolutions found;
+  const JointVector seed = {0.1, -1.5, 1.5, -1.5, -1.5, 0.0};
+  int total = 0;
+  const std::uint64_t before = bench::allocations();
+  for (const world::Pose& pose : poses) {
+    generic.inverse(pose, seed, found);
+    total += found.size();
+    total += generic.inverseNearest(pose, seed).has_value();
+  }
+  EXPECT_EQ(bench::allocations() - before, 0u);
+  EXPECT_GT(total, 50);
 }
 
 TEST(ArmAllocation, NoneWhenSampling) {
