@@ -25,6 +25,10 @@ class ArmDriver {
   /// Follows `trajectory` from clock time `start` (its sample at t - start), replacing any
   /// trajectory being followed; after its end, holds its final position.
   virtual void execute(std::shared_ptr<const JointTrajectory> trajectory, TimePoint start) = 0;
+  /// How far a speed override (a controller's speed and separation monitoring slowing or
+  /// stopping the arm for a person) has held the present trajectory back: the controller
+  /// follows its sample at t - start - heldBack(). Zero from a controller without one.
+  virtual Duration heldBack() const { return Duration::zero(); }
 };
 
 }  // namespace costar::arm

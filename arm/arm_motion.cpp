@@ -40,8 +40,10 @@ void stopMotion(ArmMotion& motion, ArmDriver& driver, const Clock& clock, const 
   if (!motion.trajectory) {
     return;
   }
-  if (now - motion.start < motion.trajectory->duration()) {
-    const TrajectoryPoint state = motion.trajectory->sample(now - motion.start);
+  // Where the controller is along the trajectory: a speed override may have held it back.
+  const Duration along = now - motion.start - driver.heldBack();
+  if (along < motion.trajectory->duration()) {
+    const TrajectoryPoint state = motion.trajectory->sample(along);
     auto stop = std::make_shared<JointTrajectory>(JointTrajectory::stopFrom(state, limits));
     driver.execute(stop, now);
     motion.trajectory = std::move(stop);
@@ -86,7 +88,7 @@ OperationResult MotionOperation::poll() {
     stopMotion(*motion_, driver_, clock_, kinematics_->limits());
     return OperationResult::failure(what_ + ": " + problem + "; the arm was stopped");
   }
-  const TimePoint end = start_ + plan_.trajectory->duration();
+  const TimePoint end = start_ + plan_.trajectory->duration() + driver_.heldBack();
   if (now < end) {
     return OperationResult::running();
   }

@@ -60,6 +60,8 @@ class FaultyArmDriver final : public arm::ArmDriver {
     inner_.execute(std::move(trajectory), start);
   }
 
+  Duration heldBack() const override { return inner_.heldBack(); }
+
  private:
   arm::ArmDriver& inner_;
   Injector& injector_;

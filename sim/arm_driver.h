@@ -25,6 +25,8 @@ class SimArmDriver final : public arm::ArmDriver {
     });
   }
 
+  Duration heldBack() const override { return simulation_.trajectoryLag(); }
+
  private:
   Simulation& simulation_;
 };

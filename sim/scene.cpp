@@ -236,7 +236,7 @@ Scene parseScene(const std::string& text, const std::string& label) {
     const json file = core::parseJson(text);
     onlyKnownFields(object(file, "the file"), "",
                     {"description", "seed", "min_gap", "camera_offset", "regions", "parts", "jig", "wire", "workpiece",
-                     "power_tool"});
+                     "power_tool", "person"});
     Scene scene;
     scene.label = label;
     if (file.contains("description")) {
@@ -292,6 +292,9 @@ Scene parseScene(const std::string& text, const std::string& label) {
       scene.wire = parseWire(file.at("wire"), "wire");
     }
     checkJigAndWire(scene.jig, scene.wire);
+    if (file.contains("person")) {
+      scene.person = parsePerson(file.at("person").dump(), "person");
+    }
     return scene;
   } catch (const std::exception& e) {
     throw std::runtime_error("scene '" + label + "': " + e.what());
@@ -595,6 +598,9 @@ std::string sceneFileText(const Scene& scene) {
   }
   if (scene.wire) {
     file["wire"] = wireJson(*scene.wire);
+  }
+  if (scene.person) {
+    file["person"] = core::parseJson(scene.person->source);
   }
   return file.dump(1) + "\n";
 }

@@ -16,7 +16,8 @@
 // {"at": [x, y, yaw_deg], "size": [sx, sy, sz], "marked": [mx, my]} (a block fixed on the table,
 // its top's middle mx by my marked for polishing; sizes in m), which random placements keep
 // clear of; "power_tool": true puts the cell's power tool on its stand (workcells/NAME.json
-// "power_tool", sim/power_tool.h). Custom
+// "power_tool", sim/power_tool.h). A person beside the table, driven by a script: "person"
+// (sim/person.h). Custom
 // regions add to (or replace) the default ones. A field the format does not know, a value of
 // the wrong type or out of range (a count of 4294967297, a negative min_gap, a region or an
 // "at" off the table) is an error naming the file and the field, e.g.
@@ -33,6 +34,7 @@
 
 #include <Eigen/Core>
 
+#include "sim/person.h"
 #include "sim/wire.h"
 #include "world/object_class.h"
 #include "world/pose.h"
@@ -101,6 +103,8 @@ struct Scene {
   std::optional<WorkpieceRequest> workpiece;
   /// The cell's power tool sits on its stand.
   bool power_tool = false;
+  /// A person beside the table and what the hand does (sim/person.h).
+  std::optional<PersonSpec> person;
 };
 
 /// The table top (x, y in m), as sim/models/table_cell.xml has it; regions and fixed

@@ -17,6 +17,7 @@
 #include "sim/cell_model.h"
 #include "sim/gl_context.h"
 #include "sim/impedance_controller.h"
+#include "sim/person_sim.h"
 #include "sim/wire_sim.h"
 
 namespace costar::sim {
@@ -133,11 +134,29 @@ struct Simulation::Impl {
   SimClock* clock = nullptr;
   int listener = 0;
 
+  // The scene's person, the speed and separation monitor and its record.
+  std::unique_ptr<SimPerson> person;
+  std::optional<SpeedSeparationMonitor> monitor;  // absent: not monitored
+  SpeedSeparationParams ssm_params;
+  std::vector<int> arm_geoms;         // the arm's and gripper's colliding geoms
+  std::vector<Capsule> arm_previous;  // their capsules one step ago
+  bool have_previous = false;
+  bool settled = false;
+  double lag = 0.0;  // s the override held the present trajectory back
+  double scale = 1.0;
+  double scale_rate = 0.0;
+  std::int64_t sensor_steps = 1;  // steps between separation readings
+  double sensed = 1e9;
+  std::int64_t last_touch_step = -1000000;  // when the arm last touched the person
+  SeparationStatus status;
+  SeparationRecord record;
+
   ~Impl() {
     if (clock != nullptr) {
       clock->removeStepListener(listener);
     }
     renderer.reset();
+    person.reset();
     jig.reset();
     power_tool.reset();
     cartesian.reset();
@@ -237,13 +256,22 @@ struct Simulation::Impl {
 
   void jointControl() {
     // Arm: computed torque, tau = M (qdd_d + Kp e + Kd de) + bias, clamped by the actuators.
-    const TimePoint t = now();
+    // The speed override (speed and separation monitoring) slows the trajectory's time: its
+    // sample at t - lag, velocities scaled by s, accelerations by s^2 plus the velocity times s'.
+    const TimePoint t = now() - Duration(static_cast<std::int64_t>(std::llround(lag * 1e9)));
     ArmSetpoint setpoint = setpoint_source ? setpoint_source(t) : held;
     if (setpoint.position.size() != arm_joints || setpoint.velocity.size() != arm_joints ||
         setpoint.acceleration.size() != arm_joints) {
       setpoint = held;  // a setpoint for another arm: hold where the last good one was
     } else if (setpoint_source) {
       held = {setpoint.position, ArmJoints::zero(arm_joints), ArmJoints::zero(arm_joints)};
+      if (scale < 1.0 || scale_rate != 0.0) {
+        for (int i = 0; i < arm_joints; ++i) {
+          setpoint.acceleration[i] = setpoint.acceleration[i] * scale * scale + setpoint.velocity[i] * scale_rate;
+          setpoint.velocity[i] *= scale;
+        }
+      }
+      lag += (1.0 - scale) * model->opt.timestep;
     }
     std::fill(acceleration.begin(), acceleration.end(), 0.0);
     for (int i = 0; i < arm_joints; ++i) {
@@ -268,7 +296,125 @@ struct Simulation::Impl {
     }
   }
 
+  /// The separation between the arm's and the person's capsules, and the closest pair.
+  double separationNow(int* arm_geom, int* person_geom, std::vector<Capsule>& arm_capsules) const {
+    arm_capsules.clear();
+    for (const int geom : arm_geoms) {
+      arm_capsules.push_back(geomCapsule(model, data, geom));
+    }
+    double closest = 1e9;
+    for (const int other : person->geoms()) {
+      const Capsule capsule = geomCapsule(model, data, other);
+      for (std::size_t i = 0; i < arm_capsules.size(); ++i) {
+        const double distance = capsuleDistance(arm_capsules[i], capsule);
+        if (distance < closest) {
+          closest = distance;
+          *arm_geom = arm_geoms[i];
+          *person_geom = other;
+        }
+      }
+    }
+    return closest;
+  }
+
+  /// Before a physics step: places the person, measures the separation and the arm's speed,
+  /// updates the speed override and the record.
+  void watchPerson() {
+    const double dt = model->opt.timestep;
+    person->drive(settled ? toSeconds(now()) : -1.0);
+    mj_kinematics(model, data);
+    int arm_geom = -1;
+    int person_geom = -1;
+    std::vector<Capsule> capsules;
+    const double separation = separationNow(&arm_geom, &person_geom, capsules);
+    double speed = 0.0;
+    if (have_previous) {
+      for (std::size_t i = 0; i < capsules.size(); ++i) {
+        speed = std::max(
+            {speed, (capsules[i].a - arm_previous[i].a).norm() / dt, (capsules[i].b - arm_previous[i].b).norm() / dt});
+      }
+    }
+    arm_previous = std::move(capsules);
+    have_previous = true;
+    if (steps % sensor_steps == 0) {
+      sensed = separation;  // the sensor's reading, held until the next one
+    }
+    if (monitor) {
+      scale = monitor->update(dt, sensed, speed);
+      scale_rate = monitor->scaleRate();
+    }
+    const double protective = protectiveDistance(ssm_params, speed);
+    status.separation = separation;
+    status.sensed_separation = sensed;
+    status.arm_speed = speed;
+    status.scale = scale;
+    status.protective_distance = protective;
+    status.state = monitor ? stateName(monitor->state()) : "off";
+    status.arm_geom = arm_geom >= 0 ? geomName(arm_geom) : "";
+    status.person_geom = person_geom >= 0 ? person->geomLabel(person_geom) : "";
+    if (!settled) {
+      return;
+    }
+    record.seconds += dt;
+    record.min_separation = std::min(record.min_separation, separation);
+    // The person pushing the arm while the override holds it still moves it, but not of its own
+    // accord: such steps count as contact with a stopped arm, not as the arm moving fast.
+    // (Touched in the last 0.2 s: a pushed arm bounces off the hand and back.)
+    const bool pushed = scale <= 0.0 && steps - last_touch_step < static_cast<std::int64_t>(std::llround(0.2 / dt));
+    if (speed > SeparationRecord::fast_speed && !pushed) {
+      record.fast_seconds += dt;
+      record.min_separation_fast = std::min(record.min_separation_fast, separation);
+      record.min_margin_fast = std::min(record.min_margin_fast, separation - protective);
+      record.violation_steps += separation < protective ? 1 : 0;
+    }
+    if (monitor) {
+      record.stops = monitor->stops();
+      record.stopped_seconds += scale <= 0.0 && setpoint_source ? dt : 0.0;
+    }
+  }
+
+  /// After a physics step: the normal force between the arm and the person, counted against
+  /// the arm when it was moving (its override above 0), against the person when it was held still.
+  void recordPersonContact() {
+    double force = 0.0;
+    for (int i = 0; i < data->ncon; ++i) {
+      const mjContact& contact = data->contact[i];
+      const bool first = person->isPersonGeom(contact.geom1);
+      const bool second = person->isPersonGeom(contact.geom2);
+      if (first == second) {
+        continue;
+      }
+      const int other = first ? contact.geom2 : contact.geom1;
+      if (!isArmBody(model->geom_bodyid[other])) {
+        continue;
+      }
+      mjtNum wrench[6];
+      mj_contactForce(model, data, i, wrench);
+      force += std::abs(wrench[0]);
+    }
+    if (force > 0.0) {
+      last_touch_step = steps;
+    }
+    if (force > 0.0 && settled) {
+      if (scale > 0.0) {
+        ++record.contact_steps;
+        record.max_contact_force = std::max(record.max_contact_force, force);
+      } else {
+        ++record.stopped_contact_steps;
+        record.max_stopped_contact_force = std::max(record.max_stopped_contact_force, force);
+      }
+    }
+  }
+
+  std::string geomName(int geom) const {
+    const char* name = mj_id2name(model, mjOBJ_GEOM, geom);
+    return name != nullptr ? name : bodyLabel(model->geom_bodyid[geom]);
+  }
+
   void step() {
+    if (person) {
+      watchPerson();
+    }
     mj_step1(model, data);
     control();
     mj_step2(model, data);
@@ -278,6 +424,9 @@ struct Simulation::Impl {
                                std::to_string(model->nconmax) + " njmax=" + std::to_string(model->njmax) + "> allows");
     }
     countTableContacts();
+    if (person) {
+      recordPersonContact();
+    }
     ++steps;
     if (jig) {
       jig->afterStep(toSeconds(now()));
@@ -348,6 +497,9 @@ struct Simulation::Impl {
       if (std::string label = jig->geomLabel(geom); !label.empty()) {
         return label;
       }
+    }
+    if (person && person->isPersonGeom(geom)) {
+      return person->geomLabel(geom);
     }
     if (adaptive && adaptive->isGripperGeom(geom)) {
       const int finger = adaptive->fingerOfGeom(geom);
@@ -472,6 +624,19 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
     bodies += powerToolBodies(options.power_tool ? &*options.power_tool : nullptr, scene.power_tool,
                               scene.workpiece ? &*scene.workpiece : nullptr);
   }
+  if (scene.person) {
+    bodies += personBodiesMjcf(*scene.person);
+    const auto actuators = xml.rfind("</actuator>");
+    if (actuators == std::string::npos) {
+      throw std::runtime_error("the workcell model has no <actuator> section for the person's fingers");
+    }
+    xml.insert(actuators, personActuatorsMjcf());
+    const auto end = xml.rfind("</mujoco>");
+    if (end == std::string::npos) {
+      throw std::runtime_error("the workcell model has no </mujoco>");
+    }
+    xml.insert(end, personEqualityMjcf());
+  }
   replaceMarker(xml, "<!--PART_ASSETS-->", assets);
   replaceMarker(xml, "<!--PARTS-->", bodies);
 
@@ -560,6 +725,23 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   for (const auto& part : impl->placements) {
     impl->part_bodies.push_back(impl->id(mjOBJ_BODY, part.name.c_str()));
   }
+  if (scene.person) {
+    impl->person =
+        std::make_unique<SimPerson>(m, impl->data, *scene.person, options.placement_seed.value_or(scene.seed));
+    for (int geom = 0; geom < m->ngeom; ++geom) {
+      if (impl->isArmBody(m->geom_bodyid[geom]) && (m->geom_contype[geom] != 0 || m->geom_conaffinity[geom] != 0)) {
+        impl->arm_geoms.push_back(geom);
+      }
+    }
+    impl->ssm_params = options.speed_separation;
+    impl->ssm_params.control_period = m->opt.timestep;
+    impl->sensor_steps =
+        std::max<std::int64_t>(1, std::llround(options.speed_separation.sensor_period / m->opt.timestep));
+    impl->ssm_params.sensor_period = static_cast<double>(impl->sensor_steps) * m->opt.timestep;
+    if (options.speed_separation_monitoring) {
+      impl->monitor.emplace(impl->ssm_params);
+    }
+  }
   if (scene.jig) {
     const Impl* raw = impl.get();
     SimJig::Gripper gripper{[raw](int geom) { return raw->fingerOfGeom(geom); },
@@ -596,6 +778,7 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   }
   impl->settle_steps = settle;
   impl->steps = 0;
+  impl->settled = true;
   impl->arm_table_contact_steps = 0;
   return std::unique_ptr<Simulation>(new Simulation(std::move(impl)));
 }
@@ -646,6 +829,7 @@ ArmJoints Simulation::armVelocities() const {
 }
 
 void Simulation::setArmSetpointSource(std::function<ArmSetpoint(TimePoint)> source) {
+  impl_->lag = 0.0;
   if (impl_->cartesian->active()) {
     // The joint controller takes over from where the arm is.
     impl_->held = {armPositions(), ArmJoints::zero(impl_->arm_joints), ArmJoints::zero(impl_->arm_joints)};
@@ -830,6 +1014,40 @@ std::optional<JigState> Simulation::jig() const {
     return std::nullopt;
   }
   return impl_->jig->state();
+}
+
+std::optional<PersonPose> Simulation::person() const {
+  if (!impl_->person) {
+    return std::nullopt;
+  }
+  return impl_->person->pose();
+}
+
+std::optional<SeparationStatus> Simulation::separation() const {
+  if (!impl_->person) {
+    return std::nullopt;
+  }
+  return impl_->status;
+}
+
+std::optional<SeparationRecord> Simulation::separationRecord() const {
+  if (!impl_->person) {
+    return std::nullopt;
+  }
+  return impl_->record;
+}
+
+void Simulation::setStopInput(bool stop) {
+  if (!impl_->monitor) {
+    throw std::logic_error(
+        "Simulation::setStopInput: no speed and separation monitor (no person in the scene, or "
+        "monitoring off)");
+  }
+  impl_->monitor->setStopInput(stop);
+}
+
+Duration Simulation::trajectoryLag() const {
+  return Duration(static_cast<std::int64_t>(std::llround(impl_->lag * 1e9)));
 }
 
 }  // namespace costar::sim

@@ -37,8 +37,10 @@
 #include "gripper/adaptive_gripper_driver.h"
 #include "sim/depth_noise.h"
 #include "sim/force_torque.h"
+#include "sim/person.h"
 #include "sim/power_tool.h"
 #include "sim/scene.h"
+#include "sim/speed_separation.h"
 #include "sim/wire.h"
 #include "world/object_class.h"
 
@@ -100,6 +102,44 @@ struct SimulationOptions {
   /// puts a part on the table mid-task (movePart). Named after the scene's parts (node_3 after node_0..2), in the
   /// class's first colour.
   std::vector<std::string> spare_classes;
+  /// With a person in the scene: the controller's speed and separation monitoring
+  /// (sim/speed_separation.h) scales the arm's joint trajectories. false: the arm ignores the
+  /// person (for measuring what the monitor prevents; the record is kept either way).
+  bool speed_separation_monitoring = true;
+  SpeedSeparationParams speed_separation;
+};
+
+/// The separation between the arm (with its gripper) and the scene's person now.
+struct SeparationStatus {
+  double separation = 0.0;           // m, between the enclosing capsules (true geometry)
+  double sensed_separation = 0.0;    // m, as the monitor last sensed it (every sensor_period)
+  double arm_speed = 0.0;            // m/s, the fastest point of the arm's capsules
+  double scale = 1.0;                // the speed override, 0 .. 1
+  double protective_distance = 0.0;  // S_p at arm_speed
+  std::string state;                 // "free", "limited", "stopped" ("off": not monitored)
+  std::string arm_geom;              // the closest pair's geoms
+  std::string person_geom;
+};
+
+/// What the monitor's judge recorded since time 0 (ground truth, for trials and benches).
+struct SeparationRecord {
+  double seconds = 0.0;               // simulated with the person present
+  double min_separation = 1e9;        // m, at any speed
+  double fast_seconds = 0.0;          // with the arm faster than fast_speed
+  double min_separation_fast = 1e9;   // m, while faster than fast_speed
+  double min_margin_fast = 1e9;       // m, separation - S_p(speed) while faster
+  std::uint64_t violation_steps = 0;  // physics steps faster with separation < S_p(speed)
+  /// Contact while the arm moved of its own accord (its speed override above 0): steps and the
+  /// largest total normal force arm-person in a step (N).
+  std::uint64_t contact_steps = 0;
+  double max_contact_force = 0.0;
+  /// Contact while the override held the arm still: the person ran into a stopped arm. Steps in
+  /// which the person pushes the stopped arm do not count as the arm moving fast.
+  std::uint64_t stopped_contact_steps = 0;
+  double max_stopped_contact_force = 0.0;
+  int stops = 0;                              // protective stops
+  double stopped_seconds = 0.0;               // with the speed override at 0 while a trajectory ran
+  static constexpr double fast_speed = 0.25;  // m/s (the threshold)
 };
 
 /// A part's true state, for tests and the trial judge.
@@ -220,6 +260,18 @@ class Simulation {
   /// The scene's bending jig and wire as they truly are (sim/wire.h): the pins, the wire's
   /// centreline and bends, how the gripper has held it so far. Absent without a "jig".
   std::optional<JigState> jig() const;
+  /// The scene's person as the script places it now (absent without a "person").
+  std::optional<PersonPose> person() const;
+  /// The separation monitor's reading now, and its record (absent without a person).
+  std::optional<SeparationStatus> separation() const;
+  std::optional<SeparationRecord> separationRecord() const;
+  /// How far the speed override has held the present joint trajectory back: the controller
+  /// follows its sample at t - start - lag (arm::ArmDriver::heldBack).
+  Duration trajectoryLag() const;
+  /// The monitor's stop input (SpeedSeparationMonitor::setStopInput): the arm brakes along
+  /// its path to rest and stays until released. @throws std::logic_error without a monitor (no
+  /// person in the scene, or monitoring off).
+  void setStopInput(bool stop);
 
   /// The default robot's "home" configuration: tool pointing down above the table.
   static ArmJoints homeConfiguration();

@@ -29,15 +29,19 @@ class IdealDriver final : public ArmDriver {
     if (!trajectory_) {
       return {hold_, {}};
     }
-    const TrajectoryPoint point = trajectory_->sample(clock_.now() - start_);
+    const TrajectoryPoint point = trajectory_->sample(clock_.now() - start_ - held_back);
     return {point.position, point.velocity};
   }
   void execute(std::shared_ptr<const JointTrajectory> trajectory, TimePoint start) override {
     trajectory_ = std::move(trajectory);
     start_ = start;
+    held_back = Duration::zero();
     executed.push_back(trajectory_);
   }
+  Duration heldBack() const override { return held_back; }
   std::vector<std::shared_ptr<const JointTrajectory>> executed;
+  /// A speed override holding the trajectory back (a person near the arm), as a controller reports it.
+  Duration held_back = Duration::zero();
 
  private:
   const SimClock& clock_;
@@ -211,6 +215,27 @@ TEST_F(ArmTest, CancellingDeceleratesAlongThePathAndStops) {
   EXPECT_LT(toSeconds(stop.duration()), 1.0);
   clock.advanceBy(stop.duration() + std::chrono::milliseconds(10));
   EXPECT_FALSE(holds("arm_moving"));
+}
+
+TEST_F(ArmTest, AMotionHeldBackByTheControllersSpeedOverrideWaitsForItAndStopsWhereTheArmIs) {
+  waypoints.put({"far_side", Waypoint::Kind::kJoints, {2.5, -2.0, 2.0, -M_PI / 2, -M_PI / 2, 0.0}, {}, "world"});
+  const auto move = arm.start("Move", {{"waypoint", "far_side"}, {"speed", 1.0}});
+  const Duration nominal = driver.executed.back()->duration();
+  // The override held the arm back by as long as the motion takes and more than settle_time:
+  // the motion waits instead of failing as if the arm were blocked.
+  driver.held_back = nominal + config().settle_time + std::chrono::seconds(1);
+  clock.advanceBy(nominal + config().settle_time + std::chrono::milliseconds(500));
+  EXPECT_EQ(arm.poll(move).state, OperationState::kRunning);
+  // Cancelled there, the arm stops from where the controller is along the path (not from where
+  // the clock alone would put it: the end).
+  const JointVector here = driver.read().position;
+  arm.cancel(move);
+  const auto& stop = *driver.executed.back();
+  EXPECT_LT((stop.initialPosition().eigen() - here.eigen()).norm(), 1e-9);
+  // Released, a motion arrives and succeeds.
+  const auto again = arm.start("Move", {{"waypoint", "far_side"}, {"speed", 1.0}});
+  clock.advanceBy(driver.executed.back()->duration() + std::chrono::milliseconds(10));
+  EXPECT_EQ(arm.poll(again).state, OperationState::kSuccess);
 }
 
 TEST_F(ArmTest, TeachSavesWhereTheArmIsAndJoggingMovesIt) {

@@ -302,7 +302,7 @@ TEST(Scene, BadValuesAreErrorsNamingTheField) {
   EXPECT_EQ(problem(R"({"regoins": {}, "parts": []})"),
             prefix +
                 "regoins: unknown field (known: description, seed, min_gap, camera_offset, regions, parts, jig, wire, "
-                "workpiece, power_tool)");
+                "workpiece, power_tool, person)");
   EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5]}]})"),
             prefix + "parts[0].at: must be [x, y] or [x, y, yaw] (m, m, degrees), not [0.5]");
   EXPECT_EQ(problem(R"({"parts": [{"class": "node", "at": [0.5, null]}]})"),
