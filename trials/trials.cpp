@@ -165,6 +165,29 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
         result.failure_path = "judge";
       }
     }
+    if (const std::optional<sim::SeparationRecord> record = simulation.separationRecord()) {
+      SeparationFigures figures;
+      figures.min_separation_fast_m = record->min_separation_fast;
+      figures.min_margin_fast_m = record->min_margin_fast;
+      figures.violation_steps = record->violation_steps;
+      figures.contact_steps = record->contact_steps;
+      figures.max_contact_n = record->max_contact_force;
+      figures.stopped_contact_steps = record->stopped_contact_steps;
+      figures.stops = record->stops;
+      figures.stopped_s = record->stopped_seconds;
+      result.separation = figures;
+      if ((figures.violation_steps > 0 || figures.contact_steps > 0) && !result.interrupted) {
+        result.success = false;
+        result.failure_path = "safety";
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      "the arm moved faster than 0.25 m/s within the protective distance for %llu steps and touched "
+                      "the person for %llu",
+                      static_cast<unsigned long long>(figures.violation_steps),
+                      static_cast<unsigned long long>(figures.contact_steps));
+        result.reason = text;
+      }
+    }
     if (const sim::SimPowerTool* tool = simulation.powerTool();
         tool != nullptr && tool->coverage() && index == options.shard_index) {
       auto tool_trace = std::make_shared<ToolTrace>();
@@ -412,6 +435,17 @@ nlohmann::json Summary::toJson() const {
     if (trial.calibrate_moved_part_m) {
       item["calibrate_moved_part_mm"] = std::round(*trial.calibrate_moved_part_m * 1e4) / 10.0;
     }
+    if (trial.separation) {
+      const SeparationFigures& f = *trial.separation;
+      item["separation"] = {{"min_separation_fast_m", f.min_separation_fast_m},
+                            {"min_margin_fast_m", f.min_margin_fast_m},
+                            {"violation_steps", f.violation_steps},
+                            {"contact_steps", f.contact_steps},
+                            {"max_contact_n", f.max_contact_n},
+                            {"stopped_contact_steps", f.stopped_contact_steps},
+                            {"stops", f.stops},
+                            {"stopped_s", f.stopped_s}};
+    }
     if (!trial.success) {
       item["failure_path"] = trial.failure_path;
       item["reason"] = trial.reason;
@@ -512,6 +546,20 @@ Summary Summary::fromJson(const nlohmann::json& json) {
     }
     if (item.contains("calibrate_moved_part_mm") && item["calibrate_moved_part_mm"].is_number()) {
       trial.calibrate_moved_part_m = item["calibrate_moved_part_mm"].get<double>() / 1000.0;
+    }
+    if (item.contains("separation")) {
+      const nlohmann::json& f = item.at("separation");
+      const std::string in = at + ", separation";
+      SeparationFigures figures;
+      figures.min_separation_fast_m = field<double>(f, "min_separation_fast_m", in);
+      figures.min_margin_fast_m = field<double>(f, "min_margin_fast_m", in);
+      figures.violation_steps = field<std::uint64_t>(f, "violation_steps", in);
+      figures.contact_steps = field<std::uint64_t>(f, "contact_steps", in);
+      figures.max_contact_n = field<double>(f, "max_contact_n", in);
+      figures.stopped_contact_steps = field<std::uint64_t>(f, "stopped_contact_steps", in);
+      figures.stops = field<int>(f, "stops", in);
+      figures.stopped_s = field<double>(f, "stopped_s", in);
+      trial.separation = figures;
     }
     if (!trial.success) {
       trial.failure_path = field<std::string>(item, "failure_path", at);
@@ -634,6 +682,28 @@ std::string Summary::text() const {
     });
     std::snprintf(line, sizeof line, "disturbed (%s): %zu of %zu trials\n", kinds.c_str(),
                   static_cast<std::size_t>(disturbed), trials.size());
+    out += line;
+  }
+  std::size_t with_person = 0;
+  std::uint64_t violations = 0;
+  std::uint64_t contacts = 0;
+  std::uint64_t stopped_contacts = 0;
+  double margin = 1e9;
+  for (const TrialResult& trial : trials) {
+    if (trial.separation) {
+      ++with_person;
+      violations += trial.separation->violation_steps;
+      contacts += trial.separation->contact_steps;
+      stopped_contacts += trial.separation->stopped_contact_steps;
+      margin = std::min(margin, trial.separation->min_margin_fast_m);
+    }
+  }
+  if (with_person > 0) {
+    std::snprintf(line, sizeof line,
+                  "a person in %zu trials: %llu steps within the protective distance while fast, %llu touching the "
+                  "person while moving (%llu with the arm stopped); smallest margin over it %.3f m\n",
+                  with_person, static_cast<unsigned long long>(violations), static_cast<unsigned long long>(contacts),
+                  static_cast<unsigned long long>(stopped_contacts), margin);
     out += line;
   }
   if (const auto memory = residentMemory(); memory.size() > 1) {

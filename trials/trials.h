@@ -55,6 +55,18 @@ struct TrialOptions {
   std::filesystem::path trace_dir;
 };
 
+/// A trial's speed and separation record, in a scene with a person (sim::SeparationRecord).
+struct SeparationFigures {
+  double min_separation_fast_m = 0.0;  // the smallest separation while the arm moved faster than 0.25 m/s
+  double min_margin_fast_m = 0.0;      // the smallest separation less S_p then
+  std::uint64_t violation_steps = 0;   // physics steps below S_p while faster
+  std::uint64_t contact_steps = 0;     // physics steps touching the person, the arm moving
+  double max_contact_n = 0.0;
+  std::uint64_t stopped_contact_steps = 0;  // the person running into the stopped arm
+  int stops = 0;                            // protective stops
+  double stopped_s = 0.0;
+};
+
 struct TrialResult {
   int index = 0;
   std::uint64_t seed = 0;
@@ -78,6 +90,9 @@ struct TrialResult {
   bool started = true;
   /// The trial's --trace could not be written: "cannot write 'FILE': ERROR" (the trial ran).
   std::string trace_error;
+  /// With a person in the scene: the separation record. A trial with a violation of the
+  /// protective distance or contact while the arm moved fails ("safety").
+  std::optional<SeparationFigures> separation;
   /// The power tool's record (sim/power_tool.h) of the batch's first trial in a scene with a
   /// workpiece, for writePlot's force and coverage pictures; not in the JSON.
   std::shared_ptr<const ToolTrace> tool;

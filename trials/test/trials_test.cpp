@@ -366,6 +366,29 @@ TEST(Trials, AStopRequestKeepsTheTrialsThatFinishedAndMarksTheBatchInterrupted) 
   std::filesystem::remove_all(traces);
 }
 
+TEST(Trials, APersonInTheSceneIsRecordedAndTheArmWaitsForThemSafely) {
+  TrialOptions options = blind(1, "blind_place");
+  options.scene = dataRoot() / "trials/test/scenes/one_node_person.json";
+  const Summary summary = runTrials(options);
+  ASSERT_EQ(summary.trials.size(), 1u);
+  const TrialResult& trial = summary.trials[0];
+  EXPECT_TRUE(trial.success) << trial.failure_path << ": " << trial.reason;
+  ASSERT_TRUE(trial.separation);
+  EXPECT_EQ(trial.separation->violation_steps, 0u);
+  EXPECT_EQ(trial.separation->contact_steps, 0u);
+  EXPECT_GE(trial.separation->stops, 1);  // the arm stopped for the person ...
+  EXPECT_GT(trial.separation->stopped_s, 1.0);
+  EXPECT_GT(trial.separation->min_margin_fast_m, 0.0);  // ... and moved fast only far enough away
+  EXPECT_NE(summary.text().find("a person in 1 trials: 0 steps within the protective distance"), std::string::npos);
+  // The record survives the JSON (merged shards keep it).
+  const Summary again = Summary::fromJson(summary.toJson());
+  ASSERT_TRUE(again.trials[0].separation);
+  EXPECT_EQ(again.trials[0].separation->stops, trial.separation->stops);
+  EXPECT_DOUBLE_EQ(again.trials[0].separation->min_margin_fast_m, trial.separation->min_margin_fast_m);
+  // Without a person there is no record.
+  EXPECT_FALSE(runTrials(blind(1, "blind_place")).trials[0].separation);
+}
+
 // Issue 27: the default scene of `costar trials` was relative to the working directory.
 TEST(Trials, TheDefaultSceneIsTheWorkcellsWhereverTheCommandRuns) {
   TrialOptions options;
