@@ -62,6 +62,43 @@ class FixedFrames final : public component::TableComponent {
   std::vector<std::pair<std::string, world::Pose>> frames_;
 };
 
+/// The cell controller's speed and separation monitor (sim/speed_separation.h, docs/PERSON.md)
+/// as a safety controller reports it, for the editor and for plans that wait on it: the
+/// separation its sensor last read, the protective distance at the arm's speed, the speed
+/// override, and whether it is slowing or holding the arm for the person. In cells whose scene has
+/// a person.
+class SeparationMonitor final : public component::TableComponent {
+ public:
+  explicit SeparationMonitor(const sim::Simulation& simulation) : simulation_(simulation) {
+    component::ComponentDescription description;
+    description.name = "safety";
+    description.type = "SpeedSeparationMonitor";
+    description.symbols = {
+        {"person_separation", world::SymbolKind::kNumber, "the separation arm-person the monitor last sensed (m)"},
+        {"protective_distance", world::SymbolKind::kNumber, "ISO/TS 15066's S_p at the arm's present speed (m)"},
+        {"arm_speed_scale", world::SymbolKind::kNumber, "the speed override, 0 (held) to 1 (full speed)"}};
+    description.predicates = {{"arm_slowed_for_person", 0, "the monitor slows the arm for the person"},
+                              {"arm_stopped_for_person", 0, "the monitor holds the arm still for the person"}};
+    declare(std::move(description), {});  // no operations
+  }
+  world::Report report() const override {
+    world::Report report;
+    const std::optional<sim::SeparationStatus> status = simulation_.separation();
+    if (!status) {
+      return report;
+    }
+    report.symbols.push_back({"person_separation", "", {}, world::NumberValue{status->sensed_separation, "m"}});
+    report.symbols.push_back({"protective_distance", "", {}, world::NumberValue{status->protective_distance, "m"}});
+    report.symbols.push_back({"arm_speed_scale", "", {}, world::NumberValue{status->scale, ""}});
+    report.predicates.push_back({"arm_slowed_for_person", {}, status->state == "limited"});
+    report.predicates.push_back({"arm_stopped_for_person", {}, status->state == "stopped"});
+    return report;
+  }
+
+ private:
+  const sim::Simulation& simulation_;
+};
+
 /// The perception pipeline (models and SVM loaded from the data files, about half a second),
 /// loaded once per thread and shared by the workcells that thread creates: trials create one
 /// workcell per trial, and a pipeline runs one detection at a time.
@@ -262,6 +299,9 @@ class SimWorkcell final : public Workcell {
     add(calibration_);
     add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
         {"table_center", tableCenter()}, {"robot_base", cell_.robot_base}}));
+    if (simulation_->separation()) {
+      add(std::make_shared<SeparationMonitor>(*simulation_));
+    }
     // The power tool on its driver (the simulator's); its shape is an object class SmartGrasp
     // picks it up by. The stand and the workpiece are obstacles the planner knows.
     std::vector<world::ObjectClass> classes = simulation_->objectClasses();
