@@ -50,7 +50,25 @@ json cellState(workcell::Workcell& cell, std::int64_t active, bool paused) {
     arm_json["joints"] = std::move(positions);
   }
   arm_json["moving"] = world.holds("arm_moving", kNoArgs);
+  // The wrist sensor's wrench (what the tool pushes with, in the tool frame): the page shows
+  // the force while a plan presses.
+  if (const world::Symbol* symbol = world.symbol("wrench"); symbol != nullptr && symbol->wrench() != nullptr) {
+    const world::WrenchValue& wrench = *symbol->wrench();
+    const auto triple = [](const Eigen::Vector3d& v) {
+      return json::array({rounded(v.x(), 1e3), rounded(v.y(), 1e3), rounded(v.z(), 1e3)});
+    };
+    arm_json["wrench"] = {{"frame", wrench.frame}, {"force", triple(wrench.force)}, {"torque", triple(wrench.torque)}};
+    arm_json["in_contact"] = world.holds("in_contact", kNoArgs);
+  }
   state["arm"] = std::move(arm_json);
+
+  // The power tool (its component's symbol and predicates), when the cell has one.
+  if (const world::Symbol* speed = world.symbol("tool_speed"); speed != nullptr && speed->number() != nullptr) {
+    state["tool"] = {
+        {"speed", rounded(speed->number()->value, 10)}, {"unit", speed->number()->unit},
+        {"on", world.holds("tool_on", kNoArgs)},        {"at_speed", world.holds("tool_at_speed", kNoArgs)},
+        {"held", world.holds("tool_held", kNoArgs)},    {"docked", world.holds("tool_docked", kNoArgs)}};
+  }
 
   json gripper = {{"open", world.holds("gripper_open", kNoArgs)},
                   {"closed", world.holds("gripper_closed", kNoArgs)},

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <functional>
 #include <set>
+#include <string_view>
 #include "server/cell_state.h"
 #include "sim/simulation.h"
 #include "smartmove/grasps.h"
@@ -17,6 +18,22 @@
 namespace costar::server {
 
 namespace {
+
+/// The names of a list parameter ("a;b; c"), trimmed, empty ones left out.
+std::vector<std::string> splitList(std::string_view text) {
+  std::vector<std::string> names;
+  for (std::size_t start = 0; start <= text.size();) {
+    const std::size_t end = std::min(text.find(';', start), text.size());
+    std::string_view name = text.substr(start, end - start);
+    name.remove_prefix(std::min(name.find_first_not_of(' '), name.size()));
+    name.remove_suffix(name.size() - std::min(name.find_last_not_of(' ') + 1, name.size()));
+    if (!name.empty()) {
+      names.emplace_back(name);
+    }
+    start = end + 1;
+  }
+  return names;
+}
 
 /// A class as the 3D view draws it: its boxes (object frame, metres) and its named colours
 /// (RGB in [0, 1], ordered by name as the simulator numbers them).
@@ -118,9 +135,16 @@ std::vector<bt::Diagnostic> Engine::checkAgainstCell(const bt::Plan& plan) {
                  param->extra_choices.end();
         };
         std::string problem;
-        if (param->choices_from == "waypoint" && !known.waypoints.contains(value) && !taught.contains(value)) {
-          problem = "no waypoint '" + value +
-                    "' in this cell now (renamed or deleted?); its waypoints: " + listed(known.waypoints);
+        if (param->choices_from == "waypoint") {
+          // A list of waypoints (PressAndFollow's path, "row1_start;row1_end") names each one.
+          for (const std::string& waypoint :
+               param->type == component::ValueType::kStringList ? splitList(value) : std::vector{value}) {
+            if (!known.waypoints.contains(waypoint) && !taught.contains(waypoint)) {
+              problem = "no waypoint '" + waypoint +
+                        "' in this cell now (renamed or deleted?); its waypoints: " + listed(known.waypoints);
+              break;
+            }
+          }
         } else if (param->choices_from == "frame" && !detects && !extra() && !known.frames.contains(value) &&
                    !known.waypoints.contains(value) && !taught.contains(value)) {
           problem = "no frame '" + value + "' in this cell now; its frames: " + listed(known.frames);

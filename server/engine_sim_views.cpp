@@ -3,6 +3,7 @@
 
 #include "server/engine_parts.h"
 
+#include "sim/power_tool.h"
 #include "sim/simulation.h"
 #include "workcell/workcell.h"
 
@@ -29,6 +30,19 @@ std::optional<json> Engine::groundTruth() {
                   {"arm_table_contact_steps", simulation->armTableContactSteps()}};
     if (simulation->adaptiveGripper() == nullptr) {  // a 2-finger gripper: its opening
       truth["finger_opening"] = simulation->fingers().opening;
+    }
+    if (const sim::SimPowerTool* tool = simulation->powerTool(); tool != nullptr && tool->hasTool()) {
+      const tool::PowerToolReading reading = tool->read();
+      json power_tool = poseJson(tool->toolPose());
+      power_tool["powered"] = reading.powered;
+      power_tool["speed"] = reading.speed;
+      power_tool["held"] = reading.held;
+      power_tool["docked"] = reading.docked;
+      power_tool["arm_workpiece_steps"] = tool->armWorkpieceSteps();
+      if (tool->coverage()) {  // the marked area's fraction worked (texels worked 0.05 s or more)
+        power_tool["coverage"] = tool->coverage()->fraction();
+      }
+      truth["power_tool"] = std::move(power_tool);
     }
     return truth;
   });

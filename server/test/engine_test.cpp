@@ -715,6 +715,61 @@ TEST(Ur5Cell, CheckValidatesAgainstTheCell) {
       << run.body;
 }
 
+// --- the iiwa with the power tool (iiwa-3f-sim, the polishing scene) ---------------------------
+
+workcell::WorkcellOptions polishingCell() {
+  workcell::WorkcellOptions options;
+  options.name = "iiwa-3f-sim";
+  options.scene = dataRoot() / "sim/scenes/polishing.json";
+  options.waypoints = dataRoot() / "examples/iiwa/polishing_waypoints.json";
+  return options;
+}
+
+// A path of waypoints (PressAndFollow's "row1_start;row1_end") is checked waypoint by waypoint:
+// the whole text was looked up as one waypoint's name, so Check and Run refused every path
+// built in the editor ("no waypoint 'row1_start;row1_end'") and examples/iiwa/polishing.xml.
+TEST(PolishingCell, APathIsCheckedWaypointByWaypoint) {
+  Harness h(polishingCell());
+  const auto check = [&](const std::string& body) {
+    const std::string xml =
+        R"(<root BTCPP_format="4"><BehaviorTree ID="main"><Sequence>)" + body + R"(</Sequence></BehaviorTree></root>)";
+    const HttpResponse response = h.call("POST", "/api/validate", {{"xml", xml}});
+    EXPECT_EQ(response.status, 200) << response.body;
+    return json::parse(response.body);
+  };
+  EXPECT_TRUE(check(R"(<PressAndFollow path="row1_start;row1_end"/>)")["valid"]);
+  EXPECT_TRUE(check(R"(<PressAndFollow path=" row1_start ; row1_end;row2_start "/>)")["valid"]);
+  const json result = check(R"(<PressAndFollow path="row1_start;row9_end"/>)");
+  ASSERT_FALSE(result["valid"]) << result.dump();
+  const std::string message = result["diagnostics"][0]["message"];
+  EXPECT_NE(message.find("path: no waypoint 'row9_end' in this cell now"), std::string::npos) << message;
+}
+
+// The state the page shows while force is used: the wrist sensor's wrench and whether it
+// touches, the power tool's speed and where it is; the test endpoint has the tool's true state.
+TEST(PolishingCell, TheStateCarriesTheWrenchAndTheTool) {
+  ApiOptions api_options;
+  api_options.test_endpoints = true;
+  Harness h(polishingCell(), 0.0, api_options);
+  h.waitTicks(5);
+  const json state = h.get("/api/state");
+  ASSERT_TRUE(state["arm"].contains("wrench")) << state.dump();
+  EXPECT_EQ(state["arm"]["wrench"]["frame"], "tool");
+  EXPECT_EQ(state["arm"]["wrench"]["force"].size(), 3u);
+  EXPECT_FALSE(state["arm"]["in_contact"].get<bool>()) << state["arm"].dump();  // tared at rest, nothing touched
+  ASSERT_TRUE(state.contains("tool")) << state.dump();
+  EXPECT_FALSE(state["tool"]["on"].get<bool>());
+  EXPECT_TRUE(state["tool"]["docked"].get<bool>());
+  EXPECT_FALSE(state["tool"]["held"].get<bool>());
+  EXPECT_EQ(state["tool"]["unit"], "opm");
+  const json truth = h.get("/api/test/ground_truth");
+  ASSERT_TRUE(truth.contains("power_tool")) << truth.dump();
+  EXPECT_TRUE(truth["power_tool"]["docked"].get<bool>());
+  EXPECT_FALSE(truth["power_tool"]["powered"].get<bool>());
+  EXPECT_EQ(truth["power_tool"]["coverage"].get<double>(), 0.0);
+  EXPECT_EQ(truth["power_tool"]["arm_workpiece_steps"].get<int>(), 0);
+}
+
 // GET /api/robot: the robot as the planner models it (the arm's URDF with the gripper's on its
 // flange), where it stands, its joints, its gripper; the state carries the fingers' reading.
 TEST(Ur5Cell, TheRobotIsDescribedByThePlannersUrdf) {

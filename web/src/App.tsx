@@ -27,6 +27,7 @@ import {
   unchangedStatusesByKey,
 } from './model/status';
 import { controlRefusal, motionRefusal, resetRefusal, runRefusal, saveRefusal } from './model/controls';
+import { rangeProblems } from './model/units';
 import { fixFor, renameWaypoint, waypointUses } from './model/fixes';
 import type { DiffEntry } from './model/diff';
 import type { RobotDescription } from './model/robot';
@@ -360,10 +361,16 @@ export function App() {
     activeRun,
     replaying: !!replay,
   };
-  const refusedRun = runRefusal(controls);
+  // A number out of its range is refused before anything is saved or run (the field says why).
+  const outOfRange = useMemo(
+    () => plan.trees.flatMap((t) => rangeProblems(t.root, nodeInfo).map((p) => ({ ...p, tree: t.id }))),
+    [plan, nodeInfo],
+  );
+  const rangeRefusal = outOfRange.length ? `${outOfRange[0].id}: ${outOfRange[0].message}` : null;
+  const refusedRun = runRefusal(controls) ?? rangeRefusal;
   const refusedMotion = motionRefusal(controls);
   const refusedControl = controlRefusal(controls);
-  const refusedSave = saveRefusal(controls);
+  const refusedSave = saveRefusal(controls) ?? rangeRefusal;
   const paused = cell?.mode === 'paused';
 
   // --- editing -------------------------------------------------------------------------------
@@ -478,9 +485,12 @@ export function App() {
   useEffect(() => {
     const onKey = (e: KeyboardEvent) => {
       const target = e.target as HTMLElement;
-      if (target && ['INPUT', 'SELECT', 'TEXTAREA'].includes(target.tagName)) return;
       const ctrl = e.ctrlKey || e.metaKey;
       const key = e.key.toLowerCase();
+      // A list just chosen from keeps the focus: the tree's Ctrl shortcuts (copy, paste,
+      // duplicate, undo) still apply there (a list has no text of its own to copy or undo).
+      const treeShortcut = ctrl && ['c', 'x', 'v', 'd', 'z', 'y'].includes(key);
+      if (target && (['INPUT', 'TEXTAREA'].includes(target.tagName) || (target.tagName === 'SELECT' && !treeShortcut))) return;
       const root = tree?.root ?? null;
       const go = (direction: 'parent' | 'child' | 'previous' | 'next') => {
         const next = selectedKey ? T.neighbour(root, selectedKey, direction) : root?.key ?? null;
@@ -754,8 +764,9 @@ export function App() {
         if (node) map.set(node.key, d.message);
       }
     }
+    for (const p of outOfRange) if (p.tree === tree?.id && !map.has(p.key)) map.set(p.key, p.message);
     return map;
-  }, [diagnostics, tree]);
+  }, [diagnostics, tree, outOfRange]);
   const changes = useMemo(() => {
     if (!comparison || replay) return undefined;
     const map = new Map<string, 'added' | 'changed'>();

@@ -62,7 +62,16 @@ export interface CellState {
   t: number;
   run: number;
   mode: 'idle' | 'running' | 'paused';
-  arm: { joints?: number[]; endpoint?: Pose; moving?: boolean };
+  /** wrench: the wrist sensor's (N, N m, in the tool frame); in_contact: it reads more than 4 N. */
+  arm: {
+    joints?: number[];
+    endpoint?: Pose;
+    moving?: boolean;
+    wrench?: { frame: string; force: [number, number, number]; torque: [number, number, number] };
+    in_contact?: boolean;
+  };
+  /** The power tool, on cells that have one: speed in `unit` (opm: per minute). */
+  tool?: { speed: number; unit: string; on: boolean; at_speed: boolean; held: boolean; docked: boolean };
   /** reading: the gripper_fingers symbol (2 fingers: their opening, m; 3 fingers: each one's position, 0 open .. 1 closed). */
   gripper: { open: boolean; closed: boolean; holding: boolean; mode?: string; reading?: FingerReading };
   /** color: the mean RGB ([0, 1]) DetectObjects saw on the part, when it reported one. */

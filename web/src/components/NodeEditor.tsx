@@ -5,6 +5,8 @@ import type { Choices, NodeInfo, PortInfo } from '../api';
 import type { EditorNode } from '../model/tree';
 import { formatPredicates, parsePredicates, PredicateTerm, referenceChoices } from '../model/predicates';
 import { formatPoseText, parsePoseText, POSE_FIELDS, PoseFields } from '../model/poseText';
+import { argumentKinds, waypointPaths } from '../model/paths';
+import { rangeProblem, rangeText, toPlan, toShown, unitOf } from '../model/units';
 
 interface Props {
   node: EditorNode | null;
@@ -89,6 +91,93 @@ function PoseInput(props: { id: string; text: string | undefined; disabled: bool
           />
         </label>
       ))}
+    </div>
+  );
+}
+
+/**
+ * A path of waypoints (PressAndFollow's `path`): the waypoints in order, each removable; a whole
+ * path taught as one (names sharing a prefix: row1_start, row1_end) set at once, or one
+ * waypoint added at the end.
+ */
+function PathInput(props: { id: string; text: string | undefined; waypoints: string[]; disabled: boolean; onChange: (value: string | undefined) => void }) {
+  const list = (props.text ?? '').split(';').map((w) => w.trim()).filter((w) => w !== '');
+  const paths = waypointPaths(props.waypoints);
+  const set = (next: string[]) => props.onChange(next.length ? next.join(';') : undefined);
+  return (
+    <div id={props.id} className="path-list" role="group" aria-label="path">
+      {list.length === 0 && <span className="hint">no waypoints yet</span>}
+      <ol>
+        {list.map((w, i) => (
+          <li key={`${i}-${w}`}>
+            <span className={props.waypoints.includes(w) ? undefined : 'unknown-choice'} title={props.waypoints.includes(w) ? undefined : `'${w}' is not in the cell now`}>
+              {w}
+            </span>
+            <button type="button" className="remove-condition" disabled={props.disabled} aria-label={`remove ${w}`} onClick={() => set(list.filter((_, k) => k !== i))}>
+              ✕
+            </button>
+          </li>
+        ))}
+      </ol>
+      {paths.length > 0 && (
+        <select
+          aria-label="whole path"
+          className="whole-path"
+          value=""
+          disabled={props.disabled}
+          onChange={(e) => {
+            const path = paths.find((p) => p.prefix === e.target.value);
+            if (path) set(path.waypoints);
+          }}
+        >
+          <option value="">the whole path…</option>
+          {paths.map((p) => (
+            <option key={p.prefix} value={p.prefix} title={p.waypoints.join(' → ')}>
+              {p.prefix}… ({p.waypoints.length}: {p.waypoints[0]} → {p.waypoints[p.waypoints.length - 1]})
+            </option>
+          ))}
+        </select>
+      )}
+      <select aria-label="add waypoint" className="add-condition" value="" disabled={props.disabled} onChange={(e) => e.target.value && set([...list, e.target.value])}>
+        <option value="">+ waypoint…</option>
+        {props.waypoints.map((w) => (
+          <option key={w} value={w}>
+            {w}
+          </option>
+        ))}
+      </select>
+    </div>
+  );
+}
+
+/** A number in the unit a technician states it in (mm, mm/s, N), with its range and why a value is refused. */
+function NumberInput(props: { id: string; port: PortInfo; current: string | undefined; disabled: boolean; onChange: (value: string | undefined) => void }) {
+  const { port } = props;
+  const unit = unitOf(port);
+  const range = rangeText(port);
+  const problem = rangeProblem(port, props.current);
+  const placeholder = port.default !== undefined ? `default: ${toShown(unit, port.default) || '(none)'}` : 'type a number';
+  return (
+    <div className="number-port">
+      <span className="number-field">
+        <input
+          id={props.id}
+          type="number"
+          step={port.type === 'int' ? 1 : 'any'}
+          placeholder={placeholder}
+          value={toShown(unit, props.current)}
+          disabled={props.disabled}
+          aria-invalid={problem !== null}
+          onChange={(e) => props.onChange(toPlan(unit, e.target.value))}
+        />
+        {unit && <span className="unit">{unit.shown}</span>}
+      </span>
+      {range && <span className="hint range">{range}</span>}
+      {problem && (
+        <span className="reason" role="alert">
+          {problem}
+        </span>
+      )}
     </div>
   );
 }
@@ -231,33 +320,54 @@ export function NodeEditor({ node, info, choices, objects, trees, readOnly, onCh
       return <Select id={id} current={current} options={trees} placeholder="choose a tree…" disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;
     }
     if (node.id === 'CheckPredicate' && port.name === 'args') {
-      const predicate = value(node, 'predicate');
-      const arity = choices?.predicate.find((p) => p.name === predicate)?.arity ?? 0;
+      const predicate = choices?.predicate.find((p) => p.name === value(node, 'predicate'));
+      const arity = predicate?.arity ?? 0;
+      const kinds = argumentKinds(predicate?.description ?? '', arity);
       const args = (current ?? '').split(';').filter((a) => a !== '');
       while (args.length < arity) args.push('');
+      const setArg = (i: number, v: string | undefined) => {
+        const next = [...args.slice(0, arity)];
+        next[i] = v ?? '';
+        onChange(port.name, next.join(';'));
+      };
       return (
         <div id={id} className="args">
           {arity === 0 && <span className="hint">no arguments</span>}
-          {args.slice(0, arity).map((arg, i) => (
-            <Select
-              key={i}
-              id={`${id}-${i}`}
-              current={arg || undefined}
-              options={['?', ...references]}
-              placeholder="choose…"
-              disabled={readOnly}
-              onChange={(v) => {
-                const next = [...args.slice(0, arity)];
-                next[i] = v ?? '';
-                onChange(port.name, next.join(';'));
-              }}
-            />
-          ))}
+          {args.slice(0, arity).map((arg, i) =>
+            kinds[i] === 'number' ? (
+              <span key={i} className="number-field">
+                <input
+                  id={`${id}-${i}`}
+                  type="number"
+                  step="any"
+                  placeholder="newtons"
+                  value={arg}
+                  disabled={readOnly}
+                  aria-invalid={arg !== '' && !Number.isFinite(Number(arg))}
+                  onChange={(e) => setArg(i, e.target.value)}
+                />
+                <span className="unit">N</span>
+              </span>
+            ) : (
+              <Select
+                key={i}
+                id={`${id}-${i}`}
+                current={arg || undefined}
+                options={kinds[i] === 'waypoint' ? choices?.waypoint ?? [] : ['?', ...references]}
+                placeholder="choose…"
+                disabled={readOnly}
+                onChange={(v) => setArg(i, v)}
+              />
+            ),
+          )}
         </div>
       );
     }
     if (port.choices_from === 'predicate' && choices) {
       return <PredicateList id={id} text={current ?? ''} choices={choices} references={references} disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;
+    }
+    if (port.choices_from === 'waypoint' && port.type.includes('vector')) {
+      return <PathInput id={id} text={current} waypoints={choices?.waypoint ?? []} disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;
     }
     let list: string[] | undefined = port.choices;
     let shownPlaceholder = placeholder;
@@ -286,19 +396,7 @@ export function NodeEditor({ node, info, choices, objects, trees, readOnly, onCh
       );
     }
     if (port.type === 'int' || port.type === 'double') {
-      return (
-        <input
-          id={id}
-          type="number"
-          step={port.type === 'int' ? 1 : 'any'}
-          min={port.min}
-          max={port.max}
-          placeholder={placeholder}
-          value={current ?? ''}
-          disabled={readOnly}
-          onChange={(e) => onChange(port.name, e.target.value === '' ? undefined : e.target.value)}
-        />
-      );
+      return <NumberInput id={id} port={port} current={current} disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;
     }
     if (port.type === 'costar::Pose') {
       return <PoseInput id={id} text={current} disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;

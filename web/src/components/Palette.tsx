@@ -7,8 +7,11 @@
 import { Fragment, useMemo, useState } from 'react';
 import type { NodeInfo } from '../api';
 
-/** Control flow a plan uses most: always in view. */
-const EVERYDAY = ['Sequence', 'Fallback', 'Repeat', 'RetryUntilSuccessful'];
+/**
+ * Control flow a plan uses most, and the paper's own (CoSTAR's Iterator and RESET, the guard a
+ * RESET watches: a ReactiveSequence): always in view.
+ */
+const EVERYDAY = ['Sequence', 'Fallback', 'ReactiveSequence', 'Iterator', 'Reset', 'Repeat', 'RetryUntilSuccessful'];
 
 /** The rest of the control flow, by what it is for. */
 const CONTROL_GROUPS: { title: string; about: string; kinds: NodeInfo['kind'][] }[] = [

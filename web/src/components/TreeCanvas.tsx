@@ -56,14 +56,14 @@ interface Props {
 
 
 // The parameters that tell nodes of one type apart, in the order they are shown.
-const SUMMARY_PORTS = ['waypoint', 'object_class', 'target_class', 'target', 'predicates', 'grasp', 'predicate', 'args',
-  'expected', 'num_cycles', 'num_attempts', 'msec', 'ID', 'offset', 'pose', 'speed', 'mode', 'frame', 'joint', 'axis', 'amount', 'degrees', 'message'];
+const SUMMARY_PORTS = ['waypoint', 'path', 'direction', 'force', 'object_class', 'target_class', 'target', 'predicates', 'grasp', 'predicate', 'args',
+  'expected', 'num_cycles', 'num_attempts', 'num_resets', 'msec', 'ID', 'offset', 'pose', 'speed', 'mode', 'frame', 'joint', 'axis', 'amount', 'degrees', 'message'];
 
 export function summary(node: EditorNode): string {
   const shown = node.attributes.filter(([k]) => k !== 'name' && SUMMARY_PORTS.includes(k));
   shown.sort((a, b) => SUMMARY_PORTS.indexOf(a[0]) - SUMMARY_PORTS.indexOf(b[0]));
   // The values alone where the type says what they are: a class, where it goes, the conditions.
-  const bare = ['waypoint', 'object_class', 'predicates'];
+  const bare = ['waypoint', 'object_class', 'predicates', 'direction'];
   const pose = (k: string, v: string) => {
     const f = parsePoseText(v);
     if (!f) return `${k}=${v}`;
@@ -72,7 +72,7 @@ export function summary(node: EditorNode): string {
   };
   return shown
     .map(([k, v]) =>
-      k === 'target_class' ? `on ${v}` : k === 'target' ? `at ${v}` : k === 'offset' || k === 'pose' ? pose(k, v) : bare.includes(k) ? v : `${k}=${v}`,
+      k === 'path' ? v.split(';').join(' → ') : k === 'force' ? `${v} N` : k === 'target_class' ? `on ${v}` : k === 'target' ? `at ${v}` : k === 'offset' || k === 'pose' ? pose(k, v) : bare.includes(k) ? v : `${k}=${v}`,
     )
     .join('  ');
 }
@@ -137,7 +137,9 @@ const TreeBox = memo(function TreeBox({ data }: NodeProps<Node<BoxData>>) {
       onDrop={(e) => {
         e.preventDefault();
         e.stopPropagation();
-        const position = drop ?? 'inside';
+        // Where the drop lands, not where the last drag-over said (its state may not have
+        // been rendered yet when the drop follows it at once).
+        const position = dropPosition(e, props.orientation, root);
         setDrop(null);
         const moving = e.dataTransfer.getData('application/x-costar-move');
         const fresh = e.dataTransfer.getData('application/x-costar-new');

@@ -15,6 +15,7 @@ import { partLook } from '../model/parts';
 import { DrawnRobot } from '../model/drawnRobot';
 import type { RobotDescription } from '../model/robot';
 import type { Candidate } from './ObjectsPane';
+import { ForceStrip } from './ForceStrip';
 
 interface Props {
   state: CellState | null;
@@ -326,6 +327,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
         )}
       </h2>
       {replayLabel && <div className="view3d-replay">{replayLabel}</div>}
+      <ForceStrip state={state} />
       {error ? (
         <p className="empty">{error}</p>
       ) : (
