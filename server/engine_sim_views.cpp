@@ -44,6 +44,22 @@ std::optional<json> Engine::groundTruth() {
       }
       truth["power_tool"] = std::move(power_tool);
     }
+    if (const std::optional<sim::JigState> jig = simulation->jig(); jig && jig->has_wire) {
+      json bends = json::array();
+      for (const sim::MeasuredBend& bend : jig->bends) {
+        bends.push_back({{"target_deg", bend.target_deg},
+                         {"angle_deg", bend.angle_deg},
+                         {"out_of_plane_deg", bend.out_of_plane_deg}});
+      }
+      double slipped = 0.0;
+      for (const sim::PinState& pin : jig->pins) {
+        slipped = std::max(slipped, pin.slipped);
+      }
+      truth["wire"] = {{"bends", std::move(bends)},      {"speed", jig->wire_speed},
+                       {"held", jig->grip.held},         {"holds", jig->grip.holds},
+                       {"releases", jig->grip.releases}, {"pulled_out", jig->grip.pulled_out},
+                       {"max_slip", jig->grip.max_slip}, {"pin_slipped", slipped}};
+    }
     return truth;
   });
 }

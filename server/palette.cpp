@@ -54,6 +54,13 @@ Palette describePalette(workcell::Workcell& cell) {
     if (provider != nullptr) {
       node["component"] = provider->description().name;
     }
+    // An operation without parameters that this cell refuses whatever the plan (a 2-finger
+    // gripper's Scissor mode): the palette leaves it out, saying why; Check still names it.
+    if (operation != nullptr && operation->params.empty() && operation->check) {
+      if (std::string problem = operation->check({}); !problem.empty()) {
+        node["unavailable"] = std::move(problem);
+      }
+    }
     nodes.push_back(std::move(node));
     detect = detect || spec->id == "DetectObjects";
     calibrate = calibrate || spec->id == "Calibrate" || spec->id == "HandEyeCalibration";

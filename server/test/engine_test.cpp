@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <map>
 #include <thread>
 
 #include "bt/builder.h"
@@ -713,6 +714,24 @@ TEST(Ur5Cell, CheckValidatesAgainstTheCell) {
   EXPECT_EQ(run.status, 422) << run.body;
   EXPECT_EQ(json::parse(run.body)["error"].get<std::string>().rfind("this plan has 1 problem: Move: waypoint:", 0), 0u)
       << run.body;
+}
+
+// The palette offers the modes the cell's gripper has: a 2-finger gripper's Basic, Wide and
+// Scissor modes are marked unavailable with the reason (the editor leaves them out); Check
+// still names them in a plan.
+TEST(Ur5Cell, ThePaletteMarksTheModesTheGripperLacks) {
+  Harness h(blindCell());
+  std::map<std::string, json> nodes;
+  for (const json& node : h.get("/api/nodes")) {
+    nodes[node["id"]] = node;
+  }
+  for (const char* mode : {"BasicMode", "WideMode", "ScissorMode"}) {
+    ASSERT_TRUE(nodes[mode].contains("unavailable")) << mode;
+    EXPECT_NE(nodes[mode]["unavailable"].get<std::string>().find("has only Pinch mode"), std::string::npos) << mode;
+  }
+  for (const char* available : {"PinchMode", "Open", "Close", "SetMode", "Move"}) {
+    EXPECT_FALSE(nodes[available].contains("unavailable")) << available;
+  }
 }
 
 // --- the iiwa with the power tool (iiwa-3f-sim, the polishing scene) ---------------------------

@@ -6,7 +6,8 @@
 //   - a waypoint renamed in the cell: Check flags the plan on its Move node, the status line
 //     offers to rename it in the plan, and then Check passes;
 //   - versions: compare v1 with the open plan (a tree diff), restore v1, open v2;
-//   - Check knows the cell's gripper (ScissorMode on a 2-finger gripper) and offers the cure
+//   - the palette offers the modes the cell's gripper has; Check knows the cell's gripper
+//     (an imported ScissorMode on a 2-finger gripper) and offers the cure
 //     for a structural problem (a Repeat with two children: wrap them in a Sequence);
 //   - Reset scene: the moved part back where the scene puts it; refused while a run is active;
 //   - the server stopped: the page says "not connected" and disables Run, saying why.
@@ -164,12 +165,15 @@ async function main() {
   check((await page.inputValue('#port-waypoint')) === 'over_pick', 'an older version (2) opens in the editor');
 
   // --- Check knows the gripper; structural problems come with their cure --------------------------
-  await page.locator('.tree-node[data-node-type="Sequence"]').first().click();
-  await page.click('.palette-item[data-node-type="ScissorMode"]');
-  await page.click('button:text-is("Check")');
+  // The palette offers only the modes the cell's gripper has; a plan with another is flagged.
+  check((await page.$('.palette-item[data-node-type="ScissorMode"]')) === null, 'the palette does not offer ScissorMode on the 2-finger cell');
+  const note = await page.textContent('.palette .unavailable');
+  check(/^Not on this cell: BasicMode, ScissorMode, WideMode \(a parallel 2-finger gripper has only Pinch mode/.test(note ?? ''), `it says which and why: "${note}"`);
+  const scissorPlan = `<root BTCPP_format="4" main_tree_to_execute="main"><BehaviorTree ID="main"><Sequence><Open/><ScissorMode/></Sequence></BehaviorTree></root>`;
+  await page.setInputFiles('.file-button input', { name: 'scissor.xml', mimeType: 'application/xml', buffer: Buffer.from(scissorPlan) });
   await page.waitForSelector('.tree-node.problem[data-node-type="ScissorMode"]');
   const scissor = await page.textContent('.status-line .message');
-  check(/^1 problem: ScissorMode: a parallel 2-finger gripper has only Pinch mode/.test(scissor ?? ''), `Check fails ScissorMode on the 2-finger cell: "${scissor}"`);
+  check(/1 problem\(s\): ScissorMode: a parallel 2-finger gripper has only Pinch mode/.test(scissor ?? ''), `an imported plan's ScissorMode is flagged on the 2-finger cell: "${scissor}"`);
   const twoChildren = `<root BTCPP_format="4" main_tree_to_execute="main"><BehaviorTree ID="main"><Repeat num_cycles="2"><Open/><Close/></Repeat></BehaviorTree></root>`;
   await page.setInputFiles('.file-button input', { name: 'two_children.xml', mimeType: 'application/xml', buffer: Buffer.from(twoChildren) });
   await page.waitForSelector('.status-line .offer');

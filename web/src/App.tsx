@@ -1148,6 +1148,16 @@ export function App() {
           selectedKey &&
           edit((p) => (clear ?? []).reduce((q, other) => T.setAttribute(q, treeId, selectedKey, other, undefined), T.setAttribute(p, treeId, selectedKey, name, value)))
         }
+        onAlongPath={(name, waypoints) => {
+          if (!selectedKey) return;
+          let last = selectedKey;
+          edit((p) => {
+            const done = T.alongPath(p, treeId, selectedKey, name, waypoints, kindOf);
+            last = done.last;
+            return done.plan;
+          });
+          setSelectedKey(last);
+        }}
       />
       <ObjectsPane state={viewState} selectedType={selected?.id ?? null} data={selectedData} shapes={choices?.object_shape} believed={viewBelieved} />
       <View3D

@@ -27,6 +27,8 @@ export interface NodeInfo {
   asynchronous: boolean;
   component?: string;
   ports: PortInfo[];
+  /** Why this cell refuses it whatever the plan (a 2-finger gripper's Scissor mode): not offered. */
+  unavailable?: string;
 }
 
 export interface Choices {

@@ -178,3 +178,22 @@ describe('plan JSON (what the server turns into XML)', () => {
     expect(T.removeTree(plan, 'grasp').trees.length).toBe(1);
   });
 });
+
+describe('a node along a path', () => {
+  it('goes to each waypoint of the path in turn, its other parameters copied, after it in order', () => {
+    let plan = T.emptyPlan();
+    const move = T.makeNode('Move', [['waypoint', 'wire_grip'], ['speed', '0.15']]);
+    plan = T.addChild(plan, 'main', rootKey(plan), move, kindOf);
+    plan = T.addChild(plan, 'main', rootKey(plan), T.makeNode('Open'), kindOf);
+    const done = T.alongPath(plan, 'main', move.key, 'waypoint', ['bend_b_10', 'bend_b_20', 'bend_b_over'], kindOf);
+    const children = T.findTree(done.plan, 'main')!.root!.children;
+    expect(children.map((c) => `${c.id} ${c.attributes.map(([k, v]) => `${k}=${v}`).join(' ')}`)).toEqual([
+      'Move waypoint=bend_b_10 speed=0.15',
+      'Move waypoint=bend_b_20 speed=0.15',
+      'Move waypoint=bend_b_over speed=0.15',
+      'Open ',
+    ]);
+    expect(new Set(children.map((c) => c.key)).size).toBe(4);
+    expect(done.last).toBe(children[2].key);
+  });
+});

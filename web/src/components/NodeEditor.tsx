@@ -17,6 +17,8 @@ interface Props {
   readOnly: boolean;
   /** Sets one parameter; `clear` names others removed in the same edit (one undo step). */
   onChange: (name: string, value: string | undefined, clear?: string[]) => void;
+  /** The node to each of these waypoints in turn: copies of it after it, one per waypoint (one undo step). */
+  onAlongPath: (name: string, waypoints: string[]) => void;
 }
 
 function value(node: EditorNode, name: string): string | undefined {
@@ -289,7 +291,7 @@ function PredicateList(props: {
   );
 }
 
-export function NodeEditor({ node, info, choices, objects, trees, readOnly, onChange }: Props) {
+export function NodeEditor({ node, info, choices, objects, trees, readOnly, onChange, onAlongPath }: Props) {
   if (!node) {
     return (
       <section className="pane editor" aria-label="Customise">
@@ -381,6 +383,35 @@ export function NodeEditor({ node, info, choices, objects, trees, readOnly, onCh
       if (port.default === '') shownPlaceholder = `default: the first taught${objectClass && list[0] ? ` (${list[0]})` : ''}`;
     }
     if (list && port.extra_choices) list = [...port.extra_choices, ...list.filter((c) => !port.extra_choices!.includes(c))];
+    if (list && port.choices_from === 'waypoint') {
+      // One waypoint (Move's): or a path taught as one, a copy of the node to each of its waypoints.
+      const paths = waypointPaths(list);
+      return (
+        <div className="waypoint-port">
+          <Select id={id} current={current} options={list} placeholder={shownPlaceholder} disabled={readOnly} onChange={(v) => onChange(port.name, v)} />
+          {paths.length > 0 && (
+            <select
+              aria-label="along a path"
+              className="whole-path"
+              value=""
+              disabled={readOnly}
+              title={`a ${node.id} to each waypoint of a path taught as one, in order, with this node's other parameters`}
+              onChange={(e) => {
+                const path = paths.find((p) => p.prefix === e.target.value);
+                if (path) onAlongPath(port.name, path.waypoints);
+              }}
+            >
+              <option value="">{`a ${node.id} to each of a path…`}</option>
+              {paths.map((p) => (
+                <option key={p.prefix} value={p.prefix} title={p.waypoints.join(' → ')}>
+                  {p.prefix}… ({p.waypoints.length}: {p.waypoints[0]} → {p.waypoints[p.waypoints.length - 1]})
+                </option>
+              ))}
+            </select>
+          )}
+        </div>
+      );
+    }
     if (list) {
       // The empty choice of an optional list is its default: shown by the placeholder.
       const options = port.default === '' ? list.filter((c) => c !== '') : list;

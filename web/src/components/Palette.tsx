@@ -43,8 +43,10 @@ export function Palette({ nodes, disabledReason, onAdd }: Props) {
   const [filter, setFilter] = useState('');
   const shown = useMemo(() => {
     const f = filter.trim().toLowerCase();
-    return nodes.filter((n) => !f || n.id.toLowerCase().includes(f) || n.description.toLowerCase().includes(f));
+    return nodes.filter((n) => !n.unavailable && (!f || n.id.toLowerCase().includes(f) || n.description.toLowerCase().includes(f)));
   }, [nodes, filter]);
+  // What the cell's own components refuse whatever the plan (its gripper's modes): named apart.
+  const unavailable = nodes.filter((n) => n.unavailable);
   const item = (n: NodeInfo) => (
     <button
       key={n.id}
@@ -79,6 +81,11 @@ export function Palette({ nodes, disabledReason, onAdd }: Props) {
           <div>
             <h3 title="what the arm and the gripper do">Robot actions</h3>
             {robot.map(item)}
+            {unavailable.length > 0 && (
+              <p className="hint unavailable" title={[...new Set(unavailable.map((n) => n.unavailable))].join('\n')}>
+                Not on this cell: {unavailable.map((n) => n.id).join(', ')} ({unavailable[0].unavailable})
+              </p>
+            )}
           </div>
         )}
         {knowledge.length > 0 && (

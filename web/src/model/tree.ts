@@ -423,3 +423,29 @@ export function neighbour(root: EditorNode | null, key: string, direction: 'pare
   const index = at.index + (direction === 'next' ? 1 : -1);
   return at.parent.children[index]?.key ?? null;
 }
+
+/**
+ * The node to each waypoint of a path in turn: it takes the first, copies of it (its other
+ * attributes, fresh keys) follow it for the others. Returns the plan and the last copy's key.
+ */
+export function alongPath(
+  plan: EditorPlan,
+  treeId: string,
+  key: string,
+  port: string,
+  waypoints: string[],
+  kindOf: KindLookup,
+): { plan: EditorPlan; last: string } {
+  if (waypoints.length === 0) return { plan, last: key };
+  let next = setAttribute(plan, treeId, key, port, waypoints[0]);
+  const node = locate(findTree(next, treeId)?.root ?? null, key)?.node;
+  if (!node) throw new Error('that node is not in this tree');
+  let after = key;
+  for (const waypoint of waypoints.slice(1)) {
+    const copy = cloneNode(node);
+    copy.attributes = copy.attributes.map(([k, v]) => [k, k === port ? waypoint : v]);
+    next = addSibling(next, treeId, after, copy, kindOf);
+    after = copy.key;
+  }
+  return { plan: next, last: after };
+}
