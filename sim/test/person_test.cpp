@@ -222,6 +222,37 @@ TEST(SimPerson, TheHandHoldsAPartByClosingAroundIt) {
   EXPECT_TRUE(fingers_touch);
 }
 
+TEST(SimPerson, TheRgbdCameraSeesTheHandOverTheTableAndNothingWhenThePersonHasLeft) {
+  // The hand held still over an empty part of the table; then the person walks away.
+  const Scene scene = parseScene(R"({"parts": [], "person": {"shoulder": [0.55, 0.8, 0.45], "script": [
+      {"do": "reach", "to": [0.6, 0.35, 0.2], "speed": 1.0}, {"do": "wait", "seconds": 1},
+      {"do": "leave", "speed": 1.6}, {"do": "wait", "seconds": 10}]}})",
+                                 "test");
+  const auto sim = Simulation::create(scene);
+  const auto pointsNearTheHand = [&sim] {
+    const camera::RgbdFrame frame = sim->captureRgbd(1, false);
+    int near = 0;
+    for (const auto& p : frame.points) {
+      if (std::isfinite(p.z())) {
+        const Eigen::Vector3d world_point = frame.camera_pose * p.cast<double>();
+        // Above the table top by more than a part's height, within 12 cm of where the hand
+        // reached (over the table: only the person is there).
+        near += world_point.z() > 0.08 && (world_point - Eigen::Vector3d(0.6, 0.35, 0.2)).norm() < 0.12 ? 1 : 0;
+      }
+    }
+    return near;
+  };
+  const PersonMotion motion(*scene.person, scene.seed);
+  double t = 0.0;
+  while (motion.at(t).step != "wait") {
+    t += 0.01;
+  }
+  sim->stepTo(TimePoint(fromSeconds(t + 0.2)));
+  EXPECT_GT(pointsNearTheHand(), 200);
+  sim->stepTo(TimePoint(fromSeconds(motion.duration() - 5.0)));
+  EXPECT_EQ(pointsNearTheHand(), 0);
+}
+
 /// The UR5 sweeps its base joint back and forth across where the person's hand waits; returns
 /// the record, and in `finished` whether the arm ended its last sweep where it should.
 SeparationRecord sweepPastAPerson(bool monitored, bool* finished) {
