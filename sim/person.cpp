@@ -7,7 +7,6 @@
 #include <stdexcept>
 
 #include "core/json_file.h"
-#include "sim/scene.h"
 #include "sim/scene_fields.h"
 
 namespace costar::sim {
@@ -39,11 +38,9 @@ void checkTarget(const Eigen::Vector3d& target, const Eigen::Vector3d& shoulder,
     fail(field, "lies " + fields::written(std::round(distance * 1000) / 1000) +
                     " m from the shoulder; a person's arm reaches " + fields::written(kPersonReach) + " m");
   }
-  const Region table = tableTop();
-  const bool over_table = target.x() >= table.min.x() && target.x() <= table.max.x() && target.y() >= table.min.y() &&
-                          target.y() <= table.max.y();
-  if (over_table && target.z() < kMinHeight) {
-    fail(field, "lies " + fields::written(target.z()) + " m above the table; over it the hand keeps at least " +
+  // Everywhere, not only over the table: the simulator's table top is an endless plane.
+  if (target.z() < kMinHeight) {
+    fail(field, "lies " + fields::written(target.z()) + " m above the table top's height; the hand keeps at least " +
                     fields::written(kMinHeight) + " m above it");
   }
 }
@@ -170,7 +167,7 @@ Eigen::Vector3d PersonSpec::restPosition() const {
   }
   Eigen::Vector3d toward(0.0, -shoulder.y(), 0.0);
   toward = toward.norm() > 1e-6 ? toward.normalized() : Eigen::Vector3d(1, 0, 0);
-  return shoulder + 0.1 * toward + Eigen::Vector3d(0, 0, -0.45);
+  return shoulder + 0.1 * toward + Eigen::Vector3d(0, 0, -std::min(0.35, shoulder.z() - 0.05));
 }
 
 PersonSpec parsePerson(const std::string& json_text, const std::string& field) {

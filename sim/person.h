@@ -22,14 +22,16 @@
 // - "wait": the hand holds still for "seconds".
 // - "close" / "open": the fingers close (or open) over "seconds"; closing around a part holds it
 //   (force-limited finger joints, contact and friction only: whoever else holds it must let go).
-// - "withdraw": a reach back to where the hand started ("rest", default: hanging beside the
-//   body, 0.1 m toward the table's middle from the shoulder and 0.45 m lower).
+// - "withdraw": a reach back to where the hand started ("rest", default: beside the body, 0.1 m
+//   toward the table's middle from the shoulder and 0.35 m lower, at least 5 cm above the table
+//   top's height).
 // - "leave" / "enter": the whole person walks 1.5 m straight away from the table (along y, on
 //   the shoulder's side) or back, the hand at rest, at "speed" (m/s, default 1, at most 1.6);
 //   "start": "away" has the person away at first. Away, only "enter" and "wait" may follow.
 // "repeat": true starts the script again when it ends (drawing new random reaches), for long
-// randomized runs. Every target must lie within the arm's reach (0.56 m from the shoulder) and,
-// over the table, at least 3 cm above it. A field or step the format does not know, a value of the wrong
+// randomized runs. Every target must lie within the arm's reach (0.56 m from the shoulder) and at
+// least 3 cm above the table top's height (also beside the table: the simulator's table top is an
+// endless plane). A field or step the format does not know, a value of the wrong
 // type or out of range is an error naming the field, e.g.
 //   scene 'x.json': person.script[1].speed: must be from 0.05 to 1.6 m/s, not 2.5
 //
@@ -60,7 +62,7 @@ struct PersonStep {
 struct PersonSpec {
   Eigen::Vector3d shoulder = Eigen::Vector3d(0.55, 0.8, 0.4);
   /// Where the wrist starts and withdraws to; absent: 0.1 m from the shoulder toward the
-  /// table's middle (y = 0) and 0.45 m lower, the arm hanging beside the body.
+  /// table's middle (y = 0) and 0.35 m lower (at least 5 cm above the table top's height).
   std::optional<Eigen::Vector3d> rest;
   std::optional<std::uint64_t> seed;
   bool repeat = false;

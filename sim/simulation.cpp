@@ -147,7 +147,6 @@ struct Simulation::Impl {
   double scale_rate = 0.0;
   std::int64_t sensor_steps = 1;  // steps between separation readings
   double sensed = 1e9;
-  std::int64_t last_touch_step = -1000000;  // when the arm last touched the person
   SeparationStatus status;
   SeparationRecord record;
 
@@ -357,10 +356,11 @@ struct Simulation::Impl {
     }
     record.seconds += dt;
     record.min_separation = std::min(record.min_separation, separation);
-    // The person pushing the arm while the override holds it still moves it, but not of its own
-    // accord: such steps count as contact with a stopped arm, not as the arm moving fast.
-    // (Touched in the last 0.2 s: a pushed arm bounces off the hand and back.)
-    const bool pushed = scale <= 0.0 && steps - last_touch_step < static_cast<std::int64_t>(std::llround(0.2 / dt));
+    // With the override at 0 the controller holds the arm still on its path (it reaches 0 only
+    // at the end of braking): the arm moving then was moved by the person, who pushed it (its
+    // controller swinging it back afterwards), not of its own accord. Such steps do not count as
+    // the arm moving fast; the contact counts apart (recordPersonContact).
+    const bool pushed = scale <= 0.0;
     if (speed > SeparationRecord::fast_speed && !pushed) {
       record.fast_seconds += dt;
       record.min_separation_fast = std::min(record.min_separation_fast, separation);
@@ -391,9 +391,6 @@ struct Simulation::Impl {
       mjtNum wrench[6];
       mj_contactForce(model, data, i, wrench);
       force += std::abs(wrench[0]);
-    }
-    if (force > 0.0) {
-      last_touch_step = steps;
     }
     if (force > 0.0 && settled) {
       if (scale > 0.0) {

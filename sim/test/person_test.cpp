@@ -65,6 +65,14 @@ TEST(PersonScript, RefusesWhatItDoesNotKnowNamingTheField) {
   EXPECT_NE(errorOf(R"({"repeat": true, "script": [{"do": "leave"}]})")
                 .find("person.script: a repeating script must end at the table"),
             std::string::npos);
+  // Beside the table too: its top is an endless plane to the simulator (a hand resting in it
+  // was pushed out by the contacts).
+  EXPECT_NE(errorOf(R"({"script": [{"do": "reach", "to": [0.5, 0.75, 0.0]}]})")
+                .find("person.script[0].to: lies 0 m above the table top's height"),
+            std::string::npos);
+  PersonSpec low;
+  low.shoulder = Eigen::Vector3d(0.5, 0.8, 0.2);
+  EXPECT_NEAR(low.restPosition().z(), 0.05, 1e-12);
   EXPECT_NE(errorOf(R"({"script": []})").find("person.script: must be a list of 1 to 1000 steps"), std::string::npos);
   EXPECT_NE(errorOf(R"({"script": [{"do": "wait"}]})").find("person.script[0].seconds: missing"), std::string::npos);
 }
