@@ -164,11 +164,11 @@ std::optional<JointVector> descendChain(const ChainGeometry& geometry, const Joi
   // Sugihara's lambda = w E + lambda_bar: w < 1 lets the steps grow far from the pose (fewer
   // iterations than w = 1 on random starts); lambda_bar keeps a step bounded at a singularity.
   // Units: m^2 and rad^2, as E.
-  constexpr double kEnergyWeight = 0.1;
+  constexpr double kEnergyWeight = 0.03;
   constexpr double kDampingFloor = 1e-5;
   // A start that stops improving (a joint against its limit, a local minimum) is given up soon:
   // a restart costs less than waiting.
-  constexpr int kPatience = 5;
+  constexpr int kPatience = 3;
   double best_energy = std::numeric_limits<double>::infinity();
   int since_improvement = 0;
   for (int iteration = 0;; ++iteration) {
@@ -180,14 +180,33 @@ std::optional<JointVector> descendChain(const ChainGeometry& geometry, const Joi
       rotation = rotation * joint.origin.linear();
       axes[j] = rotation * joint.axis;
       points[j] = position;
-      rotation = rotation * rotationAbout(joint.axis, q[j]);
+      if (joint.axis.z() == 1.0) {  // about z (URDF's and DH's usual axis): two columns turn
+        const double c = std::cos(q[j]);
+        const double s = std::sin(q[j]);
+        const Eigen::Vector3d x = rotation.col(0);
+        rotation.col(0) = c * x + s * rotation.col(1);
+        rotation.col(1) = c * rotation.col(1) - s * x;
+      } else {
+        rotation = rotation * rotationAbout(joint.axis, q[j]);
+      }
     }
     position += rotation * geometry.flange.translation();
     rotation = rotation * geometry.flange.linear();
     Vector6 error;
     error.head<3>() = target_position - position;
-    const Eigen::AngleAxisd turn(target_rotation * rotation.transpose());
-    error.tail<3>() = turn.angle() * turn.axis();
+    // The rotation vector of target * reached^-1: its skew part is sin(angle) axis, its trace
+    // 1 + 2 cos(angle); near a half turn the axis comes from Eigen's conversion instead.
+    const Eigen::Matrix3d turn = target_rotation * rotation.transpose();
+    const Eigen::Vector3d sine_axis =
+        0.5 * Eigen::Vector3d(turn(2, 1) - turn(1, 2), turn(0, 2) - turn(2, 0), turn(1, 0) - turn(0, 1));
+    const double sine = sine_axis.norm();
+    const double cosine = 0.5 * (turn.trace() - 1.0);
+    if (sine > 1e-6 || cosine > 0.0) {
+      error.tail<3>() = sine > 0.0 ? (std::atan2(sine, cosine) / sine) * sine_axis : sine_axis;
+    } else {
+      const Eigen::AngleAxisd half_turn(turn);
+      error.tail<3>() = half_turn.angle() * half_turn.axis();
+    }
     if (error.head<3>().norm() < options.position_tolerance && error.tail<3>().norm() < options.angle_tolerance) {
       return q;
     }
@@ -243,10 +262,11 @@ std::optional<JointVector> ChainKinematics::descend(const world::Pose& flange, c
 
 JointVector ChainKinematics::restartStart(int k, const JointVector& seed) const {
   static constexpr std::array<int, kMaxJoints> kPrimes = {2, 3, 5, 7, 11, 13, 17, 19};
-  // The first restarts stay near the seed (within 0.2 rad per joint: the seed's own start may
+  // The first restart stays near the seed (within 0.2 rad per joint: the seed's own start may
   // have failed at a singularity or a limit, and the answer near it is the one wanted), the
-  // others spread over the whole range.
-  constexpr int kNearSeed = 3;
+  // others spread over the range less a tenth at each end (a start at a limit is held there).
+  constexpr double kMargin = 0.1;
+  constexpr int kNearSeed = 1;
   constexpr double kNearSeedSpan = 0.4;
   const JointLimits& bounds = limits();
   JointVector q(jointCount());
@@ -254,7 +274,8 @@ JointVector ChainKinematics::restartStart(int k, const JointVector& seed) const 
     const double u = radicalInverse(k + 1, kPrimes[j]);
     q[j] = k < kNearSeed
                ? std::clamp(seed[j] + (u - 0.5) * kNearSeedSpan, bounds.min_position[j], bounds.max_position[j])
-               : bounds.min_position[j] + u * (bounds.max_position[j] - bounds.min_position[j]);
+               : bounds.min_position[j] +
+                     (kMargin + (1.0 - 2.0 * kMargin) * u) * (bounds.max_position[j] - bounds.min_position[j]);
   }
   return q;
 }

@@ -103,14 +103,19 @@ def read_description(path):
         if entry["child"] not in links:
             reader.fail(f"{field}.child", f'"{entry["child"]}" is not a link')
         entry["origin"] = reader.get(joint, "origin", field, "vec3", at_most=MAX_M)
-        if not any(entry["origin"]):
-            reader.fail(f"{field}.origin", f'[0, 0, 0] puts {entry["name"]} on the joint before it: a link of zero length')
         entry["rpy"] = reader.get(joint, "rpy", field, "vec3", optional=True, default=[0, 0, 0])
         axis = reader.get(joint, "axis", field, "vec3")
         norm = math.sqrt(sum(x * x for x in axis))
         if abs(norm - 1) > 1e-9:
             reader.fail(f"{field}.axis", "must be a unit vector")
         entry["axis"] = axis
+        # Two joints at one point are a wrist or a shoulder (the Panda's joints 1 and 2) when their
+        # axes differ; about the same axis they are one joint: a link of zero length.
+        if joints and not any(entry["origin"]):
+            turned = mat_vec(rotation_rpy(entry["rpy"]), axis)
+            if math.dist(turned, joints[-1]["axis"]) < 1e-9 or math.dist(turned, [-x for x in joints[-1]["axis"]]) < 1e-9:
+                reader.fail(f"{field}.origin", f'[0, 0, 0] puts {entry["name"]} on the joint before it, about the same '
+                            "axis: a link of zero length")
         for key in ("lower_deg", "upper_deg", "velocity_deg_s", "effort_nm"):
             entry[key] = reader.get(joint, key, field, "number")
         if not entry["lower_deg"] < entry["upper_deg"]:

@@ -44,7 +44,7 @@ class GenerateModels(GeneratorCase):
         self.expect_error(lambda d: d["joints"][3].update(origin=[0, 0, 0.2255]), "published_lengths.shoulder_to_elbow",
                           "0.43")
         # Issue 27: a zero-length link and numbers of 1e308 passed.
-        self.expect_error(lambda d: d["joints"][3].update(origin=[0, 0, 0]), "joints[3].origin",
+        self.expect_error(lambda d: d["joints"][3].update(origin=[0, 0, 0], axis=[0, 0, 1]), "joints[3].origin",
                           "a link of zero length")
         self.expect_error(lambda d: d["joints"][2].update(origin=[0, 0, 1e308]), "joints[2].origin",
                           "magnitude at most 10")

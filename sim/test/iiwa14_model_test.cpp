@@ -3,7 +3,6 @@
 // solver's), and it holds its pose under gravity with the simulation's position control.
 
 #include <gtest/gtest.h>
-#include <mujoco/mujoco.h>
 
 #include <nlohmann/json.hpp>
 
@@ -16,6 +15,7 @@
 
 #include "arm/srs_kinematics.h"
 #include "planning/robot_model.h"
+#include "sim/test/arm_model_fixture.h"
 
 namespace costar::sim {
 namespace {
@@ -24,60 +24,11 @@ using arm::Joints7;
 
 constexpr double kDegree = std::numbers::pi / 180.0;
 
-struct ModelDeleter {
-  void operator()(mjModel* model) const { mj_deleteModel(model); }
-};
-struct DataDeleter {
-  void operator()(mjData* data) const { mj_deleteData(data); }
-};
-
-class Iiwa14Model : public ::testing::Test {
+class Iiwa14Model : public testing::ArmModelTest {
  protected:
-  void SetUp() override {
-    std::array<char, 1000> error{};
-    model_.reset(mj_loadXML(COSTAR_IIWA14_MJCF, nullptr, error.data(), static_cast<int>(error.size())));
-    ASSERT_TRUE(model_) << error.data();
-    data_.reset(mj_makeData(model_.get()));
-    flange_site_ = mj_name2id(model_.get(), mjOBJ_SITE, "tool0");
-    ASSERT_GE(flange_site_, 0);
-  }
-
-  world::Pose flange() const {
-    world::Pose pose = world::Pose::Identity();
-    for (int i = 0; i < 3; ++i) {
-      pose.translation()[i] = data_->site_xpos[3 * flange_site_ + i];
-      for (int j = 0; j < 3; ++j) {
-        pose.linear()(i, j) = data_->site_xmat[9 * flange_site_ + 3 * i + j];
-      }
-    }
-    return pose;
-  }
-
-  Joints7 positions() const { return Eigen::Map<const Joints7>(data_->qpos); }
-
-  /// The simulation's arm control (sim/simulation.cpp): computed torque with critically damped
-  /// PD gains (omega 50 rad/s), tau = M (Kp e + Kd de) + bias, clamped by the motors' ranges.
-  void hold(const Joints7& target, double seconds) {
-    constexpr double kOmega = 50.0;
-    std::array<mjtNum, 7> acceleration{};
-    std::array<mjtNum, 7> torque{};
-    const int steps = static_cast<int>(seconds / model_->opt.timestep);
-    for (int n = 0; n < steps; ++n) {
-      mj_step1(model_.get(), data_.get());
-      for (int i = 0; i < 7; ++i) {
-        acceleration[i] = kOmega * kOmega * (target[i] - data_->qpos[i]) - 2.0 * kOmega * data_->qvel[i];
-      }
-      mj_mulM(model_.get(), data_.get(), torque.data(), acceleration.data());
-      for (int i = 0; i < 7; ++i) {
-        data_->ctrl[i] = torque[i] + data_->qfrc_bias[i];
-      }
-      mj_step2(model_.get(), data_.get());
-    }
-  }
-
-  std::unique_ptr<mjModel, ModelDeleter> model_;
-  std::unique_ptr<mjData, DataDeleter> data_;
-  int flange_site_ = -1;
+  void SetUp() override { load(COSTAR_IIWA14_MJCF, "tool0"); }
+  Joints7 positions() const { return ArmModelTest::positions(); }
+  void hold(const Joints7& target, double seconds) { ArmModelTest::hold(Eigen::VectorXd(target), seconds); }
 };
 
 TEST_F(Iiwa14Model, HasTheDescribedJointsActuatorsAndHome) {
