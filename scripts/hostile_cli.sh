@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A stranger's attack on the command line, its files and the data files (issue 27), on every
-# simulated cell (ur5-sim, iiwa-sim, iiwa-3f-sim): bad and hostile options, hostile plan files,
+# simulated cell (workcells/*.json): bad and hostile options, hostile plan files,
 # text that is not UTF-8, data and description files edited after the build, signals in the
 # middle of a run, outputs that cannot be written, several writers of one waypoint file, shards
 # run differently, another working directory. The inputs are fixed (no clock, no /dev/urandom), so
@@ -17,7 +17,8 @@ trap 'rm -rf "$tmp"' EXIT
 scratch() {  # the scratch folder must last the whole run: a finding without it would be false
   [[ -d $tmp ]] || { echo "hostile_cli.sh: the scratch folder $tmp vanished (removed by another process?)" >&2; exit 3; }
 }
-cells=(ur5-sim iiwa-sim iiwa-3f-sim)
+cells=()  # every simulated cell: workcells/*.json
+for file in workcells/*.json; do cells+=("$(basename "$file" .json)"); done
 plan=examples/ur5/pick_up_node.xml
 blind=(examples/ur5/blind_pick_place.xml --judge blind_place --scene sim/scenes/one_node.json
        --waypoints examples/ur5/blind_waypoints.json)

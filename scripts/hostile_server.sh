@@ -6,7 +6,7 @@
 #
 # Usage: scripts/hostile_server.sh [BUILD_DIR] [CELL...]
 #   BUILD_DIR defaults to build (it needs the costar and costar-robot targets); the cells
-#   default to ur5-sim iiwa-sim iiwa-3f-sim. HOSTILE_ARGS passes options to the script
+#   default to every cell in workcells/. HOSTILE_ARGS passes options to the script
 #   (e.g. HOSTILE_ARGS="--transitions 20000 --kills 2" for a quick run).
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -14,7 +14,7 @@ build="${1:-build}"
 shift || true
 cells=("$@")
 if [[ ${#cells[@]} -eq 0 ]]; then
-  cells=(ur5-sim iiwa-sim iiwa-3f-sim)
+  for file in workcells/*.json; do cells+=("$(basename "$file" .json)"); done
 fi
 read -r -a extra <<<"${HOSTILE_ARGS:-}"
 status=0

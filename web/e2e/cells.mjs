@@ -7,7 +7,7 @@
 // Screenshots at 1280x800 of each cell after a detection.
 //
 //   node web/e2e/cells.mjs [--costar build/cli/costar] [--artifacts build/test-artifacts]
-//                          [--cells ur5-sim,iiwa-sim,iiwa-3f-sim] [--docs-screenshots docs]
+//                          [--cells ur5-sim,iiwa-sim,iiwa-3f-sim,panda-sim] [--docs-screenshots docs]
 // (--docs-screenshots: each cell's screenshot there as editor_CELL_1280x800.png)
 
 import fs from 'node:fs';
@@ -15,7 +15,7 @@ import path from 'node:path';
 import { api, args, artifacts, launchBrowser, makeLog, openPage, runScript, startServer } from './lib.mjs';
 
 const { log, check } = makeLog('cells');
-const CELLS = { 'ur5-sim': 6, 'iiwa-sim': 7, 'iiwa-3f-sim': 7 };
+const CELLS = { 'ur5-sim': 6, 'iiwa-sim': 7, 'iiwa-3f-sim': 7, 'panda-sim': 7 };
 const MAX_ERROR_MM = 5;
 const MAX_ERROR_DEG = 1;
 let server;

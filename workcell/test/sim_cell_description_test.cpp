@@ -37,7 +37,7 @@ TEST(SimCellDescription, BothCellsLoadAndAreListed) {
   for (const auto& info : knownWorkcells()) {
     names.push_back(info.name);
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"ur5-sim", "iiwa-3f-sim", "iiwa-sim", "test", "none"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"ur5-sim", "iiwa-3f-sim", "iiwa-sim", "panda-sim", "test", "none"}));
 }
 
 class BadCellFile : public ::testing::Test {
