@@ -163,6 +163,11 @@ void ArmComponent::declareOperations() {
   description.predicates = {{"arm_moving", 0, "a joint is turning"},
                             {"at_waypoint", 1, "at_waypoint(w): the tool is at waypoint w"}};
   declareForceOperations(description, operations);
+  if (force_.sensor != nullptr && force_.controller != nullptr) {
+    description.predicates.push_back({"free_driving", 0, "the arm is guided by hand (FreeDrive), its dead-man held"});
+    declareFreeDrive(operations);
+  }
+  declareFollowTrajectory(operations);
   declare(std::move(description), std::move(operations));
 }
 
@@ -340,6 +345,9 @@ world::Report ArmComponent::report() const {
     report.predicates.push_back({"arm_moving", {}, true, ""});
   }
   reportForce(report);
+  if (freeDriveStatus().active) {
+    report.predicates.push_back({"free_driving", {}, true, ""});
+  }
   for (const Waypoint& waypoint : waypoints_.all()) {
     if (waypoint.kind == Waypoint::Kind::kJoints) {
       report.symbols.push_back({waypoint.name, "", now,

@@ -25,7 +25,9 @@
 // `in_contact` and the operation Tare; the component zeroes the sensor once when it starts.
 // With the controller's Cartesian impedance mode as well: MoveUntilContact, PressAndFollow,
 // ReleaseContact and ForgetPressed, and the predicate pressed_at(w) (docs/FORCE.md:
-// arm/force_operations.cpp).
+// arm/force_operations.cpp), and FreeDrive(mode, locked, axes, hold): hand guiding, moving while
+// its dead-man is held (holdFreeDrive), the predicate free_driving (docs/TEACHING.md:
+// arm/free_drive.h, arm/free_drive_operation.cpp).
 
 #include <functional>
 #include <memory>
@@ -52,6 +54,8 @@ namespace costar::arm {
 struct ForceControl {
   ForceTorqueSensor* sensor = nullptr;
   CartesianController* controller = nullptr;
+  /// What the sensor carries (its weight is taken out of free-drive's readings).
+  Payload payload;
 };
 
 class ArmComponent final : public component::TableComponent {
@@ -112,10 +116,27 @@ class ArmComponent final : public component::TableComponent {
   std::unique_ptr<component::RunningOperation> execute(MotionPlan plan, const std::string& what);
 
   const ArmConfig& config() const { return config_; }
+  /// The taught waypoints and recorded trajectories.
+  const WaypointStore& waypoints() const { return waypoints_; }
   /// Number of joints of the arm.
   int jointCount() const { return kinematics_->jointCount(); }
   const Kinematics& kinematics() const { return *kinematics_; }
   const JointLimits& limits() const { return kinematics_->limits(); }
+
+  // --- free-drive (arm/free_drive.h; its FreeDrive operation, with the force control) -------
+  /// The dead-man: a running FreeDrive moves only while held; this holds it for `duration` more
+  /// of the clock's time (the page's pointer or a key held down). False when none runs.
+  bool holdFreeDrive(Duration duration);
+  /// Lets go: the running FreeDrive stops the arm, which holds where it is, and ends.
+  void releaseFreeDrive();
+  struct FreeDriveStatus {
+    bool active = false;
+    std::string mode;     // the guiding mode (GuidingMode::str())
+    std::string blocked;  // why the last step was not (wholly) taken: a limit, a contact ahead
+    Wrench hand;          // the push it measures (world, at the tool centre point)
+    double speed = 0.0;   // m/s of its reference
+  };
+  FreeDriveStatus freeDriveStatus() const;
 
   /// The contact threshold of in_contact (N, the force's magnitude).
   static constexpr double kContactForce = 4.0;
@@ -144,6 +165,12 @@ class ArmComponent final : public component::TableComponent {
   std::unique_ptr<component::RunningOperation> moveUntilContact(const component::ParamMap& params);
   std::unique_ptr<component::RunningOperation> pressAndFollow(const component::ParamMap& params);
   std::unique_ptr<component::RunningOperation> releaseContact(const component::ParamMap& params);
+  // Free-drive (arm/free_drive_operation.cpp).
+  void declareFreeDrive(component::OperationTable& operations);
+  std::unique_ptr<component::RunningOperation> freeDrive(const component::ParamMap& params);
+  // Replaying recorded trajectories (arm/follow_trajectory.cpp).
+  void declareFollowTrajectory(component::OperationTable& operations);
+  std::unique_ptr<component::RunningOperation> followTrajectory(const component::ParamMap& params);
   /// The wrist's wrench in the tool frame about the tool centre point.
   Wrench toolWrench(const Wrench& sensor) const;
 
@@ -161,6 +188,9 @@ class ArmComponent final : public component::TableComponent {
   /// motion is pressing now.
   struct Pressing;
   std::shared_ptr<Pressing> pressing_;
+  /// The running FreeDrive's dead-man and state, shared with its operation.
+  struct FreeDriving;
+  std::shared_ptr<FreeDriving> free_driving_;
 };
 
 }  // namespace costar::arm

@@ -52,6 +52,15 @@ struct CartesianMotion {
   /// Redundant arms: the joints' configuration the controller keeps in the null space of the
   /// tool's motion (the elbow's); empty: where the joints are when the motion starts.
   JointVector posture{};
+  /// A streamed reference (free-drive's admittance, arm/free_drive.h): the path's pose moves on
+  /// at this twist (world, m/s and rad/s) from the start for at most `horizon`, then holds, so
+  /// that a stream of motions that stops leaves the tool held.
+  struct Drift {
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+    Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+    Duration horizon{};
+  };
+  std::optional<Drift> drift;
 };
 
 struct CartesianState {

@@ -25,6 +25,14 @@ struct ForceTorqueReading {
   TimePoint stamp{};
 };
 
+/// What the sensor carries (the tool, as a UR's installation or a Franka's end-effector setting
+/// states it): its mass (kg) and centre of mass (m, in the sensor frame). Free-drive
+/// (arm/free_drive.h) takes its weight out of the readings as the tool turns.
+struct Payload {
+  double mass = 0.0;
+  Eigen::Vector3d center_of_mass = Eigen::Vector3d::Zero();
+};
+
 class ForceTorqueSensor {
  public:
   virtual ~ForceTorqueSensor() = default;

@@ -179,6 +179,58 @@ Waypoint fromJson(const json& item, const std::string& field, int joint_count) {
   return waypoint;
 }
 
+nlohmann::json trajectoryToJson(const RecordedTrajectory& trajectory) {
+  nlohmann::json poses = nlohmann::json::array();
+  for (const world::Pose& pose : trajectory.poses) {
+    const Eigen::Quaterniond q(pose.linear());
+    const Eigen::Vector3d& p = pose.translation();
+    poses.push_back({p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z()});
+  }
+  return {{"name", trajectory.name}, {"frame", trajectory.frame}, {"times", trajectory.times}, {"poses", poses}};
+}
+
+RecordedTrajectory trajectoryFromJson(const json& item, const std::string& field) {
+  if (!item.is_object()) {
+    fail(field,
+         "must be an object {\"name\": ..., \"frame\": ..., \"times\": [...], \"poses\": [...]}, not " + shown(item));
+  }
+  for (const auto& [key, value] : item.items()) {
+    if (key != "name" && key != "frame" && key != "times" && key != "poses") {
+      fail(field + "." + key, "unknown field (known: name, frame, times, poses)");
+    }
+  }
+  for (const char* key : {"name", "frame", "times", "poses"}) {
+    if (!item.contains(key)) {
+      fail(field + "." + key, "missing");
+    }
+  }
+  RecordedTrajectory trajectory;
+  trajectory.name = stringField(item.at("name"), field + ".name");
+  trajectory.frame = stringField(item.at("frame"), field + ".frame");
+  const json& times = item.at("times");
+  const json& poses = item.at("poses");
+  if (!times.is_array() || !poses.is_array()) {
+    fail(field, "times and poses must be lists");
+  }
+  trajectory.times = numbers(times, field + ".times", times.size(), "a list of seconds");
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const std::string at = field + ".poses[" + std::to_string(i) + "]";
+    const auto v = numbers(poses[i], at, 7, "[x, y, z, qw, qx, qy, qz] (m, a unit quaternion)");
+    const Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
+    if (std::abs(q.norm() - 1.0) > 0.01) {
+      fail(at, "its quaternion must have unit length");
+    }
+    world::Pose pose = world::Pose::Identity();
+    pose.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+    pose.linear() = q.normalized().toRotationMatrix();
+    trajectory.poses.push_back(pose);
+  }
+  if (const std::string problem = checkRecordedTrajectory(trajectory); !problem.empty()) {
+    fail(field + "." + problem.substr(0, problem.find(':')), problem.substr(problem.find(':') + 2));
+  }
+  return trajectory;
+}
+
 /// The waypoint file's advisory lock, FILE.lock beside it (flock: released when the process
 /// dies, so a crashed writer never blocks the others). Held around every read-modify-write.
 class FileLock {
@@ -254,8 +306,22 @@ WaypointStore::Map WaypointStore::read() const {
       fail("waypoints", "missing: the file is {\"waypoints\": [...]}");
     }
     for (const auto& [key, value] : document.items()) {
-      if (key != "waypoints") {
-        fail(key, "unknown field (known: waypoints)");
+      if (key != "waypoints" && key != "trajectories") {
+        fail(key, "unknown field (known: waypoints, trajectories)");
+      }
+    }
+    if (document.contains("trajectories")) {
+      const json& trajectories = document.at("trajectories");
+      if (!trajectories.is_array()) {
+        fail("trajectories", "must be a list [{\"name\": ..., \"frame\": ..., \"times\": [...], \"poses\": [...]}]");
+      }
+      for (std::size_t i = 0; i < trajectories.size(); ++i) {
+        const std::string field = "trajectories[" + std::to_string(i) + "]";
+        RecordedTrajectory trajectory = trajectoryFromJson(trajectories[i], field);
+        if (waypoints.trajectories.contains(trajectory.name)) {
+          fail(field + ".name", "'" + trajectory.name + "' is taken already; names must differ");
+        }
+        waypoints.trajectories[trajectory.name] = std::move(trajectory);
       }
     }
     const json& list = document.at("waypoints");
@@ -267,7 +333,7 @@ WaypointStore::Map WaypointStore::read() const {
         fail(field + ".name", "'" + waypoint.name + "' is taken already (by waypoints[" +
                                   std::to_string(previous->second) + "]); names must differ");
       }
-      waypoints[waypoint.name] = std::move(waypoint);
+      waypoints.waypoints[waypoint.name] = std::move(waypoint);
     }
   } catch (const std::exception& e) {
     throw std::runtime_error(label + ": " + e.what());
@@ -313,18 +379,49 @@ auto WaypointStore::update(Change&& change) {
 std::optional<Waypoint> WaypointStore::find(const std::string& name) const {
   std::lock_guard lock(mutex_);
   refresh();
-  const auto it = waypoints_.find(name);
-  return it == waypoints_.end() ? std::nullopt : std::optional<Waypoint>(it->second);
+  const auto it = waypoints_.waypoints.find(name);
+  return it == waypoints_.waypoints.end() ? std::nullopt : std::optional<Waypoint>(it->second);
 }
 
 std::vector<Waypoint> WaypointStore::all() const {
   std::lock_guard lock(mutex_);
   refresh();
   std::vector<Waypoint> all;
-  for (const auto& [name, waypoint] : waypoints_) {
+  for (const auto& [name, waypoint] : waypoints_.waypoints) {
     all.push_back(waypoint);
   }
   return all;
+}
+
+std::optional<RecordedTrajectory> WaypointStore::findTrajectory(const std::string& name) const {
+  std::lock_guard lock(mutex_);
+  refresh();
+  const auto it = waypoints_.trajectories.find(name);
+  return it == waypoints_.trajectories.end() ? std::nullopt : std::optional<RecordedTrajectory>(it->second);
+}
+
+std::vector<RecordedTrajectory> WaypointStore::trajectories() const {
+  std::lock_guard lock(mutex_);
+  refresh();
+  std::vector<RecordedTrajectory> all;
+  for (const auto& [name, trajectory] : waypoints_.trajectories) {
+    all.push_back(trajectory);
+  }
+  return all;
+}
+
+void WaypointStore::putTrajectory(const RecordedTrajectory& trajectory) {
+  if (const std::string problem = checkRecordedTrajectory(trajectory); !problem.empty()) {
+    throw std::invalid_argument("trajectory '" + trajectory.name + "': " + problem);
+  }
+  update([&trajectory](Map& contents) {
+    contents.trajectories[trajectory.name] = trajectory;
+    return true;
+  });
+}
+
+bool WaypointStore::removeTrajectory(const std::string& name) {
+  return update([&name](Map& contents) { return contents.trajectories.erase(name) > 0; });
 }
 
 void WaypointStore::put(const Waypoint& waypoint) {
@@ -347,21 +444,22 @@ void WaypointStore::put(const Waypoint& waypoint) {
     throw std::invalid_argument("waypoint '" + waypoint.name +
                                 "': " + (waypoint.kind == Waypoint::Kind::kJoints ? "joints" : "position") + problem);
   }
-  update([&waypoint](Map& waypoints) {
-    waypoints[waypoint.name] = waypoint;
+  update([&waypoint](Map& contents) {
+    contents.waypoints[waypoint.name] = waypoint;
     return true;
   });
 }
 
 bool WaypointStore::remove(const std::string& name) {
-  return update([&name](Map& waypoints) { return waypoints.erase(name) > 0; });
+  return update([&name](Map& contents) { return contents.waypoints.erase(name) > 0; });
 }
 
 void WaypointStore::rename(const std::string& from, const std::string& to) {
   if (const std::string problem = checkWaypointName(to); !problem.empty()) {
     throw std::invalid_argument(problem);
   }
-  update([&from, &to](Map& waypoints) {
+  update([&from, &to](Map& contents) {
+    auto& waypoints = contents.waypoints;
     const auto it = waypoints.find(from);
     if (it == waypoints.end()) {
       throw std::invalid_argument("unknown waypoint '" + from + "'");
@@ -379,8 +477,14 @@ void WaypointStore::rename(const std::string& from, const std::string& to) {
 
 void WaypointStore::save(const Map& waypoints) const {
   nlohmann::json json = {{"waypoints", nlohmann::json::array()}};
-  for (const auto& [name, waypoint] : waypoints) {
+  for (const auto& [name, waypoint] : waypoints.waypoints) {
     json["waypoints"].push_back(toJson(waypoint));
+  }
+  if (!waypoints.trajectories.empty()) {
+    json["trajectories"] = nlohmann::json::array();
+    for (const auto& [name, trajectory] : waypoints.trajectories) {
+      json["trajectories"].push_back(trajectoryToJson(trajectory));
+    }
   }
   writeFileAtomically(file_, json.dump(2) + "\n");
 }

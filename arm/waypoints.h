@@ -5,7 +5,8 @@
 // crash never loses a saved waypoint. Several writers of one file (the editor's server and
 // `costar teach`, in two processes) keep each other's changes: each change is applied to the
 // file's contents of the moment under an advisory lock (FILE.lock, flock), and every reader
-// picks up the file anew when another process changed it.
+// picks up the file anew when another process changed it. The same file keeps the trajectories
+// recorded while guiding the arm by hand (arm/recorded_trajectory.h), under "trajectories".
 
 #include <filesystem>
 #include <map>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "arm/joints.h"
+#include "arm/recorded_trajectory.h"
 #include "world/pose.h"
 
 namespace costar::arm {
@@ -56,8 +58,20 @@ class WaypointStore {
   void rename(const std::string& from, const std::string& to);
   const std::filesystem::path& file() const { return file_; }
 
+  // --- recorded trajectories (their names are checked as waypoints' are; a name of its own) --
+  std::optional<RecordedTrajectory> findTrajectory(const std::string& name) const;
+  std::vector<RecordedTrajectory> trajectories() const;
+  /// Adds or replaces, then saves. @throws std::invalid_argument naming the field for a
+  /// trajectory checkRecordedTrajectory refuses; std::runtime_error as put().
+  void putTrajectory(const RecordedTrajectory& trajectory);
+  /// @return false when there is no such trajectory.
+  bool removeTrajectory(const std::string& name);
+
  private:
-  using Map = std::map<std::string, Waypoint>;
+  struct Map {
+    std::map<std::string, Waypoint> waypoints;
+    std::map<std::string, RecordedTrajectory> trajectories;
+  };
   /// What identifies one version of the file: another writer's rename changes the inode.
   struct Stamp {
     bool exists = false;

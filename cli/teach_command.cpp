@@ -7,12 +7,14 @@
 #include <iostream>
 #include <sstream>
 
+#include "arm/arm_component.h"
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
 #include "core/image.h"
 #include "core/text.h"
 #include "sim/simulation.h"
+#include "trials/free_drive_trial.h"
 #include "workcell/workcell.h"
 
 namespace costar::cli {
@@ -35,6 +37,17 @@ constexpr const char* kHelp = R"(commands:
   objects                             the parts detected, with their poses
   grasp CLASS NAME                    teach a grasp: the gripper is around a detected part of
                                       CLASS now; SmartMove will grasp parts of CLASS like this
+  drag FX FY FZ SECONDS [MODE] [lock AXES] [tool] [turn TX TY TZ]
+                                      free-drive (simulated cells): a hand pushes the tool with
+                                      FX FY FZ N (world) and TX TY TZ N m, dead-man held for
+                                      SECONDS; MODE free, translation or rotation; AXES e.g. z,rx
+  drag random SECONDS SEED            a person's random drag for SECONDS of simulated time,
+                                      judged: joint limits, contacts, tool speed
+  drag stroke SEED [SPEED]            guide a curved stroke by hand, record it ('stroke'),
+                                      replay it (FollowTrajectory at SPEED), compare the paths
+  drag ... record NAME [in FRAME]     record the guided path as trajectory NAME (in FRAME)
+  replay NAME [in FRAME] [SPEED]      FollowTrajectory: replay a recorded trajectory
+  trajectories                        recorded trajectories
   snapshot FILE.png                   a picture of the cell (simulated cells)
   help | quit
 )";
@@ -71,15 +84,21 @@ std::string escape(const std::string& text) {
   return out;
 }
 
-/// Runs one operation node (XML) to completion; prints the outcome.
-bool runNode(workcell::Workcell& cell, const std::string& node) {
+/// Runs one operation node (XML) to completion, calling `each_tick` before every tick; prints
+/// the outcome.
+bool runNode(workcell::Workcell& cell, const std::string& node, const std::function<void()>& each_tick = {}) {
   try {
     const bt::Plan plan =
         bt::loadPlanText(R"(<root BTCPP_format="4"><BehaviorTree ID="teach">)" + node + "</BehaviorTree></root>",
                          "command", {.follow_includes = false});
     bt::Tree tree = bt::buildTree(plan, cell.nodes(), cell.clock());
     bt::Executor executor(tree, cell.clock());
-    executor.setBeforeTick([&cell] { cell.beforeTick(); });
+    executor.setBeforeTick([&cell, &each_tick] {
+      cell.beforeTick();
+      if (each_tick) {
+        each_tick();
+      }
+    });
     const bt::RunResult result = executor.run();
     if (result.status == bt::Status::kSuccess) {
       std::printf("ok (%.2f s)\n", toSeconds(result.elapsed));
@@ -130,6 +149,152 @@ void printWaypoints(workcell::Workcell& cell) {
   }
   if (count == 0) {
     std::printf("  (no waypoints taught yet)\n");
+  }
+}
+
+/// A number from a command's word, or nullopt (after saying so).
+std::optional<double> number(const std::string& word) {
+  try {
+    std::size_t used = 0;
+    const double value = std::stod(word, &used);
+    if (used == word.size() && std::isfinite(value)) {
+      return value;
+    }
+  } catch (const std::exception&) {
+  }
+  std::printf("error: '%s' is not a number\n", word.c_str());
+  return std::nullopt;
+}
+
+/// drag random SECONDS SEED: the scripted random drag, judged.
+void dragRandom(workcell::Workcell& cell, const std::vector<std::string>& w) {
+  const auto seconds = number(w[2]);
+  const auto seed = number(w[3]);
+  if (!seconds || !seed) {
+    return;
+  }
+  if (*seconds <= 0.0 || *seed < 0.0) {
+    std::printf("error: drag random needs a positive duration and a seed of 0 or more\n");
+    return;
+  }
+  try {
+    const trials::FreeDriveTrialResult r =
+        trials::runFreeDriveTrial(cell, {.seconds = *seconds, .seed = static_cast<std::uint64_t>(*seed)});
+    std::printf("dragged %.1f s (simulated) in %d holds, the tool travelled %.2f m\n", r.seconds, r.holds, r.travelled);
+    std::printf("joint limit violations: %llu ticks (closest to a limit: %.3f rad)\n",
+                static_cast<unsigned long long>(r.joint_limit_violations), r.closest_to_limit);
+    std::printf("contacts: table %llu physics steps, parts %llu ticks%s%s; lowest tool %.3f m above the table\n",
+                static_cast<unsigned long long>(r.table_contact_steps),
+                static_cast<unsigned long long>(r.part_contact_ticks), r.first_part_contact.empty() ? "" : " (first: ",
+                (r.first_part_contact + (r.first_part_contact.empty() ? "" : ")")).c_str(), r.lowest_tool);
+    std::printf("tool speed: at most %.3f m/s (at %.2f s, %s); at rest %.2f s after letting go at most\n",
+                r.max_tool_speed, r.max_speed_at, r.max_speed_held ? "free-driving" : "let go", r.max_stop_time);
+    for (const auto& [why, ticks] : r.blocked) {
+      std::printf("  refused steps: %-40s %d ticks\n", why.c_str(), ticks);
+    }
+    if (!r.failure.empty()) {
+      std::printf("failed: %s\n", r.failure.c_str());
+    }
+  } catch (const std::exception& e) {
+    std::printf("failed: %s\n", e.what());
+  }
+}
+
+/// drag stroke SEED [SPEED]: a stroke recorded by hand and replayed, compared.
+void dragStroke(workcell::Workcell& cell, const std::vector<std::string>& w) {
+  const auto seed = number(w[2]);
+  const auto speed = w.size() > 3 ? number(w[3]) : std::optional<double>(1.0);
+  if (!seed || !speed) {
+    return;
+  }
+  try {
+    const trials::ReplayTrialResult r = trials::runReplayTrial(cell, static_cast<std::uint64_t>(*seed), *speed);
+    if (!r.failure.empty()) {
+      std::printf("failed: %s\n", r.failure.c_str());
+      return;
+    }
+    std::printf("recorded a %.3f m stroke in %.2f s: %zu samples, %zu kept\n", r.length, r.recorded_seconds, r.samples,
+                r.kept);
+    std::printf(
+        "replayed in %.2f s: the tool %.2f mm RMS from the recorded path (%.2f mm at most), turned %.2f deg "
+        "from it at most\n",
+        r.replay_seconds, 1000.0 * r.rms_position, 1000.0 * r.max_position, r.max_angle * 180.0 / M_PI);
+  } catch (const std::exception& e) {
+    std::printf("failed: %s\n", e.what());
+  }
+}
+
+/// drag FX FY FZ SECONDS [MODE] [lock AXES] [tool] [turn TX TY TZ]: one push with the dead-man held.
+void drag(workcell::Workcell& cell, const std::vector<std::string>& w) {
+  sim::Simulation* simulation = cell.simulation();
+  auto* arm = dynamic_cast<arm::ArmComponent*>(cell.components().provider("FreeDrive"));
+  if (simulation == nullptr || arm == nullptr) {
+    std::printf("failed: '%s' is not a simulated workcell with free-drive\n", cell.name().c_str());
+    return;
+  }
+  arm::Wrench hand;
+  std::optional<double> seconds;
+  for (int i = 0; i < 3; ++i) {
+    const auto value = number(w[static_cast<std::size_t>(i + 1)]);
+    if (!value) {
+      return;
+    }
+    hand.force[i] = *value;
+  }
+  if (seconds = number(w[4]); !seconds) {
+    return;
+  }
+  std::string mode = "free";
+  std::string locked;
+  std::string axes = "world";
+  std::string record;
+  std::string record_frame = "world";
+  for (std::size_t i = 5; i < w.size(); ++i) {
+    if (w[i] == "lock" && i + 1 < w.size()) {
+      locked = w[++i];
+    } else if (w[i] == "tool") {
+      axes = "tool";
+    } else if (w[i] == "record" && i + 1 < w.size()) {
+      record = w[++i];
+    } else if (w[i] == "in" && i + 1 < w.size()) {
+      record_frame = w[++i];
+    } else if (w[i] == "turn" && i + 3 < w.size()) {
+      for (int k = 0; k < 3; ++k) {
+        const auto value = number(w[++i]);
+        if (!value) {
+          return;
+        }
+        hand.torque[k] = *value;
+      }
+    } else {
+      mode = w[i];
+    }
+  }
+  const world::Pose before = simulation->tcpPose();
+  const TimePoint start = cell.clock().now();
+  std::string blocked;
+  const bool ok =
+      runNode(cell,
+              "<FreeDrive mode=\"" + escape(mode) + "\" locked=\"" + escape(locked) + "\" axes=\"" + axes +
+                  "\" hold=\"0.2\" record=\"" + escape(record) + "\" record_frame=\"" + escape(record_frame) + "\"/>",
+              [&] {
+                if (toSeconds(cell.clock().now() - start) < *seconds) {
+                  simulation->setHandWrench(hand);
+                  arm->holdFreeDrive(std::chrono::milliseconds(100));
+                  if (const std::string why = arm->freeDriveStatus().blocked; !why.empty()) {
+                    blocked = why;
+                  }
+                } else {
+                  simulation->setHandWrench({});
+                }
+              });
+  simulation->setHandWrench({});
+  if (ok) {
+    const world::Pose after = simulation->tcpPose();
+    const Eigen::Vector3d moved = after.translation() - before.translation();
+    std::printf("the tool moved %.4f %.4f %.4f m and turned %.1f deg%s%s\n", moved.x(), moved.y(), moved.z(),
+                world::rotationAngle(before, after) * 180.0 / M_PI,
+                blocked.empty() ? "" : "; held back: ", blocked.c_str());
   }
 }
 
@@ -209,6 +374,32 @@ bool handle(workcell::Workcell& cell, const std::string& line) {
     runNode(cell, "<RenameWaypoint waypoint=\"" + escape(w[1]) + "\" new_name=\"" + escape(w[2]) + "\"/>");
   } else if (command == "delete" && w.size() == 2) {
     runNode(cell, "<DeleteWaypoint waypoint=\"" + escape(w[1]) + "\"/>");
+  } else if (command == "trajectories") {
+    const auto* arm = dynamic_cast<const arm::ArmComponent*>(cell.components().provider("FollowTrajectory"));
+    const auto trajectories = arm != nullptr ? arm->waypoints().trajectories() : std::vector<arm::RecordedTrajectory>{};
+    for (const arm::RecordedTrajectory& t : trajectories) {
+      std::printf("  %-20s in %s: %zu poses, %.3f m in %.2f s\n", t.name.c_str(), t.frame.c_str(), t.poses.size(),
+                  t.length(), t.duration());
+    }
+    if (trajectories.empty()) {
+      std::printf("  (no trajectories recorded yet: drag ... record NAME)\n");
+    }
+  } else if (command == "replay" && w.size() >= 2) {
+    std::string node = "<FollowTrajectory trajectory=\"" + escape(w[1]) + "\"";
+    for (std::size_t i = 2; i < w.size(); ++i) {
+      if (w[i] == "in" && i + 1 < w.size()) {
+        node += " frame=\"" + escape(w[++i]) + "\"";
+      } else {
+        node += " speed=\"" + escape(w[i]) + "\"";
+      }
+    }
+    runNode(cell, node + "/>");
+  } else if (command == "drag" && (w.size() == 3 || w.size() == 4) && w[1] == "stroke") {
+    dragStroke(cell, w);
+  } else if (command == "drag" && w.size() == 4 && w[1] == "random") {
+    dragRandom(cell, w);
+  } else if (command == "drag" && w.size() >= 5) {
+    drag(cell, w);
   } else if (command == "snapshot" && w.size() == 2) {
     if (cell.simulation() == nullptr) {
       std::printf("failed: '%s' is not a simulated workcell\n", cell.name().c_str());

@@ -1,6 +1,9 @@
 #include "server/api.h"
 
+#include <array>
 #include <charconv>
+#include <cmath>
+#include <cstdio>
 #include <map>
 
 #include "bt/plan_xml.h"
@@ -543,6 +546,54 @@ HttpResponse startOperation(const Call& call) {
   return startRun(call.backend, std::move(run));
 }
 
+/// The most a page's hand pushes with: a firm push (N), a firm twist (N m).
+constexpr double kMaxHandForce = 60.0;
+constexpr double kMaxHandTorque = 3.0;
+
+/// POST /api/drag: free-drive's hand and dead-man (Backend::Drag): {"force": [x, y, z], "torque":
+/// [x, y, z]} (N, N m, world, at the tool) held for 0.5 s, or {"release": true}.
+HttpResponse dragTool(const Call& call) {
+  const json body = call.body();
+  if (!body.is_object()) {
+    throw RequestError(400, "the body must be {\"force\": [x, y, z], \"torque\": [x, y, z]} or {\"release\": true}");
+  }
+  Backend::Drag drag;
+  for (const auto& [key, value] : body.items()) {
+    if (key == "release") {
+      if (!value.is_boolean()) {
+        throw RequestError(400, "'release' must be true or false");
+      }
+      drag.release = value.get<bool>();
+    } else if (key == "force" || key == "torque") {
+      const double limit = key == "force" ? kMaxHandForce : kMaxHandTorque;
+      if (!value.is_array() || value.size() != 3) {
+        throw RequestError(400, "'" + key + "' must be [x, y, z]");
+      }
+      std::array<double, 3>& out = key == "force" ? drag.force : drag.torque;
+      for (std::size_t i = 0; i < 3; ++i) {
+        if (!value[i].is_number() || !std::isfinite(value[i].get<double>())) {
+          throw RequestError(400, "'" + key + "[" + std::to_string(i) + "]' must be a finite number");
+        }
+        out[i] = value[i].get<double>();
+      }
+      const double size = std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
+      if (size > limit) {
+        char text[160];
+        std::snprintf(text, sizeof text, "'%s' is %.1f %s, more than a hand pushes with (at most %.0f)", key.c_str(),
+                      size, key == "force" ? "N" : "N m", limit);
+        throw RequestError(400, text);
+      }
+    } else {
+      throw RequestError(400, "unknown field '" + key.substr(0, 32) + "' (force, torque, release)");
+    }
+  }
+  const StartResult result = call.backend.drag(drag);
+  if (result.status != 0) {
+    return errorResponse(result.status, result.error);
+  }
+  return jsonResponse({{"ok", drag.release ? "released" : "held"}});
+}
+
 HttpResponse getGroundTruth(const Call& call) {
   const auto truth = call.backend.groundTruth();
   return truth ? jsonResponse(*truth) : errorResponse(404, "this workcell has no simulator");
@@ -602,6 +653,7 @@ constexpr Route kRoutes[] = {
     {"GET", "runs/{id}/transitions", getRunTransitions, Access::kRead, 0, true},
     {"POST", "control", controlRun, Access::kChange, kSmallBody},
     {"POST", "operations", startOperation, Access::kChange},
+    {"POST", "drag", dragTool, Access::kChange, kSmallBody},
     {"GET", "test/ground_truth", getGroundTruth, Access::kToken, 0, false, true},
 };
 

@@ -2,6 +2,7 @@
 // What the HTTP API and its live stream need from the system behind it. The Engine (engine.h)
 // implements it on a workcell; the fuzz targets and some tests implement it without one.
 
+#include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -87,6 +88,26 @@ class Backend {
     StartResult refused;
     refused.status = 404;
     refused.error = "this cell has no simulated scene to reset";
+    return refused;
+  }
+
+  /// Free-drive's hand and dead-man (docs/TEACHING.md): while a FreeDrive operation runs, the
+  /// person's push on the tool (force N and torque N m, world axes, at the tool centre point),
+  /// held for `hold_seconds`: the page sends one every 50 ms while the pointer is held, and when
+  /// the stream stops the hand lets go and the dead-man lapses (the arm stops and holds).
+  /// `release`: lets go now. Status 0 when applied; 409 when no FreeDrive runs, 404 for a cell
+  /// without a simulator (a real arm is pushed by a real hand).
+  struct Drag {
+    std::array<double, 3> force{};
+    std::array<double, 3> torque{};
+    double hold_seconds = 0.5;
+    bool release = false;
+  };
+  virtual StartResult drag(const Drag& drag) {
+    StartResult refused;
+    refused.status = 404;
+    refused.error = "this backend has no arm to guide";
+    (void)drag;
     return refused;
   }
 

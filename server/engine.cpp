@@ -8,11 +8,13 @@
 
 #include "server/engine_parts.h"
 
+#include "arm/arm_component.h"
 #include "bt/builder.h"
 #include "server/cell_state.h"
 #include "server/guard.h"
 #include "server/run_lifecycle.h"
 #include "server/run_observer.h"
+#include "sim/simulation.h"
 #include "workcell/workcell.h"
 
 namespace costar::server {
@@ -325,6 +327,36 @@ StartResult Engine::resetScene() {
       events_.push_back(json{{"type", "scene_reset"}, {"t", toSeconds(cell_->clock().now())}}.dump());
     }
     return out;  // status 0: done
+  });
+}
+
+StartResult Engine::drag(const Drag& request) {
+  return call([this, request]() -> StartResult {
+    StartResult out;
+    sim::Simulation* simulation = cell_->simulation();
+    auto* arm = dynamic_cast<arm::ArmComponent*>(cell_->components().provider("FreeDrive"));
+    if (simulation == nullptr || arm == nullptr) {
+      out.status = 404;
+      out.error = "this cell has no simulated arm to guide by hand";
+      return out;
+    }
+    if (request.release) {
+      simulation->setHandWrench({});
+      arm->releaseFreeDrive();
+      return out;
+    }
+    const auto hold = std::chrono::duration_cast<Duration>(std::chrono::duration<double>(request.hold_seconds));
+    if (!arm->holdFreeDrive(hold)) {
+      simulation->setHandWrench({});
+      out.status = 409;
+      out.error = "free-drive is off: start the FreeDrive operation first (refused while a plan runs)";
+      return out;
+    }
+    arm::Wrench hand;
+    hand.force = Eigen::Vector3d(request.force[0], request.force[1], request.force[2]);
+    hand.torque = Eigen::Vector3d(request.torque[0], request.torque[1], request.torque[2]);
+    simulation->setHandWrench(hand, hold);
+    return out;
   });
 }
 

@@ -9,6 +9,7 @@
 #include <functional>
 #include <set>
 #include <string_view>
+#include "arm/arm_component.h"
 #include "server/cell_state.h"
 #include "sim/simulation.h"
 #include "smartmove/grasps.h"
@@ -53,6 +54,7 @@ json classShape(const world::ObjectClass& object_class) {
 /// The names a plan may use of what the cell knows now (engine thread).
 struct Known {
   std::set<std::string> waypoints;
+  std::set<std::string> trajectories;
   std::set<std::string> frames = {"world"};
   std::set<std::string> classes;
 };
@@ -79,7 +81,36 @@ Known knownNow(workcell::Workcell& cell) {
       known.classes.insert(object_class.name);
     }
   }
+  if (const auto* arm = dynamic_cast<const arm::ArmComponent*>(cell.components().provider("FollowTrajectory"))) {
+    for (const arm::RecordedTrajectory& trajectory : arm->waypoints().trajectories()) {
+      known.trajectories.insert(trajectory.name);
+    }
+  }
   return known;
+}
+
+/// The recorded trajectories as the 3D view draws them: each pose kept, in the world (through
+/// its frame as the world has it now; none when the frame is unknown now).
+json trajectoryLines(workcell::Workcell& cell) {
+  json lines = json::object();
+  const auto* arm = dynamic_cast<const arm::ArmComponent*>(cell.components().provider("FollowTrajectory"));
+  if (arm == nullptr) {
+    return lines;
+  }
+  for (const arm::RecordedTrajectory& trajectory : arm->waypoints().trajectories()) {
+    const std::optional<world::Pose> frame = trajectory.frame == "world"
+                                                 ? std::optional<world::Pose>(world::Pose::Identity())
+                                                 : cell.components().world().worldPose(trajectory.frame);
+    json points = json::array();
+    if (frame) {
+      for (const world::Pose& pose : trajectory.poses) {
+        const Eigen::Vector3d p = *frame * pose.translation();
+        points.push_back({p.x(), p.y(), p.z()});
+      }
+    }
+    lines[trajectory.name] = {{"frame", trajectory.frame}, {"points", std::move(points)}};
+  }
+  return lines;
 }
 
 std::string listed(const std::set<std::string>& names) {
@@ -135,7 +166,10 @@ std::vector<bt::Diagnostic> Engine::checkAgainstCell(const bt::Plan& plan) {
                  param->extra_choices.end();
         };
         std::string problem;
-        if (param->choices_from == "waypoint") {
+        if (param->choices_from == "trajectory" && !known.trajectories.contains(value)) {
+          problem =
+              "no trajectory '" + value + "' recorded in this cell; its trajectories: " + listed(known.trajectories);
+        } else if (param->choices_from == "waypoint") {
           // A list of waypoints (PressAndFollow's path, "row1_start;row1_end") names each one.
           for (const std::string& waypoint :
                param->type == component::ValueType::kStringList ? splitList(value) : std::vector{value}) {
@@ -216,9 +250,10 @@ json Engine::choices() {
     } catch (const std::exception&) {
       // An unreadable grasp file: SmartMove reports it when it runs; offer no list.
     }
-    return json{{"waypoint", known.waypoints}, {"frame", known.frames},
-                {"object_class", classes},     {"predicate", std::move(predicates)},
-                {"grasp", std::move(grasps)},  {"object_shape", std::move(shapes)}};
+    return json{
+        {"waypoint", known.waypoints}, {"trajectory", known.trajectories}, {"trajectory_line", trajectoryLines(*cell_)},
+        {"frame", known.frames},       {"object_class", classes},          {"predicate", std::move(predicates)},
+        {"grasp", std::move(grasps)},  {"object_shape", std::move(shapes)}};
   });
 }
 

@@ -76,6 +76,8 @@ Palette describePalette(workcell::Workcell& cell) {
        {{"detect", detect},
         {"calibrate", calibrate},
         {"pointcloud", cell.simulation() != nullptr},
+        // Free-drive from the 3D view: the simulator is the hand that pushes (POST /api/drag).
+        {"free_drive", cell.simulation() != nullptr && cell.nodes().find("FreeDrive") != nullptr},
         {"detect_node", detect ? "DetectObjects" : ""},
         {"calibrate_node", cell.nodes().find("Calibrate") != nullptr ? "Calibrate" : "HandEyeCalibration"}}},
       {"version", "0.1.0"}};

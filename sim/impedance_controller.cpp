@@ -159,6 +159,19 @@ void SimCartesianController::control() {
     reference = sample.pose;
     reference_velocity = sample.velocity;
     reference_rate = sample.angular_velocity;
+    if (motion_.drift) {
+      const arm::CartesianMotion::Drift& drift = *motion_.drift;
+      const double moving = std::clamp(toSeconds(elapsed), 0.0, toSeconds(drift.horizon));
+      reference.translation() += drift.velocity * moving;
+      const Eigen::Vector3d turn = drift.angular_velocity * moving;
+      if (turn.norm() > 0.0) {
+        reference.linear() = Eigen::AngleAxisd(turn.norm(), turn.normalized()).toRotationMatrix() * reference.linear();
+      }
+      if (elapsed < drift.horizon) {
+        reference_velocity += drift.velocity;
+        reference_rate += drift.angular_velocity;
+      }
+    }
     arc_ = sample.arc;
     path_done_ = elapsed >= motion_.path->duration();
     if (motion_.force) {

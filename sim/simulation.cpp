@@ -125,6 +125,8 @@ struct Simulation::Impl {
   double finger_command = kMaxOpening / 2;
   double finger_speed = 0.05;
   std::uint64_t arm_table_contact_steps = 0;
+  arm::Wrench hand;  // a person's hand on the tool (world, at the tool centre point)
+  TimePoint hand_until{};
 
   camera::Intrinsics intrinsics = camera::Intrinsics::fromHorizontalFov(640, 480, 58.0 * M_PI / 180.0);
   DepthNoiseOptions noise;
@@ -408,11 +410,27 @@ struct Simulation::Impl {
     return name != nullptr ? name : bodyLabel(model->geom_bodyid[geom]);
   }
 
+  /// The hand's wrench on the flange's body, at its centre of mass.
+  void applyHand() {
+    if (hand_until <= now()) {
+      hand = {};
+    }
+    mjtNum* applied = data->xfrc_applied + 6 * tool_body;
+    const Eigen::Vector3d tcp = Eigen::Map<const Eigen::Vector3d>(data->site_xpos + 3 * tcp_site);
+    const Eigen::Vector3d com = Eigen::Map<const Eigen::Vector3d>(data->xipos + 3 * tool_body);
+    const Eigen::Vector3d about_com = hand.torque + (tcp - com).cross(hand.force);
+    for (int i = 0; i < 3; ++i) {
+      applied[i] = hand.force[i];
+      applied[3 + i] = about_com[i];
+    }
+  }
+
   void step() {
     if (person) {
       watchPerson();
     }
     mj_step1(model, data);
+    applyHand();
     control();
     mj_step2(model, data);
     if (data->warning[mjWARN_CONTACTFULL].number > 0 || data->warning[mjWARN_CNSTRFULL].number > 0) {
@@ -840,6 +858,27 @@ arm::ForceTorqueSensor& Simulation::forceTorqueSensor() { return *impl_->force_t
 arm::CartesianController& Simulation::cartesianController() { return *impl_->cartesian; }
 
 arm::Wrench Simulation::trueFlangeWrench() const { return impl_->force_torque->truth(); }
+
+arm::Payload Simulation::toolPayload() const {
+  const mjModel* m = impl_->model;
+  const mjData* d = impl_->data;
+  const int body = impl_->tool_body;
+  const Eigen::Matrix3d rotation = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(d->xmat + 9 * body);
+  const Eigen::Vector3d origin = Eigen::Map<const Eigen::Vector3d>(d->xpos + 3 * body);
+  // subtree_com is the centre of mass of the body and its descendants, in the world.
+  const Eigen::Vector3d com = Eigen::Map<const Eigen::Vector3d>(d->subtree_com + 3 * body);
+  return {m->body_subtreemass[body], rotation.transpose() * (com - origin)};
+}
+
+void Simulation::setHandWrench(const arm::Wrench& at_tcp, Duration hold) {
+  if (!at_tcp.force.allFinite() || !at_tcp.torque.allFinite()) {
+    throw std::invalid_argument("the hand's wrench is not finite");
+  }
+  impl_->hand = at_tcp;
+  impl_->hand_until = time() + hold;
+}
+
+arm::Wrench Simulation::handWrench() const { return impl_->hand; }
 
 world::Pose Simulation::tcpPose() const {
   const mjData* d = impl_->data;

@@ -195,6 +195,16 @@ class Simulation {
   /// The controller's Cartesian impedance mode (sim/impedance_controller.h); a joint setpoint
   /// source (setArmSetpointSource) takes the arm back from it. It lives as long as the simulation.
   arm::CartesianController& cartesianController();
+  /// What the wrist sensor carries: the mass and centre of mass (in the sensor's frame, the
+  /// flange's) of everything beyond it (the gripper, and what it holds rigidly in the model).
+  arm::Payload toolPayload() const;
+  /// A person's hand on the tool (free-drive, docs/TEACHING.md): a force (N) and a torque (N m)
+  /// in world axes, applied at the tool centre point on the flange's body at every physics step
+  /// for `hold` of simulated time (the hand lets go then, as when a page's drag stream stops), or
+  /// until changed (a zero wrench: the hand lets go). @throws std::invalid_argument for a wrench
+  /// that is not finite.
+  void setHandWrench(const arm::Wrench& at_tcp, Duration hold = std::chrono::hours(24));
+  arm::Wrench handWrench() const;
   /// The true wrench at the flange sensor (no bias, no noise, never tared; what the flange
   /// pushes the tool side with, in the flange frame), for tests and the trial judge.
   arm::Wrench trueFlangeWrench() const;

@@ -281,7 +281,8 @@ class SimWorkcell final : public Workcell {
     auto arm = std::make_shared<arm::ArmComponent>(
         arm_driver, clock(), collisions_, waypoints_,
         [this](const std::string& frame) { return components().world().worldPose(frame); }, kinematics, arm_config,
-        arm::ForceControl{&simulation_->forceTorqueSensor(), &simulation_->cartesianController()});
+        arm::ForceControl{&simulation_->forceTorqueSensor(), &simulation_->cartesianController(),
+                          simulation_->toolPayload()});
     // The cell's motion service: what SmartMove asks (IK, collisions, plans); it moves the arm
     // through the arm's operations.
     motion_ = std::make_unique<arm::MotionPlanner>(arm_driver, clock(), collisions_, kinematics, arm_config);

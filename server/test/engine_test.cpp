@@ -892,5 +892,53 @@ TEST(Ur5Cell, StopHaltsTheRunAndStopsTheArm) {
   EXPECT_LT(y, 0.24) << "the arm went on to the waypoint (y 0.25) instead of stopping";
 }
 
+// Free-drive from the page (docs/TEACHING.md): POST /api/drag pushes the tool and holds the
+// dead-man while FreeDrive runs; when the stream of drags stops, the arm stops and holds.
+TEST(Ur5Cell, DraggingTheToolGuidesTheArmWhileHeldAndItStopsWhenTheDragsStop) {
+  Harness h(blindCell(), 1.0);  // real time: the page's drags come every 50 ms of wall time
+  const json push = {{"force", {0.0, 25.0, 0.0}}, {"torque", {0.0, 0.0, 0.0}}};
+  const HttpResponse off = h.call("POST", "/api/drag", push);
+  EXPECT_EQ(off.status, 409);
+  EXPECT_NE(off.body.find("free-drive is off"), std::string::npos) << off.body;
+  EXPECT_EQ(h.call("POST", "/api/drag", push, /*with_token=*/false).status, 401);
+  EXPECT_EQ(h.call("POST", "/api/drag", {{"force", {0.0, 100.0, 0.0}}}).status, 400);
+  EXPECT_EQ(h.call("POST", "/api/drag", {{"force", {0.0, 1.0}}}).status, 400);
+  EXPECT_EQ(h.call("POST", "/api/drag", {{"hand", 1}}).status, 400);
+
+  const double y0 = h.get("/api/state")["arm"]["endpoint"]["p"][1];
+  const HttpResponse started =
+      h.call("POST", "/api/operations", {{"node", "FreeDrive"}, {"attributes", {{"mode", "translation"}}}});
+  ASSERT_EQ(started.status, 202) << started.body;
+  const std::int64_t id = json::parse(started.body)["run"];
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1200);
+  int held = 0;
+  while (std::chrono::steady_clock::now() < until) {
+    held += h.call("POST", "/api/drag", push).status == 200 ? 1 : 0;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_GT(held, 10);
+  // The drags stop: the dead-man lapses, the operation ends and the arm stands still.
+  const json ended = h.waitForRun(id);
+  EXPECT_EQ(ended["result"], "SUCCESS") << ended.dump();
+  h.waitTicks(50);
+  const json state = h.get("/api/state");
+  EXPECT_FALSE(state["arm"]["moving"].get<bool>());
+  const double y1 = state["arm"]["endpoint"]["p"][1];
+  EXPECT_GT(y1 - y0, 0.05) << "the push along y did not move the tool";
+  h.waitTicks(50);
+  EXPECT_NEAR(h.get("/api/state")["arm"]["endpoint"]["p"][1].get<double>(), y1, 0.002) << "it did not hold";
+  EXPECT_EQ(h.call("POST", "/api/drag", push).status, 409);  // no FreeDrive runs now
+
+  // Refused while something else runs, with the reason.
+  const HttpResponse moving =
+      h.call("POST", "/api/operations", {{"node", "Move"}, {"attributes", {{"waypoint", "above_place"}}}});
+  ASSERT_EQ(moving.status, 202) << moving.body;
+  const HttpResponse refused =
+      h.call("POST", "/api/operations", {{"node", "FreeDrive"}, {"attributes", json::object()}});
+  EXPECT_EQ(refused.status, 409);
+  EXPECT_NE(refused.body.find("is active"), std::string::npos) << refused.body;
+  h.waitForRun(json::parse(moving.body)["run"]);
+}
+
 }  // namespace
 }  // namespace costar::server

@@ -38,6 +38,8 @@ import { SignIn } from './components/SignIn';
 import { NodeEditor } from './components/NodeEditor';
 import { candidatesOf, ObjectsPane } from './components/ObjectsPane';
 import { Waypoints } from './components/Waypoints';
+import { HandGuiding } from './components/HandGuiding';
+import { freeDriveAttributes, type Guiding } from './model/handGuide';
 import { View3D } from './components/View3D';
 import { Replay } from './components/Replay';
 import { PlanBrowser } from './components/PlanBrowser';
@@ -103,6 +105,9 @@ export function App() {
   const [nodes, setNodes] = useState<NodeInfo[]>([]);
   const [choices, setChoices] = useState<Choices | null>(null);
   const [robot, setRobot] = useState<RobotDescription | null>(null);
+  const [guiding, setGuiding] = useState<Guiding>({ mode: 'free', locked: [], record: '', recordFrame: 'world' });
+  const guidingRef = useRef(guiding);
+  guidingRef.current = guiding;
   const [cell, setCell] = useState<CellState | null>(null);
   const [connected, setConnected] = useState(false);
   // The server refused the token (401, or the stream's auth answer).
@@ -634,6 +639,15 @@ export function App() {
       return null;
     }
   };
+
+  /** Grabbing the tool's handle in the 3D view: FreeDrive in the guiding mode (refused, with the
+   * reason shown, while a plan runs); a recording applies to this one drag. */
+  const grabTool = useCallback(async () => {
+    const id = await runOperation('FreeDrive', freeDriveAttributes(guidingRef.current));
+    if (id !== null && guidingRef.current.record) setGuiding((g) => ({ ...g, record: '' }));
+    return id !== null;
+    // eslint-disable-next-line react-hooks/exhaustive-deps
+  }, [api]);
 
   const renameWaypointInCell = async (from: string, to: string) => {
     const id = await runOperation('RenameWaypoint', { waypoint: from, new_name: to });
@@ -1169,6 +1183,8 @@ export function App() {
         shapes={choices?.object_shape}
         believed={viewBelieved}
         robot={robot}
+        onGrab={replay || !info?.features.free_drive ? undefined : grabTool}
+        trajectoryLines={choices?.trajectory_line}
         replayLabel={replay ? (replayed ? `run #${replay.log.id} at t = ${replayed.t.toFixed(1)} s (replay)` : `run #${replay.log.id}: no snapshots logged (the cell now)`) : undefined}
       />
       <Waypoints
@@ -1178,7 +1194,19 @@ export function App() {
         refusal={refusedMotion}
         run={runOperation}
         rename={renameWaypointInCell}
-      />
+      >
+        {info?.features.free_drive && (
+          <HandGuiding
+            guiding={guiding}
+            onGuiding={setGuiding}
+            frames={liveChoices?.frame ?? ['world']}
+            classes={choices?.object_class ?? []}
+            trajectories={choices?.trajectory ?? []}
+            refusal={refusedMotion}
+            run={runOperation}
+          />
+        )}
+      </Waypoints>
       <Replay
         api={api}
         runs={runs}

@@ -39,6 +39,9 @@ export interface Choices {
   grasp: Record<string, string[]>;
   /** Each object class's shape (boxes in its frame, metres) and named colours (RGB in [0, 1]). */
   object_shape?: Record<string, ObjectShape>;
+  /** Trajectories recorded by hand guiding (FreeDrive's record), and their kept points in the world. */
+  trajectory?: string[];
+  trajectory_line?: Record<string, { frame: string; points: [number, number, number][] }>;
 }
 
 export interface ObjectShape {
@@ -50,7 +53,7 @@ export interface Info {
   workcell: string;
   description: string;
   simulator: boolean;
-  features: { detect: boolean; calibrate: boolean; pointcloud: boolean; detect_node: string; calibrate_node: string };
+  features: { detect: boolean; calibrate: boolean; pointcloud: boolean; detect_node: string; calibrate_node: string; free_drive?: boolean };
   pace?: number;
 }
 
@@ -196,6 +199,9 @@ export class Api {
   control = (action: 'pause' | 'resume' | 'step' | 'stop') => this.request('POST', '/api/control', { action });
   operation = (node: string, attributes: Record<string, string> = {}) =>
     this.request<{ run: number }>('POST', '/api/operations', { node, attributes });
+  /** Free-drive's hand: a push on the tool (N, N m, world) holding the dead-man 0.5 s, or let go. */
+  drag = (body: { force: [number, number, number]; torque?: [number, number, number] } | { release: true }) =>
+    this.request<{ ok: string }>('POST', '/api/drag', body);
   runStatus = (id: number) => this.request<RunInfo>('GET', `/api/runs/${id}`);
   runs = () => this.request<StoredRun[]>('GET', '/api/runs');
   /** A logged run with every transition: the server answers a long log in pages. */

@@ -374,6 +374,7 @@ export function NodeEditor({ node, info, choices, objects, trees, readOnly, onCh
     let list: string[] | undefined = port.choices;
     let shownPlaceholder = placeholder;
     if (port.choices_from === 'waypoint') list = choices?.waypoint ?? [];
+    if (port.choices_from === 'trajectory') list = choices?.trajectory ?? [];
     if (port.choices_from === 'frame') list = frames;
     if (port.choices_from === 'object_class') list = port.choices ?? choices?.object_class ?? [];
     if (port.choices_from === 'grasp') {

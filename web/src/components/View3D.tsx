@@ -3,19 +3,22 @@
 // the fingers from the gripper's reading, the table, the parts the system believes are there
 // (object symbols; a held part moves with the tool), each drawn as its class's boxes in its
 // class's colour, the waypoints, SmartMove's candidates, and on request the RGB-D camera's
-// point cloud. During a replay it shows the run's logged snapshots, not the cell now. Drag to
-// orbit, wheel to zoom.
+// point cloud, and the trajectories recorded by hand guiding as lines. During a replay it shows
+// the run's logged snapshots, not the cell now. Drag to orbit, wheel to zoom; grab the tool's
+// handle (the sphere at the tool) and drag to guide the arm by hand (free-drive, model/handGuide.ts:
+// the arm moves while the pointer is held and stops when it is let go).
 
 import { useEffect, useRef, useState } from 'react';
 import * as THREE from 'three';
 import type { Believed } from '../model/belief';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
-import type { Api, CellState, ObjectShape } from '../api';
+import type { Api, ApiError, CellState, ObjectShape } from '../api';
 import { partLook } from '../model/parts';
 import { DrawnRobot } from '../model/drawnRobot';
 import type { RobotDescription } from '../model/robot';
 import type { Candidate } from './ObjectsPane';
 import { ForceStrip } from './ForceStrip';
+import { handForce, HAND_PERIOD_MS, type Vec3 } from '../model/handGuide';
 
 interface Props {
   state: CellState | null;
@@ -31,6 +34,11 @@ interface Props {
   robot: RobotDescription | null;
   /** Replaying a run: what the view shows then (e.g. "run #3 at t = 12.4 s"). */
   replayLabel?: string;
+  /** Free-drive: starts FreeDrive when the tool's handle is grabbed (false: refused, with its
+   * reason shown by the page); absent: the handle cannot be grabbed (a replay, no arm). */
+  onGrab?: () => Promise<boolean>;
+  /** Recorded trajectories' kept points in the world, drawn as lines. */
+  trajectoryLines?: Record<string, { points: [number, number, number][] }>;
 }
 
 interface Scene {
@@ -45,6 +53,8 @@ interface Scene {
   waypoints: THREE.Group;
   candidates: THREE.Group;
   cloud: THREE.Group;
+  trajectories: THREE.Group;
+  handle: THREE.Mesh;
   render: () => void;
 }
 
@@ -81,7 +91,7 @@ function partMesh(objectClass: string, shapes: Record<string, ObjectShape> | und
   return group;
 }
 
-export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAvailable, shapes, believed, robot, replayLabel }: Props) {
+export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAvailable, shapes, believed, robot, replayLabel, onGrab, trajectoryLines }: Props) {
   const mount = useRef<HTMLDivElement>(null);
   const sceneRef = useRef<Scene | null>(null);
   const [drawn, setDrawn] = useState<DrawnRobot | null>(null);
@@ -91,6 +101,13 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
   const [error, setError] = useState<string | null>(null);
   const [cloudInfo, setCloudInfo] = useState<string>('');
   const [cloudTime, setCloudTime] = useState<number | null>(null);
+  const [toolScreen, setToolScreen] = useState('');
+  const [partScreens, setPartScreens] = useState('{}');
+  const [guiding, setGuiding] = useState(false);
+  const grabRef = useRef(onGrab);
+  grabRef.current = onGrab;
+  const apiRef = useRef(api);
+  apiRef.current = api;
 
   useEffect(() => {
     const element = mount.current;
@@ -131,8 +148,25 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     const waypoints = new THREE.Group();
     const candidateGroup = new THREE.Group();
     const cloud = new THREE.Group();
-    scene.add(robotGroup, parts, waypoints, candidateGroup, cloud);
-    const render = () => renderer.render(scene, camera);
+    const trajectories = new THREE.Group();
+    // The tool's handle: what the user grabs to guide the arm.
+    const handle = new THREE.Mesh(
+      new THREE.SphereGeometry(0.03, 16, 12),
+      new THREE.MeshLambertMaterial({ color: 0x7a4fd6, transparent: true, opacity: 0.35, depthWrite: false }),
+    );
+    handle.visible = false;
+    scene.add(robotGroup, parts, waypoints, candidateGroup, cloud, trajectories, handle);
+    const render = () => {
+      renderer.render(scene, camera);
+      // Where the tool and the parts are drawn (canvas pixels): what a user aims at.
+      const rect = renderer.domElement.getBoundingClientRect();
+      const onScreen = (v: THREE.Vector3) => {
+        const p = v.clone().project(camera);
+        return [Number((((p.x + 1) / 2) * rect.width).toFixed(1)), Number((((1 - p.y) / 2) * rect.height).toFixed(1))];
+      };
+      if (handle.visible) setToolScreen(onScreen(handle.position).join(','));
+      setPartScreens(JSON.stringify(Object.fromEntries(parts.children.map((part) => [part.name, onScreen(part.position)]))));
+    };
     controls.addEventListener('change', render);
     const resize = () => {
       const width = element.clientWidth || 400;
@@ -145,8 +179,70 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     const observer = new ResizeObserver(resize);
     observer.observe(element);
     resize();
-    sceneRef.current = { renderer, scene, camera, controls, robot: robotGroup, table, grid, parts, waypoints, candidates: candidateGroup, cloud, render };
+    sceneRef.current = { renderer, scene, camera, controls, robot: robotGroup, table, grid, parts, waypoints, candidates: candidateGroup, cloud, trajectories, handle, render };
+
+    // Grabbing the handle: the pointer holds the tool on the plane through it facing the camera;
+    // every 50 ms the page sends the hand's push toward where the pointer holds it.
+    let grab: { plane: THREE.Plane; target: THREE.Vector3; timer: number; pointer: number } | null = null;
+    const ray = new THREE.Raycaster();
+    const pointerRay = (event: PointerEvent) => {
+      const rect = renderer.domElement.getBoundingClientRect();
+      ray.setFromCamera(
+        new THREE.Vector2(((event.clientX - rect.left) / rect.width) * 2 - 1, -((event.clientY - rect.top) / rect.height) * 2 + 1),
+        camera,
+      );
+      return ray;
+    };
+    const letGo = () => {
+      if (!grab) return;
+      window.clearInterval(grab.timer);
+      grab = null;
+      controls.enabled = true;
+      setGuiding(false);
+      apiRef.current.drag({ release: true }).catch(() => undefined);
+    };
+    const onDown = async (event: PointerEvent) => {
+      if (!grabRef.current || !handle.visible || event.button !== 0) return;
+      if (pointerRay(event).intersectObject(handle).length === 0) return;
+      event.stopPropagation();
+      controls.enabled = false;
+      const normal = camera.getWorldDirection(new THREE.Vector3());
+      const plane = new THREE.Plane().setFromNormalAndCoplanarPoint(normal, handle.position);
+      grab = { plane, target: handle.position.clone(), timer: 0, pointer: event.pointerId };
+      renderer.domElement.setPointerCapture(event.pointerId);
+      setGuiding(true);
+      const started = await grabRef.current();
+      if (!started || !grab) {
+        letGo();
+        return;
+      }
+      let rearming = false;
+      grab.timer = window.setInterval(() => {
+        if (!grab) return;
+        const tool = handle.position;
+        const force = handForce([tool.x, tool.y, tool.z] as Vec3, [grab.target.x, grab.target.y, grab.target.z] as Vec3);
+        apiRef.current.drag({ force }).catch((e) => {
+          // The server's dead-man lapsed (a push came late) while the pointer is still held:
+          // free-drive again, as a hand still on the button would.
+          if ((e as ApiError).status === 409 && grab && !rearming && grabRef.current) {
+            rearming = true;
+            grabRef.current().finally(() => (rearming = false));
+          }
+        });
+      }, HAND_PERIOD_MS);
+    };
+    const onMove = (event: PointerEvent) => {
+      if (!grab) return;
+      pointerRay(event).ray.intersectPlane(grab.plane, grab.target);
+    };
+    renderer.domElement.addEventListener('pointerdown', onDown, { capture: true });
+    renderer.domElement.addEventListener('pointermove', onMove);
+    renderer.domElement.addEventListener('pointerup', letGo);
+    renderer.domElement.addEventListener('pointercancel', letGo);
+    window.addEventListener('blur', letGo);
     return () => {
+      letGo();
+      window.removeEventListener('blur', letGo);
       observer.disconnect();
       controls.dispose();
       renderer.dispose();
@@ -188,6 +284,9 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     if (drawn) {
       drawn.update(state.arm.joints, state.gripper.reading, state.gripper.mode);
       const tool = drawn.toolPose();
+      s.handle.visible = !!onGrab;
+      s.handle.position.copy(tool.position);
+      s.handle.quaternion.copy(tool.quaternion);
       setDrawnTool([tool.position.x, tool.position.y, tool.position.z].map((v) => v.toFixed(5)).join(','));
       setDrawnToolQ([tool.quaternion.x, tool.quaternion.y, tool.quaternion.z, tool.quaternion.w].map((v) => v.toFixed(6)).join(','));
       if (!framed.current) {
@@ -199,6 +298,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     for (const object of state.objects) {
       const pose = believed?.poses.get(object.name) ?? object;
       const mesh = partMesh(object.class, shapes, object.color);
+      mesh.name = object.name;
       mesh.position.set(...pose.p);
       mesh.quaternion.set(...pose.q);
       s.parts.add(mesh);
@@ -219,7 +319,19 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       }
     }
     s.render();
-  }, [state, selectedWaypoint, shapes, believed, drawn]);
+  }, [state, selectedWaypoint, shapes, believed, drawn, onGrab]);
+
+  useEffect(() => {
+    const s = sceneRef.current;
+    if (!s) return;
+    clear(s.trajectories);
+    for (const line of Object.values(trajectoryLines ?? {})) {
+      if (line.points.length < 2) continue;
+      const geometry = new THREE.BufferGeometry().setFromPoints(line.points.map((p) => new THREE.Vector3(...p)));
+      s.trajectories.add(new THREE.Line(geometry, new THREE.LineBasicMaterial({ color: 0x7a4fd6 })));
+    }
+    s.render();
+  }, [trajectoryLines]);
 
   useEffect(() => {
     const s = sceneRef.current;
@@ -331,7 +443,13 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       {error ? (
         <p className="empty">{error}</p>
       ) : (
-        <div className="view3d-canvas" ref={mount} data-drawn-tool={drawnTool} data-drawn-tool-q={drawnToolQ} data-robot={robot?.name ?? ''} data-finger-boxes={drawn?.fingerBoxes() ?? 0} />
+        <div
+          className={`view3d-canvas${guiding ? ' guiding' : ''}`}
+          ref={mount}
+          data-tool-screen={toolScreen}
+          data-part-screens={partScreens}
+          data-trajectories={Object.keys(trajectoryLines ?? {}).length}
+          data-drawn-tool={drawnTool} data-drawn-tool-q={drawnToolQ} data-robot={robot?.name ?? ''} data-finger-boxes={drawn?.fingerBoxes() ?? 0} />
       )}
     </section>
   );

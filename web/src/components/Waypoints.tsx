@@ -3,7 +3,7 @@
 // buttons as a pendant shows them; teach where it is, rename, delete, move to one. Every button
 // runs one operation of the arm; while the cell would refuse it, it is disabled and says why.
 
-import { useState } from 'react';
+import { useState, type ReactNode } from 'react';
 import type { CellState } from '../api';
 import { poseReadout, RobotDescription } from '../model/robot';
 import { readoutNumber } from '../model/poseText';
@@ -18,6 +18,8 @@ interface Props {
   run: (node: string, attributes?: Record<string, string>) => void;
   /** Renames a waypoint (the page then offers to rename it in the open plan). */
   rename: (from: string, to: string) => void;
+  /** Shown below the teach row (hand guiding, components/HandGuiding.tsx). */
+  children?: ReactNode;
 }
 
 const AXES = ['x', 'y', 'z'] as const;
@@ -27,7 +29,7 @@ function degrees(rad: number) {
   return readoutNumber((rad * 180) / Math.PI);
 }
 
-export function Waypoints({ state, frames, robot, refusal, run, rename }: Props) {
+export function Waypoints({ state, frames, robot, refusal, run, rename, children }: Props) {
   const busy = refusal !== null;
   const why = refusal ?? undefined;
   const [name, setName] = useState('');
@@ -133,6 +135,7 @@ export function Waypoints({ state, frames, robot, refusal, run, rename }: Props)
           Teach here
         </button>
       </div>
+      {children}
       <table className="waypoint-table">
         <tbody>
           {waypoints.map((w) => (

@@ -1,0 +1,222 @@
+#include "arm/free_drive.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Geometry>
+
+namespace costar::arm {
+
+namespace {
+
+constexpr double kGravity = 9.81;
+constexpr std::array<const char*, 6> kAxisNames{"x", "y", "z", "rx", "ry", "rz"};
+/// The look-ahead of a turn: as a translation's, 0.1 m counting as 1 rad (arm/cartesian_path.h).
+constexpr double kMetresPerRadian = 0.1;
+
+/// What the flange pushes the payload with to hold it against gravity, in the sensor frame
+/// whose rotation in the world is `sensor` (force, and torque about the sensor's origin).
+Wrench payloadSupport(const Eigen::Matrix3d& sensor, const Payload& payload) {
+  Wrench support;
+  support.force = sensor.transpose() * Eigen::Vector3d(0.0, 0.0, payload.mass * kGravity);
+  support.torque = payload.center_of_mass.cross(support.force);
+  return support;
+}
+
+/// `value` with the locked components (x, y, z of `offset` 0 or 3) zeroed, in the mode's axes.
+Eigen::Vector3d masked(const Eigen::Vector3d& value, const GuidingMode& mode, int offset,
+                       const Eigen::Matrix3d& tool_rotation) {
+  const Eigen::Matrix3d axes = mode.tool_axes ? tool_rotation : Eigen::Matrix3d::Identity();
+  Eigen::Vector3d local = axes.transpose() * value;
+  for (int i = 0; i < 3; ++i) {
+    if (mode.locked[static_cast<std::size_t>(offset + i)]) {
+      local[i] = 0.0;
+    }
+  }
+  return axes * local;
+}
+
+/// The push beyond the dead band, over the damping, within the top speed.
+Eigen::Vector3d answer(const Eigen::Vector3d& push, double dead_band, double damping, double max_speed) {
+  const double size = push.norm();
+  if (size <= dead_band) {
+    return Eigen::Vector3d::Zero();
+  }
+  const double speed = std::min((size - dead_band) / damping, max_speed);
+  return push / size * speed;
+}
+
+/// `target` reached from `before` by at most `step` (a vector's change).
+Eigen::Vector3d ramp(const Eigen::Vector3d& before, const Eigen::Vector3d& target, double step) {
+  const Eigen::Vector3d change = target - before;
+  return change.norm() <= step ? target : Eigen::Vector3d(before + change.normalized() * step);
+}
+
+}  // namespace
+
+GuidingMode GuidingMode::parse(const std::string& mode, const std::string& locked, const std::string& axes) {
+  GuidingMode guiding;
+  if (mode == "translation") {
+    guiding.locked = {false, false, false, true, true, true};
+  } else if (mode == "rotation") {
+    guiding.locked = {true, true, true, false, false, false};
+  } else if (mode != "free") {
+    throw std::invalid_argument("mode: '" + mode + "' is not a guiding mode (free, translation, rotation)");
+  }
+  std::stringstream list(locked);
+  for (std::string item; std::getline(list, item, ',');) {
+    item.erase(0, item.find_first_not_of(' '));
+    item.erase(item.find_last_not_of(' ') + 1);
+    if (item.empty()) {
+      continue;
+    }
+    const auto* found = std::find(kAxisNames.begin(), kAxisNames.end(), item);
+    if (found == kAxisNames.end()) {
+      throw std::invalid_argument("locked: '" + item + "' is not an axis (x, y, z, rx, ry, rz)");
+    }
+    guiding.locked[static_cast<std::size_t>(found - kAxisNames.begin())] = true;
+  }
+  if (axes != "world" && axes != "tool") {
+    throw std::invalid_argument("axes: '" + axes + "' is neither world nor tool");
+  }
+  guiding.tool_axes = axes == "tool";
+  if (std::all_of(guiding.locked.begin(), guiding.locked.end(), [](bool l) { return l; })) {
+    throw std::invalid_argument("locked: every axis is locked: the hand could move nothing");
+  }
+  return guiding;
+}
+
+std::string GuidingMode::str() const {
+  const auto all = [this](int from) { return locked[from] && locked[from + 1] && locked[from + 2]; };
+  const auto none = [this](int from) { return !locked[from] && !locked[from + 1] && !locked[from + 2]; };
+  if (none(0) && none(3)) {
+    return "free";
+  }
+  if (none(0) && all(3)) {
+    return "translation";
+  }
+  if (all(0) && none(3)) {
+    return "rotation";
+  }
+  std::string text = "locked";
+  for (std::size_t i = 0; i < 6; ++i) {
+    if (locked[i]) {
+      text += std::string(text == "locked" ? " " : ", ") + kAxisNames[i];
+    }
+  }
+  return text + (tool_axes ? " (tool)" : " (world)");
+}
+
+Wrench handWrench(const Wrench& reading, const Wrench& start_reading, const Eigen::Matrix3d& sensor_now,
+                  const Eigen::Matrix3d& sensor_at_start, const Eigen::Vector3d& tcp_in_sensor,
+                  const Payload& payload) {
+  const Wrench now = payloadSupport(sensor_now, payload);
+  const Wrench then = payloadSupport(sensor_at_start, payload);
+  // The flange pushes the tool with the payload's support less the hand's push.
+  const Eigen::Vector3d force = -((reading.force - start_reading.force) - (now.force - then.force));
+  const Eigen::Vector3d torque = -((reading.torque - start_reading.torque) - (now.torque - then.torque));
+  Wrench hand;
+  hand.force = sensor_now * force;
+  hand.torque = sensor_now * (torque - tcp_in_sensor.cross(force));
+  return hand;
+}
+
+Twist admittance(const Wrench& hand, const Twist& before, double dt, const GuidingMode& mode,
+                 const Eigen::Matrix3d& tool_rotation, const AdmittanceGains& gains) {
+  const Eigen::Vector3d velocity =
+      answer(masked(hand.force, mode, 0, tool_rotation), gains.dead_band, gains.damping, gains.max_speed);
+  const Eigen::Vector3d rate = answer(masked(hand.torque, mode, 3, tool_rotation), gains.rotational_dead_band,
+                                      gains.rotational_damping, gains.max_rotation_speed);
+  Twist twist;
+  twist.velocity = masked(ramp(before.velocity, velocity, gains.acceleration * dt), mode, 0, tool_rotation);
+  twist.angular_velocity =
+      masked(ramp(before.angular_velocity, rate, 4.0 * gains.acceleration * dt), mode, 3, tool_rotation);
+  return twist;
+}
+
+world::Pose advance(const world::Pose& pose, const Twist& twist, double dt) {
+  world::Pose moved = pose;
+  moved.translation() += twist.velocity * dt;
+  const Eigen::Vector3d turn = twist.angular_velocity * dt;
+  if (turn.norm() > 0.0) {
+    moved.linear() = Eigen::AngleAxisd(turn.norm(), turn.normalized()).toRotationMatrix() * pose.linear();
+  }
+  return moved;
+}
+
+FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joints, const Twist& twist, double dt,
+                            const JointVector& max_joint_step, const AdmittanceGains& gains, const StepCheck& check) {
+  FreeDriveStep held{reference, joints, Twist{}, {}};
+  const bool moving = twist.velocity.norm() > 0.0;
+  const bool turning = twist.angular_velocity.norm() > 0.0;
+  if (!moving && !turning) {
+    return held;
+  }
+  Twist translation_only;
+  translation_only.velocity = twist.velocity;
+  Twist rotation_only;
+  rotation_only.angular_velocity = twist.angular_velocity;
+  std::vector<Twist> tries{twist};
+  if (moving && turning) {
+    tries.push_back(translation_only);
+    tries.push_back(rotation_only);
+  }
+  // Against a wall the hand slides along it: the translation less one world axis's part.
+  for (int axis = 0; moving && axis < 3; ++axis) {
+    Twist slide = translation_only;
+    slide.velocity[axis] = 0.0;
+    if (slide.velocity.norm() > 0.0 && slide.velocity != twist.velocity) {
+      tries.push_back(slide);
+    }
+  }
+  std::string first_reason;
+  for (Twist attempt : tries) {
+    // Near a singularity the joints would turn fast: the twist slows until they do not.
+    for (int slowing = 0; slowing < 4; ++slowing) {
+      const world::Pose next = advance(reference, attempt, dt);
+      std::string why;
+      const std::optional<JointVector> q = check(next, joints, why);
+      if (!q) {
+        if (first_reason.empty()) {
+          first_reason = why;
+        }
+        break;
+      }
+      double worst = 0.0;
+      for (int j = 0; j < joints.size(); ++j) {
+        worst = std::max(worst, std::abs((*q)[j] - joints[j]) / max_joint_step[j]);
+      }
+      if (worst > 1.0) {
+        attempt.velocity /= 2.0 * worst;
+        attempt.angular_velocity /= 2.0 * worst;
+        if (first_reason.empty()) {
+          first_reason = "a joint would turn too fast (near a singularity)";
+        }
+        continue;
+      }
+      // The stopping distance ahead must be clear too.
+      Twist ahead;
+      if (attempt.velocity.norm() > 0.0) {
+        ahead.velocity = attempt.velocity.normalized() * gains.look_ahead;
+      }
+      if (attempt.angular_velocity.norm() > 0.0) {
+        ahead.angular_velocity = attempt.angular_velocity.normalized() * (gains.look_ahead / kMetresPerRadian);
+      }
+      if (!check(advance(next, ahead, 1.0), *q, why)) {
+        if (first_reason.empty()) {
+          first_reason = why;
+        }
+        break;
+      }
+      return {next, *q, attempt,
+              attempt.velocity == twist.velocity && attempt.angular_velocity == twist.angular_velocity ? std::string()
+                                                                                                       : first_reason};
+    }
+  }
+  held.blocked = first_reason;
+  return held;
+}
+
+}  // namespace costar::arm

@@ -1,0 +1,104 @@
+#pragma once
+// Free-drive (hand guiding): the abstract Arm's Teach as a person does it with a UR's free-drive
+// button or a Franka's guiding mode. The wrist sensor measures the hand's push on the tool; the
+// controller keeps compensating gravity and follows a reference that moves as an admittance,
+// velocity = push / damping, within the teaching speed (250 mm/s at the tool, as collaborative
+// operation standards reduce it), the joint limits and the joints' speed, and never into the
+// table or a known part: each step of the reference is checked (inverse kinematics within the
+// limits less a margin, the configuration and one a stopping distance ahead free of collisions)
+// before the controller gets it, and a step that fails is not taken: the tool stops before the
+// contact, and slides along it when pushed aslant. Guiding modes (Franka's): free, translation only,
+// rotation only, and any of the six axes locked (world or tool axes).
+//
+// This file is the arithmetic, with no robot behind it (arm/test/free_drive_test.cpp); the Arm
+// component's FreeDrive operation (arm/free_drive_operation.cpp) runs it every tick and holds the
+// dead-man (ArmComponent::holdFreeDrive).
+
+#include <array>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "arm/force_torque.h"
+#include "arm/joints.h"
+#include "world/pose.h"
+
+namespace costar::arm {
+
+/// Which of the tool's six motions the hand may cause.
+struct GuidingMode {
+  /// x, y, z, then rotations about x, y, z; true: locked (the hand cannot move it).
+  std::array<bool, 6> locked{};
+  /// The axes are the tool's (true) or the world's.
+  bool tool_axes = false;
+
+  /// `mode`: free, translation (rotations locked), rotation (translations locked); `locked`: a
+  /// comma-separated list of further axes to lock (x, y, z, rx, ry, rz; empty: none); `axes`:
+  /// world or tool. @throws std::invalid_argument naming the field and the value refused.
+  static GuidingMode parse(const std::string& mode, const std::string& locked, const std::string& axes);
+  /// "free", "translation", "rotation", or the locked axes ("locked z, rx (world)").
+  std::string str() const;
+};
+
+/// How the reference answers the hand (Franka's and UR's figures are of this order).
+struct AdmittanceGains {
+  double damping = 100.0;             // N s/m: a push of 15 N beyond the dead band moves the tool at 0.15 m/s
+  double rotational_damping = 2.5;    // N m s/rad
+  double dead_band = 3.0;             // N: pushes below this do nothing (the sensor's noise, the payload's error)
+  double rotational_dead_band = 0.3;  // N m
+  double max_speed = 0.15;            // m/s of the reference: the tool stays within 0.25 m/s
+  double max_rotation_speed = 0.6;    // rad/s
+  double acceleration = 1.5;          // m/s^2 (and rad/s^2 x 4) of the reference
+  /// How far ahead along the motion (m) the configuration must be free too: the tool stops this
+  /// far before a contact at most (the collision world pads the arm by another centimetre).
+  double look_ahead = 0.04;
+  /// The joints stay this far (rad) inside their limits.
+  double joint_margin = 0.05;
+  /// The joints turn at most this fraction of their top speed.
+  double joint_speed_fraction = 0.5;
+};
+
+/// The hand's push at the tool centre point, in the world: the wrist sensor's reading less what
+/// it read when free-drive began, less the change of the payload's weight as the tool turned.
+/// `sensor_in_world`: the sensor frame's pose now and at the start; `tcp_in_sensor`: the tool
+/// centre point in the sensor frame.
+Wrench handWrench(const Wrench& reading, const Wrench& start_reading, const Eigen::Matrix3d& sensor_now,
+                  const Eigen::Matrix3d& sensor_at_start, const Eigen::Vector3d& tcp_in_sensor, const Payload& payload);
+
+/// One step of the admittance: from the hand's wrench (world, at the tool centre point), the
+/// reference's twist before, and the time step, the twist the reference should move at (masked by
+/// the guiding mode, within the dead bands, speeds and acceleration).
+struct Twist {
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+};
+Twist admittance(const Wrench& hand, const Twist& before, double dt, const GuidingMode& mode,
+                 const Eigen::Matrix3d& tool_rotation, const AdmittanceGains& gains);
+
+/// The pose a twist moves `pose` to in `dt`.
+world::Pose advance(const world::Pose& pose, const Twist& twist, double dt);
+
+/// Checks a step of the reference: the joints that reach `pose` near `seed`, or nullopt with
+/// the reason (out of reach, a joint at its limit, a collision) in `why`.
+using StepCheck =
+    std::function<std::optional<JointVector>(const world::Pose& pose, const JointVector& seed, std::string& why)>;
+
+struct FreeDriveStep {
+  world::Pose reference = world::Pose::Identity();  // where the reference is after the step
+  JointVector joints{};                             // the joints there
+  Twist twist;                                      // what it moves at now
+  /// Empty when the step was taken as the hand asked; else why (part of) it was not.
+  std::string blocked;
+};
+
+/// The step the reference takes from (`reference`, `joints`) with `twist` over `dt`: the whole
+/// twist when it passes `check` (at the new pose and `look_ahead` beyond it along the motion)
+/// and the joints turn within `max_joint_step`; otherwise its translation alone, or its
+/// rotation alone, or the translation less its part along one world axis (sliding along a wall),
+/// or none (the reference holds and the twist is zero).
+FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joints, const Twist& twist, double dt,
+                            const JointVector& max_joint_step, const AdmittanceGains& gains, const StepCheck& check);
+
+}  // namespace costar::arm

@@ -1,0 +1,148 @@
+#include "arm/free_drive.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+namespace costar::arm {
+namespace {
+
+TEST(FreeDrive, GuidingModesParseAndBadOnesAreRefusedNamingTheField) {
+  EXPECT_EQ(GuidingMode::parse("free", "", "world").str(), "free");
+  EXPECT_EQ(GuidingMode::parse("translation", "", "world").str(), "translation");
+  EXPECT_EQ(GuidingMode::parse("rotation", "", "tool").str(), "rotation");
+  EXPECT_EQ(GuidingMode::parse("free", "z, rx", "tool").str(), "locked z, rx (tool)");
+  try {
+    GuidingMode::parse("sideways", "", "world");
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "mode: 'sideways' is not a guiding mode (free, translation, rotation)");
+  }
+  EXPECT_THROW(GuidingMode::parse("free", "z,w", "world"), std::invalid_argument);
+  EXPECT_THROW(GuidingMode::parse("free", "", "base"), std::invalid_argument);
+  EXPECT_THROW(GuidingMode::parse("translation", "x,y,z", "world"), std::invalid_argument);
+}
+
+TEST(FreeDrive, ThePayloadsWeightIsTakenOutAsTheToolTurns) {
+  Payload payload{1.2, Eigen::Vector3d(0.0, 0.01, 0.08)};
+  const Eigen::Matrix3d start = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Matrix3d turned = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, 1.0, 0.2).normalized()) * start;
+  // What the flange pushes the payload with to hold it, at either orientation, plus a bias.
+  const auto reading = [&](const Eigen::Matrix3d& sensor, const Eigen::Vector3d& hand_world) {
+    Wrench w;
+    w.force = sensor.transpose() * Eigen::Vector3d(0, 0, payload.mass * 9.81) + Eigen::Vector3d(1.0, -2.0, 0.5);
+    w.torque = payload.center_of_mass.cross(w.force - Eigen::Vector3d(1.0, -2.0, 0.5)) + Eigen::Vector3d(0.1, 0, 0);
+    // The hand pushes at the sensor's origin.
+    w.force -= sensor.transpose() * hand_world;
+    return w;
+  };
+  const Wrench at_start = reading(start, Eigen::Vector3d::Zero());
+  const Wrench still =
+      handWrench(reading(turned, Eigen::Vector3d::Zero()), at_start, turned, start, Eigen::Vector3d::Zero(), payload);
+  EXPECT_LT(still.force.norm(), 1e-9);
+  EXPECT_LT(still.torque.norm(), 1e-9);
+  const Eigen::Vector3d push(5.0, -3.0, 10.0);
+  const Wrench pushed =
+      handWrench(reading(turned, push), at_start, turned, start, Eigen::Vector3d(0, 0, 0.15), payload);
+  EXPECT_LT((pushed.force - push).norm(), 1e-9);
+  // A push at the sensor's origin turns the tool about its centre point, 0.15 m beyond it.
+  const Eigen::Vector3d lever = turned * Eigen::Vector3d(0, 0, -0.15);
+  EXPECT_LT((pushed.torque - lever.cross(push)).norm(), 1e-9);
+  // Without the payload's weight taken out, the turn alone would read as a push.
+  const Wrench naive =
+      handWrench(reading(turned, Eigen::Vector3d::Zero()), at_start, turned, start, Eigen::Vector3d::Zero(), {});
+  EXPECT_GT(naive.force.norm(), 3.0);
+}
+
+TEST(FreeDrive, TheAdmittanceAnswersBeyondItsDeadBandWithinItsSpeedAndMasksLockedAxes) {
+  AdmittanceGains gains;
+  gains.acceleration = 1e6;  // no ramp here
+  const Eigen::Matrix3d tool = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  Wrench hand;
+  hand.force = Eigen::Vector3d(2.0, 0, 0);
+  EXPECT_EQ(admittance(hand, {}, 0.01, GuidingMode::parse("free", "", "world"), tool, gains).velocity.norm(), 0.0);
+  hand.force = Eigen::Vector3d(13.0, 0, 0);
+  EXPECT_NEAR(admittance(hand, {}, 0.01, GuidingMode::parse("free", "", "world"), tool, gains).velocity.x(), 0.1,
+              1e-12);
+  hand.force = Eigen::Vector3d(0, 0, -500.0);
+  EXPECT_NEAR(admittance(hand, {}, 0.01, GuidingMode::parse("free", "", "world"), tool, gains).velocity.norm(),
+              gains.max_speed, 1e-12);
+  hand.force = Eigen::Vector3d(20.0, 20.0, 20.0);
+  hand.torque = Eigen::Vector3d(1.0, 1.0, 1.0);
+  const Twist rotation = admittance(hand, {}, 0.01, GuidingMode::parse("rotation", "", "world"), tool, gains);
+  EXPECT_EQ(rotation.velocity.norm(), 0.0);
+  EXPECT_GT(rotation.angular_velocity.norm(), 0.1);
+  const Twist translation = admittance(hand, {}, 0.01, GuidingMode::parse("translation", "", "world"), tool, gains);
+  EXPECT_EQ(translation.angular_velocity.norm(), 0.0);
+  // The tool's x is the world's y here: locking it in tool axes stops the world's y.
+  const Twist locked = admittance(hand, {}, 0.01, GuidingMode::parse("translation", "x", "tool"), tool, gains);
+  EXPECT_NEAR(locked.velocity.y(), 0.0, 1e-12);
+  EXPECT_GT(locked.velocity.x(), 0.05);
+  // The ramp: from rest, at most the acceleration's worth in one step.
+  gains.acceleration = 1.5;
+  EXPECT_NEAR(admittance(hand, {}, 0.01, GuidingMode::parse("translation", "", "world"), tool, gains).velocity.norm(),
+              0.015, 1e-12);
+}
+
+TEST(FreeDrive, AStepTowardAWallStopsTheLookAheadShortOfItAndAnAslantPushSlidesAlongIt) {
+  // A one-joint-per-axis "arm": the joints are the tool's x, y, z; a wall at z = 0.1.
+  AdmittanceGains gains;
+  const StepCheck check = [](const world::Pose& pose, const JointVector&,
+                             std::string& why) -> std::optional<JointVector> {
+    if (pose.translation().z() < 0.1) {
+      why = "tool would touch table";
+      return std::nullopt;
+    }
+    JointVector q = JointVector::zero(3);
+    for (int i = 0; i < 3; ++i) {
+      q[i] = pose.translation()[i];
+    }
+    return q;
+  };
+  world::Pose reference = world::Pose::Identity();
+  reference.translation() = Eigen::Vector3d(0, 0, 0.2);
+  JointVector joints = JointVector::zero(3);
+  joints[2] = 0.2;
+  const JointVector max_step = JointVector(3, 1.0);
+  Twist down;
+  down.velocity = Eigen::Vector3d(0.05, 0.0, -0.2);
+  double lowest = 1.0;
+  std::string blocked;
+  for (int i = 0; i < 200; ++i) {
+    const FreeDriveStep step = stepReference(reference, joints, down, 0.01, max_step, gains, check);
+    reference = step.reference;
+    joints = step.joints;
+    lowest = std::min(lowest, reference.translation().z());
+    if (!step.blocked.empty()) {
+      blocked = step.blocked;
+    }
+  }
+  // It stops the look-ahead short of the wall (and a step), never at it.
+  EXPECT_GE(lowest, 0.1 + gains.look_ahead - 0.01);
+  EXPECT_LE(lowest, 0.1 + gains.look_ahead + 0.01);
+  EXPECT_EQ(blocked, "tool would touch table");
+  // Pushed down and sideways, it slides along the wall at the sideways speed: 2 s at 0.05 m/s.
+  EXPECT_NEAR(reference.translation().x(), 0.1, 1e-9);
+}
+
+TEST(FreeDrive, FastJointsNearASingularitySlowTheStep) {
+  AdmittanceGains gains;
+  const StepCheck check = [](const world::Pose& pose, const JointVector&, std::string&) -> std::optional<JointVector> {
+    JointVector q = JointVector::zero(1);
+    q[0] = 10.0 * pose.translation().x();  // the joint turns 10 rad per metre
+    return q;
+  };
+  Twist twist;
+  twist.velocity = Eigen::Vector3d(0.2, 0, 0);
+  const FreeDriveStep step =
+      stepReference(world::Pose::Identity(), JointVector::zero(1), twist, 0.01, JointVector(1, 0.01), gains, check);
+  EXPECT_LE(std::abs(step.joints[0]), 0.01);
+  EXPECT_GT(step.twist.velocity.x(), 0.0);
+  EXPECT_LT(step.twist.velocity.x(), 0.1);
+  EXPECT_EQ(step.blocked, "a joint would turn too fast (near a singularity)");
+}
+
+}  // namespace
+}  // namespace costar::arm

@@ -1,0 +1,175 @@
+// Free-drive on both simulated arms (docs/TEACHING.md): the person's hand is a wrench on the tool
+// (Simulation::setHandWrench), judged from the simulator's true state.
+#include "trials/free_drive_trial.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "arm/arm_component.h"
+#include "bt/builder.h"
+#include "bt/executor.h"
+#include "bt/plan_xml.h"
+#include "sim/simulation.h"
+#include "workcell/workcell.h"
+
+namespace costar::trials {
+namespace {
+
+class FreeDrive : public ::testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override {
+    workcell::WorkcellOptions options;
+    options.name = GetParam();
+    options.memory_only = true;
+    options.seed = 11;
+    cell_ = workcell::makeWorkcell(options);
+    simulation_ = cell_->simulation();
+    arm_ = dynamic_cast<arm::ArmComponent*>(cell_->components().provider("FreeDrive"));
+    ASSERT_NE(arm_, nullptr);
+  }
+
+  /// Runs `node`, calling `tick` (with the seconds since the start) before every tick.
+  bt::RunResult run(const std::string& node, const std::function<void(double)>& tick) {
+    const bt::Plan plan =
+        bt::loadPlanText(R"(<root BTCPP_format="4"><BehaviorTree ID="t">)" + node + "</BehaviorTree></root>", "t",
+                         {.follow_includes = false});
+    bt::Tree tree = bt::buildTree(plan, cell_->nodes(), cell_->clock());
+    bt::Executor executor(tree, cell_->clock());
+    const TimePoint start = cell_->clock().now();
+    executor.setBeforeTick([&] {
+      cell_->beforeTick();
+      if (tick) {
+        tick(toSeconds(cell_->clock().now() - start));
+      }
+    });
+    return executor.run();
+  }
+
+  /// Holds the dead-man and pushes with `hand` for `seconds`, then lets go of both.
+  bt::RunResult push(const std::string& mode, const arm::Wrench& hand, double seconds, const std::string& locked = "") {
+    return run("<FreeDrive mode=\"" + mode + "\" locked=\"" + locked + "\" hold=\"0.2\"/>", [&](double t) {
+      if (t < seconds) {
+        simulation_->setHandWrench(hand);
+        arm_->holdFreeDrive(std::chrono::milliseconds(100));
+      } else {
+        simulation_->setHandWrench({});
+      }
+    });
+  }
+
+  std::unique_ptr<workcell::Workcell> cell_;
+  sim::Simulation* simulation_ = nullptr;
+  arm::ArmComponent* arm_ = nullptr;
+};
+
+TEST_P(FreeDrive, APushMovesTheToolAlongItAndLettingGoStopsAndHoldsIt) {
+  const world::Pose before = simulation_->tcpPose();
+  arm::Wrench hand;
+  hand.force = Eigen::Vector3d(0.0, 20.0, 0.0);
+  const bt::RunResult result = push("translation", hand, 1.0);
+  ASSERT_EQ(result.status, bt::Status::kSuccess) << result.failure_reason;
+  const world::Pose let_go = simulation_->tcpPose();
+  const Eigen::Vector3d moved = let_go.translation() - before.translation();
+  EXPECT_GT(moved.y(), 0.05);  // 17 N beyond the dead band: 0.15 m/s (the most) for about a second
+  EXPECT_LT(std::abs(moved.x()), 0.2 * moved.y());
+  EXPECT_LT(std::abs(moved.z()), 0.2 * moved.y());
+  EXPECT_LT(world::rotationAngle(before, let_go), 1.0 * M_PI / 180.0);  // translation only
+  // Let go: it stays where it is.
+  run("<Sleep msec=\"500\"/>", {});
+  EXPECT_LT((simulation_->tcpPose().translation() - let_go.translation()).norm(), 0.01);
+  EXPECT_LT(arm::maxAbs(simulation_->armVelocities()), 0.02);
+  EXPECT_FALSE(arm_->freeDriveStatus().active);
+}
+
+TEST_P(FreeDrive, RotationModeTurnsTheToolAboutItsCentrePointAndKeepsItThere) {
+  const world::Pose before = simulation_->tcpPose();
+  arm::Wrench hand;
+  hand.force = Eigen::Vector3d(15.0, 0.0, 0.0);
+  hand.torque = Eigen::Vector3d(0.0, 0.0, 1.0);
+  ASSERT_EQ(push("rotation", hand, 1.0).status, bt::Status::kSuccess);
+  const world::Pose after = simulation_->tcpPose();
+  EXPECT_GT(world::rotationAngle(before, after), 10.0 * M_PI / 180.0);
+  EXPECT_LT((after.translation() - before.translation()).norm(), 0.01);
+}
+
+TEST_P(FreeDrive, ALockedAxisDoesNotMove) {
+  const world::Pose before = simulation_->tcpPose();
+  arm::Wrench hand;
+  hand.force = Eigen::Vector3d(12.0, 12.0, 12.0);
+  ASSERT_EQ(push("translation", hand, 1.0, "z").status, bt::Status::kSuccess);
+  const Eigen::Vector3d moved = simulation_->tcpPose().translation() - before.translation();
+  EXPECT_GT(moved.head<2>().norm(), 0.05);
+  EXPECT_LT(std::abs(moved.z()), 0.005);
+}
+
+TEST_P(FreeDrive, PushingIntoTheTableStopsTheToolAboveItAndSaysWhy) {
+  // From 12 cm above the table, 15 cm further out (the iiwa's elbow is near its limit below home).
+  const double down = simulation_->tcpPose().translation().z() - 0.12;
+  const bt::RunResult lowered = run("<MoveRelative offset=\"0.15;0;" + std::to_string(-down) + "\"/>", {});
+  ASSERT_EQ(lowered.status, bt::Status::kSuccess) << lowered.failure_reason;
+  const std::uint64_t contacts = simulation_->armTableContactSteps();
+  arm::Wrench hand;
+  hand.force = Eigen::Vector3d(0.0, 0.0, -40.0);
+  std::string blocked;
+  const bt::RunResult result = run("<FreeDrive mode=\"translation\" hold=\"0.2\"/>", [&](double t) {
+    if (t < 5.0) {
+      simulation_->setHandWrench(hand);
+      arm_->holdFreeDrive(std::chrono::milliseconds(100));
+      if (!arm_->freeDriveStatus().blocked.empty()) {
+        blocked = arm_->freeDriveStatus().blocked;
+      }
+    } else {
+      simulation_->setHandWrench({});
+    }
+  });
+  ASSERT_EQ(result.status, bt::Status::kSuccess) << result.failure_reason;
+  EXPECT_EQ(simulation_->armTableContactSteps(), contacts);
+  EXPECT_GT(simulation_->tcpPose().translation().z(), 0.0);
+  EXPECT_NE(blocked.find("table"), std::string::npos) << blocked;
+}
+
+TEST_P(FreeDrive, WithoutTheDeadManItEndsAndNothingMoves) {
+  const world::Pose before = simulation_->tcpPose();
+  arm::Wrench hand;
+  hand.force = Eigen::Vector3d(30.0, 0.0, 0.0);
+  simulation_->setHandWrench(hand);
+  const bt::RunResult result = run("<FreeDrive hold=\"0.1\"/>", {});
+  simulation_->setHandWrench({});
+  ASSERT_EQ(result.status, bt::Status::kSuccess) << result.failure_reason;
+  EXPECT_LT(toSeconds(result.elapsed), 0.2);
+  EXPECT_LT((simulation_->tcpPose().translation() - before.translation()).norm(), 0.03);
+  EXPECT_FALSE(arm_->holdFreeDrive(std::chrono::milliseconds(100)));  // none runs to hold
+}
+
+TEST_P(FreeDrive, ARandomDragKeepsTheLimitsTheSpeedAndClearOfTheTableAndParts) {
+  FreeDriveTrialOptions options;
+  options.seconds = 40.0;
+  options.seed = 5;
+  const FreeDriveTrialResult result = runFreeDriveTrial(*cell_, options);
+  EXPECT_EQ(result.failure, "");
+  EXPECT_GE(result.holds, 2);
+  EXPECT_GT(result.travelled, 0.5);
+  EXPECT_EQ(result.joint_limit_violations, 0U);
+  EXPECT_EQ(result.table_contact_steps, 0U);
+  EXPECT_EQ(result.part_contact_ticks, 0U);
+  EXPECT_LE(result.max_tool_speed, 0.25);
+  EXPECT_LE(result.max_stop_time, 0.5);
+}
+
+TEST_P(FreeDrive, ARecordedStrokeIsReplayedWithinTwoMillimetresAndOneDegree) {
+  const ReplayTrialResult result = runReplayTrial(*cell_, 3);
+  ASSERT_EQ(result.failure, "");
+  EXPECT_GT(result.length, 0.1);
+  EXPECT_LT(result.kept, result.samples / 4);  // simplified
+  EXPECT_GE(result.kept, 3U);
+  EXPECT_LE(result.rms_position, 0.002);
+  EXPECT_LE(result.max_angle, 1.0 * M_PI / 180.0);
+  EXPECT_GE(result.replay_seconds, 0.95 * result.recorded_seconds);  // at the recorded pace or slower
+}
+
+INSTANTIATE_TEST_SUITE_P(BothArms, FreeDrive, ::testing::Values("ur5-sim", "iiwa-sim"),
+                         [](const auto& cell) { return cell.param == "ur5-sim" ? "UR5" : "Iiwa"; });
+
+}  // namespace
+}  // namespace costar::trials
