@@ -110,6 +110,9 @@ class SimPowerTool final : public tool::PowerToolDriver {
   const std::vector<PowerToolSample>& log() const { return log_; }
   /// Absent without a workpiece.
   const std::optional<Coverage>& coverage() const { return coverage_; }
+  /// The friction coefficient (sliding) of the pad's contacts with the workpiece now; absent
+  /// while they do not touch.
+  std::optional<double> padFriction() const;
   /// Physics steps in which an arm or gripper geom touched the workpiece.
   std::uint64_t armWorkpieceSteps() const { return arm_workpiece_steps_; }
 

@@ -3,10 +3,14 @@
 // grasp, ToolOn and ToolOff switch it, the component switches it off when it leaves the hand,
 // and the simulator records which texels of the workpiece's marked area the running pad worked.
 
+#include <algorithm>
+#include <cmath>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "core/paths.h"
+#include "sim/power_tool.h"
 #include "sim/simulation.h"
 #include "workcell/workcell.h"
 
@@ -102,6 +106,52 @@ TEST(Polishing, TheRunningPadWorksTheTexelsUnderItAndTheToolOffWorksNone) {
   EXPECT_TRUE(log.back().working);
   EXPECT_NEAR(log.back().pad.norm(), 0.0, 0.002);
   EXPECT_NEAR(log[log.size() - 1].time - log[log.size() - 2].time, 0.01, 1e-9);
+}
+
+// Held in Basic mode, the sander hung 18 degrees tilted in the fingers and pressed on its pad's
+// edge, 3 cm off the path; the pinch grasp holds it straight and the pad presses flat.
+TEST(Polishing, TheSanderSitsStraightInTheHandAndItsPadPressesFlatUnderThePath) {
+  const auto cell = makeWorkcell({.name = "iiwa-3f-sim",
+                                  .scene = dataRoot() / "sim/scenes/polishing.json",
+                                  .seed = 21,
+                                  .waypoints = dataRoot() / "examples/iiwa/polishing_waypoints.json",
+                                  .memory_only = true,
+                                  .test_oracle_perception = true});
+  sim::Simulation& simulation = *cell->simulation();
+  const OperationResult grasp = run(*cell, "SmartGrasp", {{"object_class", "orbital_sander"}, {"grasp", "knob"}});
+  ASSERT_EQ(grasp.state, OperationState::kSuccess) << grasp.reason;
+  const auto tilt = [](const Eigen::Vector3d& axis, const Eigen::Vector3d& along) {
+    return std::acos(std::clamp(axis.dot(along), -1.0, 1.0)) * 180.0 / M_PI;
+  };
+  // Hanging in the hand: the tool points along the approach, its pad's centre 10.7 cm below the
+  // tool centre point (the taught grasp).
+  const world::Pose hanging = simulation.tcpPose().inverse() * simulation.powerTool()->toolPose();
+  EXPECT_LT(tilt(-hanging.linear().col(2), Eigen::Vector3d::UnitZ()), 2.0);
+  EXPECT_LT((hanging.translation() - Eigen::Vector3d(0, 0, 0.107)).norm(), 0.003);
+  ASSERT_EQ(run(*cell, "ToolOn", {{"speed", 10000.0}}).state, OperationState::kSuccess);
+  const OperationResult press =
+      run(*cell, "PressAndFollow",
+          {{"path", std::vector<std::string>{"row1_start", "row1_end"}}, {"force", 10.0}, {"speed", 0.03}});
+  ASSERT_EQ(press.state, OperationState::kSuccess) << press.reason;
+  // Pressed at the end of the pass: the pad flat on the workpiece, under the tool centre point.
+  const world::Pose tcp = simulation.tcpPose();
+  const world::Pose pad = simulation.powerTool()->toolPose();
+  EXPECT_LT(tilt(pad.linear().col(2), Eigen::Vector3d::UnitZ()), 2.0);
+  EXPECT_LT((pad.translation() - tcp.translation()).head<2>().norm(), 0.005);
+}
+
+// MuJoCo takes the larger of two geoms' friction: the pad slid with the workpiece's 1.0, not its
+// felt's 0.4, until the pad's geom took priority.
+TEST(Polishing, ThePadTouchesTheWorkpieceWithItsFeltsFriction) {
+  const auto cell = polishingCell();
+  sim::SimPowerTool& tool = *cell->simulation()->powerTool();
+  const world::Pose top = sim::workpieceTop(sim::loadScene(dataRoot() / "sim/scenes/polishing.json").workpiece.value());
+  EXPECT_FALSE(tool.padFriction().has_value());
+  tool.placeTool(top * Eigen::Translation3d(0, 0, 0.001));
+  cell->clock().sleepUntil(cell->clock().now() + std::chrono::milliseconds(500));
+  ASSERT_TRUE(tool.padFriction().has_value());
+  EXPECT_NEAR(*tool.padFriction(), tool.setup()->tool.pad_friction, 1e-9);
+  EXPECT_NEAR(tool.setup()->tool.pad_friction, 0.4, 1e-9);
 }
 
 }  // namespace
