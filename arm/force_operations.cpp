@@ -171,7 +171,8 @@ ParamSpec number(const char* name, const std::string& description, double value,
   return spec;
 }
 
-/// The force must stay below the limit that stops the motion.
+/// The force must stay below the limit that stops the motion (checked again when an operation
+/// starts, whoever starts it).
 std::string forceBelowLimit(const ParamMap& params) {
   const double force = params.at("force").asDouble();
   const double limit = params.at("max_force").asDouble();
@@ -180,6 +181,14 @@ std::string forceBelowLimit(const ParamMap& params) {
            "), the force that stops the motion";
   }
   return {};
+}
+
+/// A force the operation keeps: below the limit that stops the motion (a constraint kept in the
+/// stored descriptions, so that `costar validate` without the robot checks it too).
+ParamSpec keptForce(const std::string& description, double value) {
+  ParamSpec spec = number("force", description, value, 1.0, ArmComponent::kMaxContactForce);
+  spec.less_than = "max_force";
+  return spec;
 }
 
 }  // namespace
@@ -233,17 +242,16 @@ void ArmComponent::declareForceOperations(component::ComponentDescription& descr
   component::OperationSpec until_contact{
       "MoveUntilContact",
       "Moves the tool in a direction until it pushes with the force, then keeps pushing with it (a guarded approach).",
-      {direction, number("force", "the force (N) that stops the approach and is kept", 5.0, 1.0, kMaxContactForce),
+      {direction, keptForce("the force (N) that stops the approach and is kept", 5.0),
        number("speed", "how fast the tool approaches (m/s)", 0.01, 0.002, 0.1),
        number("distance", "the farthest it goes looking for contact (m)", 0.15, 0.005, 0.5), max_force}};
-  until_contact.check = forceBelowLimit;
   operations.add(std::move(until_contact), [this](const ParamMap& params) { return moveUntilContact(params); });
   component::OperationSpec press{
       "PressAndFollow",
       "Presses the tool onto the surface with the force along its axis and follows the waypoints, giving way in the "
       "other directions; resumes where it stopped and skips the waypoints already pressed.",
       {path,
-       number("force", "the force (N) the tool presses with, along its axis", 10.0, 1.0, kMaxContactForce),
+       keptForce("the force (N) the tool presses with, along its axis", 10.0),
        number("speed", "how fast the tool follows the path (m/s)", 0.03, 0.005, 0.2),
        number("stiffness", "how firmly the tool holds the path across its axis (N/m)", 2000.0, 100.0,
               CartesianImpedance::kMaxStiffness),
@@ -251,7 +259,6 @@ void ArmComponent::declareForceOperations(component::ComponentDescription& descr
        number("approach", "the tool comes down from this far above the path's start (m)", 0.05, 0.01, 0.2),
        {"resume", ValueType::kBool, "go on where an interrupted PressAndFollow on this path stopped", true},
        {"tare", ValueType::kBool, "zero the force sensor above the path's start before touching", true}}};
-  press.check = forceBelowLimit;
   operations.add(std::move(press), [this](const ParamMap& params) { return pressAndFollow(params); });
   ParamSpec back = number("distance", "how far the tool backs away (m)", 0.05, 0.005, 0.3);
   const ParamSpec speed = number("speed", "how fast the tool backs away (m/s)", 0.05, 0.005, 0.25);

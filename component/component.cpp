@@ -1,5 +1,6 @@
 #include "component/component.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace costar::component {
@@ -11,6 +12,31 @@ const ParamSpec* OperationSpec::param(std::string_view param_name) const {
     }
   }
   return nullptr;
+}
+
+std::string OperationSpec::checkParams(const ParamMap& values) const {
+  for (const ParamSpec& spec : params) {
+    if (spec.less_than.empty()) {
+      continue;
+    }
+    const auto value = values.find(spec.name);
+    const auto bound = values.find(spec.less_than);
+    if (value == values.end() || bound == values.end()) {
+      continue;
+    }
+    if (value->second.asDouble() >= bound->second.asDouble()) {
+      const ParamSpec* bound_spec = param(spec.less_than);
+      return spec.name + " (" + formatValue(value->second) + ") must be below " + spec.less_than + " (" +
+             formatValue(bound->second) + ")" +
+             (bound_spec != nullptr && !bound_spec->description.empty() ? ": " + bound_spec->description : "");
+    }
+  }
+  return check ? check(values) : std::string();
+}
+
+bool OperationSpec::checksAcrossParams() const {
+  return check ||
+         std::any_of(params.begin(), params.end(), [](const ParamSpec& spec) { return !spec.less_than.empty(); });
 }
 
 const OperationSpec* ComponentDescription::operation(std::string_view operation_name) const {

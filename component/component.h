@@ -40,6 +40,11 @@ struct OperationSpec {
   std::function<std::string(const ParamMap& params)> check;
 
   const ParamSpec* param(std::string_view param_name) const;
+  /// The checks across parameters: every `less_than` of its parameters, then `check`. Empty
+  /// when valid, else the first problem.
+  std::string checkParams(const ParamMap& values) const;
+  /// Whether checkParams has anything to check.
+  bool checksAcrossParams() const;
 };
 
 struct SymbolDecl {

@@ -79,6 +79,10 @@ ParamSpec paramSpecFromJson(const nlohmann::json& json) {
     spec.max = field<double>(json, "max");
   }
   spec.choices_from = optionalField<std::string>(json, "choices_from", "");
+  spec.less_than = optionalField<std::string>(json, "less_than", "");
+  if (!spec.less_than.empty() && spec.type != ValueType::kDouble && spec.type != ValueType::kInt) {
+    throw std::invalid_argument("parameter '" + spec.name + "': less_than: only a number is less than another");
+  }
   return spec;
 }
 
@@ -134,6 +138,14 @@ ComponentDescription descriptionFromJson(const nlohmann::json& json) {
                                             : OperationKind::kRobotAction;
       for (const auto& param : optionalField<nlohmann::json>(item, "params", nlohmann::json::array())) {
         operation.params.push_back(paramSpecFromJson(param));
+      }
+      for (const ParamSpec& param : operation.params) {
+        const ParamSpec* bound = param.less_than.empty() ? nullptr : operation.param(param.less_than);
+        if (!param.less_than.empty() &&
+            (bound == nullptr || (bound->type != ValueType::kDouble && bound->type != ValueType::kInt))) {
+          throw std::invalid_argument("operation '" + operation.name + "': parameter '" + param.name +
+                                      "': less_than: '" + param.less_than + "' is not a number of the operation");
+        }
       }
       description.operations.push_back(std::move(operation));
     }

@@ -129,10 +129,10 @@ void ComponentRegistry::registerNodes(bt::NodeRegistry& nodes) {
       for (const ParamSpec& param : operation.params) {
         spec.ports.push_back(portOf(param));
       }
-      if (operation.check) {
+      if (operation.checksAcrossParams()) {
         spec.check_instance = [operation](const bt::NodeArgs& args, std::size_t) -> std::string {
           try {
-            return operation.check(parseParams(operation, args));
+            return operation.checkParams(parseParams(operation, args));
           } catch (const std::invalid_argument&) {
             return {};  // an ill-typed parameter: the port check names it
           }

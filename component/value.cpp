@@ -369,6 +369,9 @@ nlohmann::json toJson(const ParamSpec& spec) {
   if (!spec.excludes.empty()) {
     json["excludes"] = spec.excludes;
   }
+  if (!spec.less_than.empty()) {
+    json["less_than"] = spec.less_than;
+  }
   return json;
 }
 

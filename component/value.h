@@ -82,6 +82,10 @@ struct ParamSpec {
   /// Parameters that cannot be given together with this one: the editor clears them when
   /// this one is set (SmartRelease's target and target_class).
   std::vector<std::string> excludes;
+  /// For numbers: the name of another number of the same operation that this one must stay
+  /// below (PressAndFollow's force below its max_force). Kept in stored descriptions, so that
+  /// every validator checks it (OperationSpec::checkParams).
+  std::string less_than;
   /// Further checks of a written value (e.g. its syntax): empty when valid, else the problem.
   std::function<std::string(std::string_view)> validate;
 

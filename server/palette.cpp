@@ -36,6 +36,9 @@ Palette describePalette(workcell::Workcell& cell) {
         if (!param->excludes.empty()) {
           item["excludes"] = param->excludes;
         }
+        if (!param->less_than.empty()) {
+          item["less_than"] = param->less_than;
+        }
         if (param->min) {
           item["min"] = *param->min;
         }

@@ -392,6 +392,13 @@ for plan in examples/ur5/*.xml cli/test/fixtures/ur5_predicates.xml; do
 done
 same "validate with waypoints as costar-robot does" validate cli/test/fixtures/ur5_predicates.xml \
   --waypoints examples/ur5/blind_waypoints.json
+# A force at or above its max_force: the constraint is in the stored description (less_than).
+same "validate forces against max_force as costar-robot does" validate cli/test/fixtures/force_limits.xml \
+  -w iiwa-3f-sim --waypoints examples/iiwa/polishing_waypoints.json
+check "force at max_force refused" 2 'force_limits.xml:8: .*force \(40\) must be below max_force \(40\)' \
+  -- "$costar" validate cli/test/fixtures/force_limits.xml -w iiwa-3f-sim --waypoints examples/iiwa/polishing_waypoints.json
+check "force above max_force refused" 2 'force_limits.xml:9: .*force \(20\) must be below max_force \(15\)' \
+  -- "$costar" validate cli/test/fixtures/force_limits.xml -w iiwa-3f-sim --waypoints examples/iiwa/polishing_waypoints.json
 same "nodes model as costar-robot writes it" nodes --waypoints "$tmp/none.json"
 same "nodes json as costar-robot writes it" nodes --format json --waypoints "$tmp/none.json"
 check "predicate problems named" 2 'ur5_predicates.xml:11: .*unknown reference frame .node_1.' \

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "bt/builder.h"
+#include "bt/plan_xml.h"
 #include "component/registry.h"
 #include "testing/test_components.h"
 
@@ -70,6 +72,60 @@ TEST(ComponentDescriptionJson, NamesWhatIsWrong) {
   EXPECT_THROW(descriptionFromJson(json), std::invalid_argument);
   json = toJson(richDescription());
   json["operations"][0]["params"][0]["default"] = "fast";
+  EXPECT_THROW(descriptionFromJson(json), std::invalid_argument);
+}
+
+// `costar validate` without the robot refused nothing of a force at or above max_force: the
+// check lived in code (OperationSpec::check), not in the stored description.
+TEST(DescribedComponent, ANumberAboveTheOneItMustStayBelowIsRefusedFromTheStoredDescription) {
+  ParamSpec force{"force", ValueType::kDouble, "pushes with (N)", 10.0};
+  force.less_than = "max_force";
+  const ParamSpec max_force{"max_force", ValueType::kDouble, "a force above this (N) stops the arm", 40.0};
+  ComponentDescription description;
+  description.name = "arm";
+  description.type = "Arm";
+  description.operations = {{"Press", "Presses.", {force, max_force}}};
+  const nlohmann::json json = toJson(description);
+  EXPECT_EQ(json["operations"][0]["params"][0]["less_than"], "max_force");
+  ComponentRegistry registry;
+  registry.add(std::make_shared<DescribedComponent>(descriptionFromJson(json)));
+  bt::NodeRegistry nodes;
+  registry.registerNodes(nodes);
+  const auto diagnostics = [&nodes](const std::string& attributes) {
+    const bt::Plan plan = bt::loadPlanText(
+        R"(<root BTCPP_format="4"><BehaviorTree ID="main"><Press )" + attributes + "/></BehaviorTree></root>", "p.xml");
+    std::string all;
+    for (const auto& diagnostic : bt::validatePlan(plan, nodes)) {
+      all += diagnostic.message + "\n";
+    }
+    return all;
+  };
+  EXPECT_EQ(diagnostics(R"(force="39.5")"), "");
+  EXPECT_NE(diagnostics(R"(force="40")")
+                .find("force (40) must be below max_force (40): a force above this (N) stops "
+                      "the arm"),
+            std::string::npos)
+      << diagnostics(R"(force="40")");
+  EXPECT_NE(diagnostics(R"(force="20" max_force="15")").find("must be below max_force (15)"), std::string::npos);
+}
+
+TEST(ComponentDescriptionJson, ALessThanNamingNoNumberOfTheOperationIsRefused) {
+  ParamSpec force{"force", ValueType::kDouble, "N", 10.0};
+  force.less_than = "max_force";
+  ComponentDescription description;
+  description.name = "arm";
+  description.type = "Arm";
+  description.operations = {{"Press", "Presses.", {force}}};
+  try {
+    descriptionFromJson(toJson(description));
+    FAIL() << "accepted a less_than naming no parameter";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("parameter 'force': less_than: 'max_force' is not a number of the operation"),
+              std::string::npos)
+        << e.what();
+  }
+  nlohmann::json json = toJson(richDescription());
+  json["operations"][0]["params"][1]["less_than"] = "speed";  // a string parameter
   EXPECT_THROW(descriptionFromJson(json), std::invalid_argument);
 }
 
