@@ -108,7 +108,8 @@ Verdict blindPlace(sim::Simulation& simulation, const std::vector<sim::PartState
 
 constexpr double kPolishForce = kPolishingForce;
 constexpr double kPolishBand = kPolishingBand;
-constexpr double kTouching = 0.5;  // N: the pad touches the workpiece
+constexpr double kTouching = 0.5;          // N: the pad touches the workpiece
+constexpr double kResumeTolerance = 0.02;  // m: polishing resumes this near where it stopped
 
 std::string percent(double fraction) {
   char text[32];
@@ -133,16 +134,44 @@ Verdict polishing(sim::Simulation& simulation, const std::vector<sim::PartState>
     }
   }
   const double band = touching > 0 ? static_cast<double>(in_band) / touching : 0.0;
-  // Each time the tool left the gripper without being put on its stand: off and the arm still
-  // within 1 s, and, if it was polishing, polishing again later near where it stopped.
-  int losses = 0;
-  double slowest_stop = 0.0;
-  double farthest_resume = 0.0;
+  const ToolLosses losses = toolLosses(log);
+  if (!losses.problem.empty()) {
+    return {false, losses.problem};
+  }
+  char summary[320];
+  std::snprintf(summary, sizeof summary,
+                "coverage %s, force within %.0f +/- %.0f N %s of %.1f s touching, %d loss(es) of the tool: off and "
+                "still after %.2f s at most, resumed %.0f mm from where it stopped at most, arm on the workpiece %llu "
+                "steps",
+                percent(coverage).c_str(), kPolishForce, kPolishBand, percent(band).c_str(), touching * 0.01,
+                losses.count, losses.slowest_stop, losses.farthest_resume * 1000.0,
+                static_cast<unsigned long long>(tool->armWorkpieceSteps()));
+  std::string problem;
+  if (coverage < 0.95) {
+    problem = "coverage " + percent(coverage) + " is below 95 %";
+  } else if (band < 0.90) {
+    problem = "the pad's force was within " + std::to_string(static_cast<int>(kPolishForce)) + " +/- " +
+              std::to_string(static_cast<int>(kPolishBand)) + " N only " + percent(band) + " of the time it touched";
+  } else if (tool->armWorkpieceSteps() > 0) {
+    problem = "the arm touched the workpiece";
+  } else if (!log.empty() && log.back().powered) {
+    problem = "the tool was still on at the end";
+  }
+  if (!problem.empty()) {
+    return {false, problem + " (" + summary + ")"};
+  }
+  return {true, summary};
+}
+
+}  // namespace
+
+ToolLosses toolLosses(const std::vector<sim::PowerToolSample>& log) {
+  ToolLosses losses;
   for (std::size_t i = 1; i < log.size(); ++i) {
     if (!(log[i - 1].held && !log[i].held && log[i].away)) {
       continue;
     }
-    ++losses;
+    ++losses.count;
     const double lost_at = log[i].time;
     std::optional<double> stopped;
     for (std::size_t k = i; k < log.size() && log[k].time <= lost_at + 1.0 + 1e-9; ++k) {
@@ -152,10 +181,14 @@ Verdict polishing(sim::Simulation& simulation, const std::vector<sim::PartState>
       }
     }
     if (!stopped) {
-      return {false, "the tool was taken out of the gripper at " + std::to_string(lost_at).substr(0, 6) +
-                         " s, and 1 s later it was still on or the arm still moving"};
+      losses.problem = "the tool was taken out of the gripper at " + std::to_string(lost_at).substr(0, 6) +
+                       " s, and 1 s later it was still on or the arm still moving";
+      return losses;
     }
-    slowest_stop = std::max(slowest_stop, *stopped);
+    losses.slowest_stop = std::max(losses.slowest_stop, *stopped);
+    if (!log[i - 1].powered) {
+      continue;  // off when it was taken: the plan had stopped polishing (its passes done, ToolOff)
+    }
     std::optional<Eigen::Vector2d> last_worked;
     for (std::size_t k = i; k-- > 0 && log[k].time >= lost_at - 0.5;) {
       if (log[k].working) {
@@ -169,38 +202,26 @@ Verdict polishing(sim::Simulation& simulation, const std::vector<sim::PartState>
     const auto resumed = std::find_if(log.begin() + static_cast<std::ptrdiff_t>(i), log.end(),
                                       [](const sim::PowerToolSample& sample) { return sample.working; });
     if (resumed == log.end()) {
-      return {false, "polishing stopped when the tool was taken at " + std::to_string(lost_at).substr(0, 6) +
-                         " s and never resumed"};
+      losses.problem = "polishing stopped when the tool was taken at " + std::to_string(lost_at).substr(0, 6) +
+                       " s and never resumed";
+      return losses;
     }
-    farthest_resume = std::max(farthest_resume, (resumed->pad - *last_worked).norm());
+    const double distance = (resumed->pad - *last_worked).norm();
+    // Away from where it stopped: right when the pass it was on was done and the next one starts
+    // on ground not polished before the loss; wrong when it goes back over that ground.
+    const bool over_polished =
+        std::any_of(log.begin(), log.begin() + static_cast<std::ptrdiff_t>(i), [&](const sim::PowerToolSample& sample) {
+          return sample.working && (sample.pad - resumed->pad).norm() <= kResumeTolerance;
+        });
+    losses.farthest_resume = std::max(losses.farthest_resume, distance);
+    if (distance > kResumeTolerance && over_polished) {
+      losses.problem = "polishing resumed " + millimetres(distance) +
+                       " from where it stopped (more than 20 mm), over ground it had polished";
+      return losses;
+    }
   }
-  char summary[320];
-  std::snprintf(summary, sizeof summary,
-                "coverage %s, force within %.0f +/- %.0f N %s of %.1f s touching, %d loss(es) of the tool: off and "
-                "still after %.2f s at most, resumed %.0f mm from where it stopped at most, arm on the workpiece %llu "
-                "steps",
-                percent(coverage).c_str(), kPolishForce, kPolishBand, percent(band).c_str(), touching * 0.01, losses,
-                slowest_stop, farthest_resume * 1000.0, static_cast<unsigned long long>(tool->armWorkpieceSteps()));
-  std::string problem;
-  if (coverage < 0.95) {
-    problem = "coverage " + percent(coverage) + " is below 95 %";
-  } else if (band < 0.90) {
-    problem = "the pad's force was within " + std::to_string(static_cast<int>(kPolishForce)) + " +/- " +
-              std::to_string(static_cast<int>(kPolishBand)) + " N only " + percent(band) + " of the time it touched";
-  } else if (farthest_resume > 0.02) {
-    problem = "polishing resumed " + millimetres(farthest_resume) + " from where it stopped (more than 20 mm)";
-  } else if (tool->armWorkpieceSteps() > 0) {
-    problem = "the arm touched the workpiece";
-  } else if (!log.empty() && log.back().powered) {
-    problem = "the tool was still on at the end";
-  }
-  if (!problem.empty()) {
-    return {false, problem + " (" + summary + ")"};
-  }
-  return {true, summary};
+  return losses;
 }
-
-}  // namespace
 
 std::vector<JudgeInfo> judges() {
   return {{"lift", "task 1: a node is held 5 cm above the table"},

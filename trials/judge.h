@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/power_tool.h"
 #include "sim/simulation.h"
 
 namespace costar::trials {
@@ -34,9 +35,20 @@ struct JudgeInfo {
 ///   (sim/power_tool.h): >= 95 % of the marked area worked; the pad's force within 10 +/- 4 N for
 ///   >= 90 % of the time it touches the workpiece; each time the tool is taken out of the gripper,
 ///   the tool off and the arm still (joints < 0.02 rad/s) within 1 s, and polishing, if it was
-///   under way, resumed within 20 mm of where it stopped; the arm never on the workpiece; the tool
-///   off at the end.
+///   under way, resumed within 20 mm of where it stopped (or, its pass done, on ground it had not
+///   polished yet: the next pass's start); the arm never on the workpiece; the tool off at the end.
 std::vector<JudgeInfo> judges();
+
+/// What the polishing judge finds of the tool's losses in the power tool's 100 Hz log: each time
+/// the tool left the gripper without being put on its stand.
+struct ToolLosses {
+  int count = 0;
+  double slowest_stop = 0.0;     // s from a loss until the tool was off and the arm still
+  double farthest_resume = 0.0;  // m from where polishing stopped to where it resumed (the next
+                                 // pass's start when the pass it was on was done)
+  std::string problem;           // empty when every loss was handled
+};
+ToolLosses toolLosses(const std::vector<sim::PowerToolSample>& log);
 /// The polishing judge's force and band (N): the plan presses with 10 N.
 inline constexpr double kPolishingForce = 10.0;
 inline constexpr double kPolishingBand = 4.0;

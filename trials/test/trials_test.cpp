@@ -194,6 +194,62 @@ TEST(Trials, ThePolishingPicturesAreWrittenChecked) {
   std::filesystem::remove_all(folder);
 }
 
+// The power tool's log of a polishing trial: a pass along y = 0 from x = -4 to +4 cm, the tool
+// taken at 2 s (`powered`: running then, else switched off after the pass), given back, and
+// polishing again from `resume`.
+std::vector<sim::PowerToolSample> polishingLog(bool powered, const Eigen::Vector2d& resume, double arm_speed = 0.0) {
+  std::vector<sim::PowerToolSample> log;
+  const auto add = [&log](double time, bool held, bool on, bool working, const Eigen::Vector2d& pad) {
+    sim::PowerToolSample sample;
+    sample.time = time;
+    sample.held = held;
+    sample.away = !held;
+    sample.powered = on;
+    sample.working = working;
+    sample.pad = pad;
+    sample.pad_force = working ? 10.0 : 0.0;
+    log.push_back(sample);
+  };
+  for (int k = 0; k <= 160; ++k) {
+    add(0.01 * k, true, true, true, Eigen::Vector2d(-0.04 + 0.0005 * k, 0.0));
+  }
+  for (int k = 161; k < 200; ++k) {
+    add(0.01 * k, true, powered, powered, Eigen::Vector2d(0.04, 0.0));
+  }
+  for (int k = 200; k < 400; ++k) {  // taken: switched off at once
+    add(0.01 * k, false, false, false, Eigen::Vector2d(0.04, 0.0));
+    log.back().arm_speed = arm_speed;
+  }
+  for (int k = 400; k < 500; ++k) {  // back in the gripper, polishing again
+    add(0.01 * k, true, true, k >= 450, resume);
+  }
+  return log;
+}
+
+// The judge wanted polishing to resume after a tool taken once the passes were done and the
+// tool switched off ("never resumed"), and within 20 mm of where it stopped when the pass it was
+// on had ended and the next one starts 3 cm away.
+TEST(PolishingJudge, PolishingResumesWhereItStoppedOrAtTheNextPassAndNeedNotWhenTheToolWasOff) {
+  const ToolLosses off = toolLosses(polishingLog(false, Eigen::Vector2d(0.04, 0.0)));
+  EXPECT_EQ(off.count, 1);
+  EXPECT_EQ(off.problem, "");
+  std::vector<sim::PowerToolSample> never = polishingLog(true, Eigen::Vector2d(0.04, 0.0));
+  for (auto& sample : never) {
+    sample.working = sample.working && sample.time < 2.0;
+  }
+  EXPECT_EQ(toolLosses(never).problem, "polishing stopped when the tool was taken at 2.0000 s and never resumed");
+  const ToolLosses next_pass = toolLosses(polishingLog(true, Eigen::Vector2d(0.04, 0.03)));
+  EXPECT_EQ(next_pass.problem, "");
+  EXPECT_NEAR(next_pass.farthest_resume, 0.03, 1e-9);
+  const ToolLosses there = toolLosses(polishingLog(true, Eigen::Vector2d(0.035, 0.0)));
+  EXPECT_EQ(there.problem, "");
+  EXPECT_NEAR(there.farthest_resume, 0.005, 1e-9);
+  EXPECT_EQ(toolLosses(polishingLog(true, Eigen::Vector2d(-0.04, 0.0))).problem,
+            "polishing resumed 80 mm from where it stopped (more than 20 mm), over ground it had polished");
+  EXPECT_EQ(toolLosses(polishingLog(true, Eigen::Vector2d(0.04, 0.0), 0.05)).problem,
+            "the tool was taken out of the gripper at 2.0000 s, and 1 s later it was still on or the arm still moving");
+}
+
 TEST(Trials, ShardsRunTheirSliceAndMergeIntoTheWholeBatch) {
   TrialOptions options = blind(3, "blind_place");
   options.jobs = 1;
