@@ -20,6 +20,7 @@
 #include "perception/training_data.h"
 #include "trials/perception_collect.h"
 #include "trials/perception_eval.h"
+#include "workcell/sim_cell_description.h"
 #include "world/pose.h"
 
 namespace costar::cli {
@@ -69,9 +70,14 @@ int collect(const trials::CollectOptions& options) {
       } else if (progress.step == 2) {
         std::printf("collect: 2. positive examples: %d scenes per class, %d parts each, well apart\n",
                     options.scenes_per_class, options.parts_per_scene);
+      } else if (progress.step == 3) {
+        std::printf("collect: 3. negative examples: %s's robot and gripper over the table (%d), clutter (%d), table\n",
+                    options.workcell.c_str(), options.arm_scenes, options.clutter_scenes);
       } else {
-        std::printf("collect: 3. negative examples: robot and gripper over the table (%d), clutter (%d), table\n",
-                    options.arm_scenes, options.clutter_scenes);
+        std::printf(
+            "collect: 4. mixed scenes (%d): parts touching and stacked, the robot over them, labelled point by point "
+            "from the simulator's truth\n",
+            options.mixed_scenes);
       }
       std::fflush(stdout);
     });
@@ -85,7 +91,8 @@ int collect(const trials::CollectOptions& options) {
     for (const auto& [label, name] : result.names) {
       std::printf("   %-10s (label %d): %6ld voxels\n", name.c_str(), label, result.voxels.at(label));
     }
-    std::printf("next: costar perception train --dataset %s\n", result.dataset.string().c_str());
+    std::printf("next: costar perception train -w %s --dataset %s\n", options.workcell.c_str(),
+                result.dataset.string().c_str());
     return kExitSuccess;
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -99,12 +106,31 @@ int collect(const trials::CollectOptions& options) {
 struct TrainOptions {
   std::string dataset = "perception_dataset";
   std::string out;
+  std::string workcell;
   perception::SvmTrainingOptions svm;
 };
 
+/// Where a trained model goes: --out, else the cell's perception_model, else the default model.
+fs::path modelFile(const TrainOptions& options) {
+  if (!options.out.empty()) {
+    return options.out;
+  }
+  if (options.workcell.empty()) {
+    return perception::PipelineFiles::under().svm_file;
+  }
+  const workcell::SimCellDescription cell = workcell::loadSimCellDescription(workcell::simCellFile(options.workcell));
+  if (cell.perception_model.empty()) {
+    throw std::runtime_error("workcell description '" + cell.file.string() +
+                             "': perception_model: absent; name the file the cell's model goes to (e.g. "
+                             "\"data/perception/svm/" +
+                             cell.name + ".json\") or pass --out");
+  }
+  return cell.perception_model;
+}
+
 int train(const TrainOptions& options) {
   try {
-    const fs::path out = options.out.empty() ? perception::PipelineFiles::under().svm_file : fs::path(options.out);
+    const fs::path out = modelFile(options);
     checkOutputFile(out, "--out");  // before the training's minutes
     const perception::TrainingSet dataset = perception::loadTrainingSet(options.dataset);
     std::printf("train: %zu examples from %s\n", dataset.labels.size(), options.dataset.c_str());
@@ -123,6 +149,13 @@ int train(const TrainOptions& options) {
         std::printf("   %-10s %5d  %6.2f %%\n", entry.name.c_str(), entry.examples, 100.0 * entry.accuracy());
       }
       std::printf("   %-10s        %6.2f %%\n", "overall", 100.0 * report.overall_accuracy);
+    }
+    if (report.held_out_accuracy > 0.0) {
+      std::printf("held-out accuracy (examples not trained on, classified by the final model):\n");
+      for (const auto& [label, entry] : report.labels) {
+        std::printf("   %-10s %5d  %6.2f %%\n", entry.name.c_str(), entry.held_out, 100.0 * entry.heldOutAccuracy());
+      }
+      std::printf("   %-10s        %6.2f %%\n", "overall", 100.0 * report.held_out_accuracy);
     }
     std::printf("train: wrote %s\n", out.string().c_str());
     return kExitSuccess;
@@ -149,8 +182,10 @@ int evaluate(const EvalOptions& options) {
       checkOutputFile(options.json, "--json");
     }
     std::printf(
-        "eval: %d random cluttered scene(s), seed %llu, %d frames per DetectObjects, %d repeat(s), %d push(es)\n",
-        eval.scenes, static_cast<unsigned long long>(eval.seed), eval.frames, eval.repeats, eval.pushes);
+        "eval on %s: %d random cluttered scene(s), seed %llu, %d frames per DetectObjects, %d repeat(s), %d "
+        "push(es)\n",
+        eval.workcell.c_str(), eval.scenes, static_cast<unsigned long long>(eval.seed), eval.frames, eval.repeats,
+        eval.pushes);
     const trials::PerceptionEvalSummary summary =
         trials::evaluatePerception(eval, [&eval](const trials::SceneReport& scene) {
           std::printf(
@@ -189,6 +224,7 @@ int evaluate(const EvalOptions& options) {
 
 struct DetectOptions {
   std::string scene;
+  std::string workcell = "ur5-sim";
   std::optional<std::uint64_t> seed;
   std::string out;
   int frames = 15;
@@ -201,7 +237,8 @@ int detectScene(const DetectOptions& options) {
     if (!options.out.empty()) {
       checkOutputFile(options.out, "--out");
     }
-    const trials::SceneDetection found = trials::detectInScene(options.scene, options.seed, options.frames);
+    const trials::SceneDetection found =
+        trials::detectInScene(options.scene, options.seed, options.frames, options.workcell);
     const trials::Match& match = found.match;
     std::printf("DetectObjects on %s: %zu object(s) in %.1f ms (%d frames; capture not included)\n",
                 options.scene.c_str(), found.detected.size(), found.milliseconds, options.frames);
@@ -287,6 +324,16 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
                    "placements of clutter objects (negative examples)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));
+  collect_command
+      ->add_option("--mixed-scenes", collect_options->mixed_scenes,
+                   "placements of parts touching and stacked with the robot over them, labelled point by point from "
+                   "the simulator's truth")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
+  collect_command
+      ->add_option("-w,--workcell", collect_options->workcell,
+                   "simulated workcell whose robot, gripper and camera are posed (workcells/NAME.json)")
+      ->capture_default_str();
   collect_command->add_option("--frames", collect_options->frames, "frames per placement (median filter)")
       ->capture_default_str()
       ->check(CLI::Range(1, 60));
@@ -299,11 +346,14 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
   CLI::App* train_command = perception->add_subcommand(
       "train",
       "Train the SVM (libsvm, RBF kernel) on collected examples, report the cross-validated accuracy per class, and "
-      "write the model (default: data/perception/svm_model.json, which DetectObjects loads). Deterministic for a "
-      "seed.");
+      "write the model (with -w: the cell's, which DetectObjects in that cell loads). Deterministic for a seed.");
   train_command->add_option("--dataset", train_options->dataset, "folder written by `costar perception collect`")
       ->capture_default_str();
-  train_command->add_option("-o,--out", train_options->out, "model file (default: data/perception/svm_model.json)");
+  train_command->add_option("-o,--out", train_options->out,
+                            "model file (default: the cell's perception_model with -w, else "
+                            "data/perception/svm/ur5-sim.json)");
+  train_command->add_option("-w,--workcell", train_options->workcell,
+                            "write the model the cell names (workcells/NAME.json's perception_model)");
   train_command->add_option("--cost", train_options->svm.cost, "SVM soft-margin cost C")
       ->check(numberIn(0.0, 1e9, true))
       ->capture_default_str();
@@ -316,10 +366,49 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
       ->add_option("--max-per-label", train_options->svm.max_per_label,
                    "examples per label used (random subset; 0: all)")
       ->capture_default_str();
+  train_command
+      ->add_option("--held-out", train_options->svm.held_out_per_label,
+                   "examples per label not trained on that the model classifies afterwards (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 10000000));
   train_command->add_option("--seed", train_options->svm.seed, "seed of the subset and the folds")
       ->check(wholeNumber<unsigned>())
       ->capture_default_str();
   train_command->callback([train_options, &exit_code] { exit_code = train(*train_options); });
+
+  // retrain: collect, then train, for one cell.
+  auto retrain_collect = std::make_shared<trials::CollectOptions>();
+  auto retrain_train = std::make_shared<TrainOptions>();
+  CLI::App* retrain_command = perception->add_subcommand(
+      "retrain",
+      "Collect training data in a simulated cell with its own robot and gripper, then train and write the cell's "
+      "model (workcells/NAME.json's perception_model): `collect -w NAME` and `train -w NAME` in one command, with "
+      "their defaults.");
+  retrain_command->add_option("-w,--workcell", retrain_collect->workcell, "simulated workcell")->required();
+  retrain_command->add_option("--dataset", retrain_collect->out,
+                              "folder for the examples (default: perception_dataset_NAME)");
+  retrain_command->add_option("--seed", retrain_collect->seed, "seed of the placements and sensor noise")
+      ->check(wholeNumber())
+      ->capture_default_str();
+  retrain_command->callback([retrain_collect, retrain_train, &exit_code] {
+    if (retrain_collect->out == trials::CollectOptions{}.out) {
+      retrain_collect->out = "perception_dataset_" + retrain_collect->workcell;
+    }
+    retrain_collect->workspace_file = retrain_collect->out / "workspace.json";
+    retrain_train->workcell = retrain_collect->workcell;
+    retrain_train->dataset = retrain_collect->out.string();
+    try {
+      checkOutputFile(modelFile(*retrain_train), "the cell's perception_model");  // before the minutes
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      exit_code = kExitError;
+      return;
+    }
+    exit_code = collect(*retrain_collect);
+    if (exit_code == kExitSuccess) {
+      exit_code = train(*retrain_train);
+    }
+  });
 
   auto eval_options = std::make_shared<EvalOptions>();
   CLI::App* eval_command = perception->add_subcommand(
@@ -357,6 +446,24 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
   eval_command->add_option("--touching", eval_options->eval.touching, "chance that a part is placed against another")
       ->capture_default_str()
       ->check(numberIn(0.0, 1.0));
+  eval_command->add_option("--stacked", eval_options->eval.stacked, "links put across nodes per scene")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 6));
+  eval_command
+      ->add_option("--arm-over", eval_options->eval.arm_over,
+                   "chance that a scene has the cell's arm posed over the parts (hiding some; none may be detected on "
+                   "it)")
+      ->capture_default_str()
+      ->check(numberIn(0.0, 1.0));
+  eval_command
+      ->add_option("-w,--workcell", eval_options->eval.workcell,
+                   "simulated workcell: its robot, gripper, camera and perception model (workcells/NAME.json)")
+      ->capture_default_str();
+  eval_command
+      ->add_option(
+          "--model", eval_options->eval.model,
+          "SVM model file to use instead of the cell's perception_model (to compare models on the same scenes)")
+      ->check(CLI::ExistingFile);
   eval_command
       ->add_option("--min-found", eval_options->min_found,
                    "fail (exit 1) when fewer of the visible parts are found within 5 mm and 5 deg (0..1)")
@@ -374,6 +481,10 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
   detect_command->add_option("--seed", detect_options->seed, "seed of the part placement and the sensor noise")
       ->check(wholeNumber());
   detect_command->add_option("--out", detect_options->out, "write the picture to this PNG file");
+  detect_command
+      ->add_option("-w,--workcell", detect_options->workcell,
+                   "simulated workcell: its robot, gripper, camera and perception model (workcells/NAME.json)")
+      ->capture_default_str();
   detect_command->add_option("--frames", detect_options->frames, "frames per DetectObjects (median filter's N)")
       ->capture_default_str()
       ->check(CLI::Range(1, 60));

@@ -1,5 +1,7 @@
 #include <algorithm>
+#include <cmath>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 
 #include "perception/pose_estimation.h"
@@ -43,6 +45,65 @@ std::vector<Detection> mergeDetections(std::vector<Detection> detections, const 
 
 std::vector<Detection> mergeDetections(std::vector<Detection> detections, const ObjectModel& model) {
   return mergeBy(std::move(detections), [&model](const std::string&) -> const ObjectModel& { return model; });
+}
+
+std::vector<Detection> keepSupported(const std::vector<Detection>& detections, const std::vector<ObjectModel>& models,
+                                     const TablePlane& table, double tolerance) {
+  struct Extent {
+    double low = 0.0, high = 0.0;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // the origin projected onto the table
+    double radius = 0.0;                               // of the footprint about it
+  };
+  std::vector<Extent> extents;
+  for (const Detection& detection : detections) {
+    const auto model = std::find_if(models.begin(), models.end(),
+                                    [&detection](const ObjectModel& m) { return m.name() == detection.object_class; });
+    if (model == models.end()) {
+      throw std::invalid_argument("keepSupported: no model of class '" + detection.object_class + "'");
+    }
+    Extent extent;
+    const Eigen::Vector3d origin = detection.pose_in_camera.translation();
+    extent.centre = origin - table.normal * (table.normal.dot(origin) + table.offset);
+    extent.low = std::numeric_limits<double>::infinity();
+    extent.high = -std::numeric_limits<double>::infinity();
+    for (const world::Box& box : model->object_class.boxes) {
+      for (int corner = 0; corner < 8; ++corner) {
+        const Eigen::Vector3d local(box.center.x() + ((corner & 1) ? 1 : -1) * box.half_size.x(),
+                                    box.center.y() + ((corner & 2) ? 1 : -1) * box.half_size.y(),
+                                    box.center.z() + ((corner & 4) ? 1 : -1) * box.half_size.z());
+        const Eigen::Vector3d point = detection.pose_in_camera * local;
+        const double height = table.normal.dot(point) + table.offset;
+        extent.low = std::min(extent.low, height);
+        extent.high = std::max(extent.high, height);
+        const Eigen::Vector3d on_table = point - table.normal * height;
+        extent.radius = std::max(extent.radius, (on_table - extent.centre).norm());
+      }
+    }
+    extents.push_back(extent);
+  }
+  std::vector<bool> kept(detections.size(), false);
+  for (std::size_t d = 0; d < detections.size(); ++d) {
+    kept[d] = extents[d].low <= tolerance;
+  }
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::size_t d = 0; d < detections.size(); ++d) {
+      for (std::size_t e = 0; e < detections.size() && !kept[d]; ++e) {
+        if (kept[e] && e != d && std::abs(extents[d].low - extents[e].high) <= tolerance &&
+            (extents[d].centre - extents[e].centre).norm() < extents[d].radius + extents[e].radius) {
+          kept[d] = true;
+          changed = true;
+        }
+      }
+    }
+  }
+  std::vector<Detection> out;
+  for (std::size_t d = 0; d < detections.size(); ++d) {
+    if (kept[d]) {
+      out.push_back(detections[d]);
+    }
+  }
+  return out;
 }
 
 }  // namespace costar::perception

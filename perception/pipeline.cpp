@@ -41,7 +41,7 @@ double since(std::chrono::steady_clock::time_point start) {
 PipelineFiles PipelineFiles::under(const std::filesystem::path& root) {
   const std::filesystem::path base = root.empty() ? dataRoot() : root;
   return {base / "data" / "objects", base / "data" / "perception" / "classes.json",
-          base / "data" / "perception" / "svm_model.json", base / "data" / "perception" / "workspace.json"};
+          base / "data" / "perception" / "svm" / "ur5-sim.json", base / "data" / "perception" / "workspace.json"};
 }
 
 void measureColors(const std::vector<ObjectModel>& models, const std::vector<Cloud>& class_points,
@@ -328,6 +328,7 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
   }
   result.pose_clusters = static_cast<int>(tasks.size());
   found = mergeDetections(std::move(found), models_);
+  found = keepSupported(found, models_, workspace.plane, options_.support_tolerance);
   // Class order, then best first.
   std::stable_sort(found.begin(), found.end(), [this](const Detection& a, const Detection& b) {
     const auto index = [this](const std::string& name) {

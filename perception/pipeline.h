@@ -32,7 +32,8 @@ struct PipelineFiles {
   std::filesystem::path objects_dir;
   /// Per-class perception parameters (data/perception/classes.json).
   std::filesystem::path classes_file;
-  /// The trained SVM (data/perception/svm_model.json).
+  /// The trained SVM: the default is the UR5 cell's (data/perception/svm/ur5-sim.json); a
+  /// simulated cell names its own (workcells/NAME.json "perception_model").
   std::filesystem::path svm_file;
   /// The workspace centre found by `costar perception collect` (data/perception/workspace.json).
   std::filesystem::path workspace_file;
@@ -51,6 +52,9 @@ struct PipelineOptions {
   /// A detection's colour is the mean of its class's points within this distance of its
   /// boxes (m).
   double color_margin = 0.004;
+  /// A detection is kept only when it rests on the table or on another detection, within this
+  /// (m; keepSupported in pose_estimation.h): boxes on the robot's arm and gripper are not parts.
+  double support_tolerance = 0.01;
   /// Worker threads of the median filter, the FPFH histograms and the pose estimation
   /// (results do not depend on it; it sets segmentation.features.threads).
   int threads = 2;

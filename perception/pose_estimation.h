@@ -195,4 +195,13 @@ std::vector<Detection> mergeDetections(std::vector<Detection> detections, const 
 /// The same for detections of one class, of `model`.
 std::vector<Detection> mergeDetections(std::vector<Detection> detections, const ObjectModel& model);
 
+/// Only detections that rest on something: a part lies on the table or on another part, while a
+/// box the robot's arm or gripper shows can be matched anywhere above it. A detection is kept
+/// when its lowest box corner lies within `tolerance` (m) of `table` (heights in the detections'
+/// optical frame), or of the highest corner of a kept detection whose footprint on the table
+/// meets its own (a link across a node), repeated until nothing more is kept. `models` must hold
+/// every detection's class; the order of the kept ones is kept.
+std::vector<Detection> keepSupported(const std::vector<Detection>& detections, const std::vector<ObjectModel>& models,
+                                     const TablePlane& table, double tolerance);
+
 }  // namespace costar::perception

@@ -158,10 +158,15 @@ SvmClassifier SvmClassifier::train(const Eigen::MatrixXf& features, const std::v
   // Balanced subsample, in a fixed order.
   std::mt19937 random(options.seed);
   std::vector<int> chosen;
+  std::map<int, std::vector<int>> held_out_of;  // per label, examples not trained on
   for (auto& [label, rows] : rows_of) {
     std::shuffle(rows.begin(), rows.end(), random);
     if (options.max_per_label > 0 && static_cast<int>(rows.size()) > options.max_per_label) {
-      rows.resize(static_cast<std::size_t>(options.max_per_label));
+      const std::size_t keep = static_cast<std::size_t>(options.max_per_label);
+      const std::size_t held = std::min(rows.size() - keep, static_cast<std::size_t>(options.held_out_per_label));
+      held_out_of[label].assign(rows.begin() + static_cast<std::ptrdiff_t>(keep),
+                                rows.begin() + static_cast<std::ptrdiff_t>(keep + held));
+      rows.resize(keep);
     }
     std::sort(rows.begin(), rows.end());
     chosen.insert(chosen.end(), rows.begin(), rows.end());
@@ -282,12 +287,31 @@ SvmClassifier SvmClassifier::train(const Eigen::MatrixXf& features, const std::v
   }
   svm_free_and_destroy_model(&model);
   local.support_vectors = total;
+  classifier.prepareKernel();
+  int held_total = 0;
+  int held_correct = 0;
+  for (const auto& [label, held] : held_out_of) {
+    if (held.empty()) {
+      continue;
+    }
+    say("classifying " + std::to_string(held.size()) + " held-out " + names.at(label) + " examples");
+    Eigen::MatrixXf rows_held(static_cast<Eigen::Index>(held.size()), dims);
+    for (std::size_t i = 0; i < held.size(); ++i) {
+      rows_held.row(static_cast<Eigen::Index>(i)) = features.row(held[i]);
+    }
+    const std::vector<int> predicted = classifier.predict(rows_held);
+    auto& entry = local.labels[label];
+    entry.held_out = static_cast<int>(held.size());
+    entry.held_out_correct = static_cast<int>(std::count(predicted.begin(), predicted.end(), label));
+    held_total += entry.held_out;
+    held_correct += entry.held_out_correct;
+  }
+  local.held_out_accuracy = held_total == 0 ? 0.0 : static_cast<double>(held_correct) / held_total;
   local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   classifier.report_ = local;
   if (report != nullptr) {
     *report = local;
   }
-  classifier.prepareKernel();
   return classifier;
 }
 
@@ -431,11 +455,15 @@ void SvmClassifier::save(const std::filesystem::path& file) const {
   json["coefficients"] = matrixToJson(coefficients_);
   nlohmann::json training;
   training["overall_accuracy"] = report_.overall_accuracy;
+  training["held_out_accuracy"] = report_.held_out_accuracy;
   training["folds"] = report_.folds;
   training["support_vectors"] = report_.support_vectors;
   for (const auto& [label, entry] : report_.labels) {
-    training["labels"][std::to_string(label)] = {
-        {"name", entry.name}, {"examples", entry.examples}, {"cross_validated_accuracy", entry.accuracy()}};
+    training["labels"][std::to_string(label)] = {{"name", entry.name},
+                                                 {"examples", entry.examples},
+                                                 {"cross_validated_accuracy", entry.accuracy()},
+                                                 {"held_out_examples", entry.held_out},
+                                                 {"held_out_accuracy", entry.heldOutAccuracy()}};
   }
   json["training"] = training;
   writeOutputFile(file, json.dump() + "\n");
@@ -480,6 +508,7 @@ SvmClassifier SvmClassifier::load(const std::filesystem::path& file) {
     if (json.contains("training")) {
       const auto& training = json.at("training");
       classifier.report_.overall_accuracy = training.value("overall_accuracy", 0.0);
+      classifier.report_.held_out_accuracy = training.value("held_out_accuracy", 0.0);
       classifier.report_.folds = training.value("folds", 0);
       classifier.report_.support_vectors = training.value("support_vectors", 0);
       const nlohmann::json per_label = training.value("labels", nlohmann::json::object());
@@ -488,6 +517,8 @@ SvmClassifier SvmClassifier::load(const std::filesystem::path& file) {
         out.name = entry.value("name", "");
         out.examples = entry.value("examples", 0);
         out.correct = static_cast<int>(std::lround(entry.value("cross_validated_accuracy", 0.0) * out.examples));
+        out.held_out = entry.value("held_out_examples", 0);
+        out.held_out_correct = static_cast<int>(std::lround(entry.value("held_out_accuracy", 0.0) * out.held_out));
       }
     }
     classifier.prepareKernel();

@@ -28,6 +28,10 @@ struct SvmTrainingOptions {
   /// At most this many training examples per label, drawn at random (keeps training and the
   /// number of support vectors, hence prediction time, bounded). 0: all.
   int max_per_label = 2000;
+  /// After training, the model classifies up to this many examples per label that it was not
+  /// trained on (drawn at random from those left out by max_per_label): the held-out accuracy.
+  /// 0: none.
+  int held_out_per_label = 5000;
 };
 
 /// What training measured: per label, how many examples, and the cross-validated fraction
@@ -37,10 +41,14 @@ struct SvmTrainingReport {
     std::string name;
     int examples = 0;
     int correct = 0;
+    int held_out = 0;  // examples left out of the training, classified by the final model
+    int held_out_correct = 0;
     double accuracy() const { return examples == 0 ? 0.0 : static_cast<double>(correct) / examples; }
+    double heldOutAccuracy() const { return held_out == 0 ? 0.0 : static_cast<double>(held_out_correct) / held_out; }
   };
   std::map<int, PerLabel> labels;
   double overall_accuracy = 0.0;
+  double held_out_accuracy = 0.0;  // over every held-out example
   int support_vectors = 0;
   int folds = 0;
   double seconds = 0.0;

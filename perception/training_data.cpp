@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
@@ -82,6 +83,38 @@ ExamplesAdded addTrainingExamples(const camera::RgbdFrame& frame, const Pipeline
       added.voxels += static_cast<int>(rows.size());
       ++added.examples;
     }
+  }
+  return added;
+}
+
+ExamplesAdded addLabelledExamples(const camera::RgbdFrame& frame, const PipelineOptions& options,
+                                  const std::function<int(const Eigen::Vector3d& world_point)>& label_of,
+                                  TrainingSet& set, int min_points) {
+  ExamplesAdded added;
+  WorkspaceCloud workspace = cropWorkspace(frame, options.workspace);
+  if (workspace.cloud.size() < 10) {
+    return added;
+  }
+  estimateNormals(frame, workspace.cloud, options.normal_window, static_cast<float>(options.normal_max_distance));
+  const VoxelFeatures voxels = computeFeatures(workspace.cloud, options.segmentation.features);
+  // Per voxel, how many of its points carry each label.
+  std::vector<std::map<int, int>> votes(voxels.voxels.size());
+  for (std::size_t i = 0; i < workspace.cloud.size(); ++i) {
+    const Eigen::Vector3d world_point = frame.camera_pose * workspace.cloud.points[i].cast<double>();
+    ++votes[static_cast<std::size_t>(voxels.voxel_of_point[i])][label_of(world_point)];
+  }
+  std::map<int, std::vector<int>> rows;  // per label
+  for (std::size_t v = 0; v < votes.size(); ++v) {
+    const auto best = std::max_element(votes[v].begin(), votes[v].end(),
+                                       [](const auto& a, const auto& b) { return a.second < b.second; });
+    if (best != votes[v].end() && best->first >= 0 && best->second >= min_points) {
+      rows[best->first].push_back(static_cast<int>(v));
+    }
+  }
+  for (const auto& [label, which] : rows) {
+    appendRows(set, voxels.features, which, label);
+    added.voxels += static_cast<int>(which.size());
+    ++added.examples;
   }
   return added;
 }

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -35,6 +36,16 @@ struct ExamplesAdded {
 /// `add_table`, a sample of the table's own points is added as background too.
 ExamplesAdded addTrainingExamples(const camera::RgbdFrame& frame, const PipelineOptions& options, int label,
                                   bool add_table, TrainingSet& set, double max_extent = 0.25);
+
+/// Adds the voxels of one filtered frame whose points `label_of` labels: it gets each cropped
+/// point in the world frame (through frame.camera_pose) and gives its label, or -1 for a point
+/// that must not be learned from (near a boundary between things). Each voxel takes the label
+/// most of its points have, and is skipped when that is -1 or when fewer than `min_points` of
+/// its points carry it. For placements whose truth is known (parts stacked, touching, partly
+/// hidden under the robot): one scene gives every class's and the background's examples.
+ExamplesAdded addLabelledExamples(const camera::RgbdFrame& frame, const PipelineOptions& options,
+                                  const std::function<int(const Eigen::Vector3d& world_point)>& label_of,
+                                  TrainingSet& set, int min_points = 3);
 
 /// Writes `set` to `folder` (dataset.json, features.f32, labels.i32). @throws std::runtime_error.
 void saveTrainingSet(const TrainingSet& set, const std::filesystem::path& folder);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <optional>
 #include <random>
@@ -10,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "arm/kinematics.h"
 #include "core/files.h"
 #include "core/paths.h"
 #include "perception/aruco_marker.h"
@@ -19,6 +21,8 @@
 #include "perception/training_data.h"
 #include "perception/workspace.h"
 #include "sim/simulation.h"
+#include "trials/perception_scenes.h"
+#include "workcell/cell_simulation.h"
 
 namespace costar::trials {
 
@@ -37,17 +41,29 @@ std::vector<camera::RgbdFrame> captureFrames(sim::Simulation& simulation, int co
   return frames;
 }
 
-/// Random joint configurations of the UR5 that may put the gripper over the table.
-sim::ArmJoints armOverTable(std::mt19937_64& random) {
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  sim::ArmJoints q = sim::ArmJoints::zero(6);
-  q[0] = -0.9 + 1.8 * unit(random);
-  q[1] = -2.3 + 1.3 * unit(random);
-  q[2] = 0.6 + 1.6 * unit(random);
-  q[3] = -M_PI + 2 * M_PI * unit(random);
-  q[4] = -M_PI + 2 * M_PI * unit(random);
-  q[5] = -M_PI + 2 * M_PI * unit(random);
-  return q;
+/// The label of a point from the simulator's truth: the SVM label of the part whose bounds
+/// (grown by 3 mm) hold it; -1 (not learned from) within 8 mm of a part's bounds otherwise;
+/// else background (0): the table's edge, the robot, the gripper, clutter.
+int truthLabel(const Eigen::Vector3d& point, const std::vector<sim::PartState>& parts,
+               const std::map<std::string, std::pair<Eigen::AlignedBox3d, int>>& bounds_and_label) {
+  int label = 0;
+  for (const sim::PartState& part : parts) {
+    const auto found = bounds_and_label.find(part.object_class);
+    if (found == bounds_and_label.end()) {
+      continue;  // clutter: background
+    }
+    const Eigen::Vector3d local = part.pose.inverse() * point;
+    const Eigen::AlignedBox3d& bounds = found->second.first;
+    const double outside = (local - bounds.min()).cwiseMin(Eigen::Vector3d::Zero()).norm() +
+                           (local - bounds.max()).cwiseMax(Eigen::Vector3d::Zero()).norm();
+    if (outside <= 0.003) {
+      return found->second.second;
+    }
+    if (outside <= 0.008) {
+      label = -1;
+    }
+  }
+  return label;
 }
 
 /// Clutter: object classes that are neither nodes nor links (negative examples), written to
@@ -58,6 +74,9 @@ fs::path makeClutterRoot(const fs::path& directory) {
   fs::create_directories(root / "sim");
   if (!fs::exists(root / "sim" / "models")) {
     fs::create_directory_symlink(fs::absolute(dataRoot() / "sim" / "models"), root / "sim" / "models");
+  }
+  if (!fs::exists(root / "robots")) {  // the adaptive gripper's description
+    fs::create_directory_symlink(fs::absolute(dataRoot() / "robots"), root / "robots");
   }
   const std::vector<std::pair<std::string, std::string>> clutter = {
       {"plate", R"({"name": "plate", "description": "clutter: a flat plate", "mass": 0.1,
@@ -92,6 +111,8 @@ CollectResult collectTrainingData(const CollectOptions& options,
   CollectResult result;
   result.dataset = options.out;
   fs::create_directories(options.out);
+  const workcell::CellSimulation cell = workcell::cellSimulation(options.workcell);
+  const std::shared_ptr<const arm::Kinematics> kinematics = arm::makeKinematics(cell.robot);
   const perception::PipelineFiles files = perception::PipelineFiles::under();
   const std::vector<perception::ObjectModel> models =
       perception::loadObjectModels(files.objects_dir, files.classes_file);
@@ -102,8 +123,12 @@ CollectResult collectTrainingData(const CollectOptions& options,
   for (const auto& model : models) {
     dataset.names[model.parameters.svm_label] = model.name();
   }
-  const int total =
-      static_cast<int>(models.size()) * options.scenes_per_class + options.arm_scenes + options.clutter_scenes;
+  const int total = static_cast<int>(models.size()) * options.scenes_per_class + options.arm_scenes +
+                    options.clutter_scenes + options.mixed_scenes;
+  std::map<std::string, std::pair<Eigen::AlignedBox3d, int>> bounds_and_label;
+  for (const auto& model : models) {
+    bounds_and_label[model.name()] = {model.object_class.bounds(), model.parameters.svm_label};
+  }
 
   // 1. The workspace centre from the ArUco marker on the clear table.
   report({1, "", 0, total});
@@ -112,7 +137,7 @@ CollectResult collectTrainingData(const CollectOptions& options,
   empty.regions = sim::defaultRegions();
   camera::RgbdFrame clear;
   {
-    auto simulation = sim::Simulation::create(empty);
+    auto simulation = sim::Simulation::create(empty, cell.options);
     clear = perception::medianFrame(captureFrames(*simulation, options.frames, options.seed));
   }
   const std::optional<world::Pose> table_center = perception::locateWorkspaceCenter(clear);
@@ -151,7 +176,7 @@ CollectResult collectTrainingData(const CollectOptions& options,
       request.count = options.parts_per_scene;
       request.region = "table";
       scene.parts.push_back(request);
-      sim::SimulationOptions sim_options;
+      sim::SimulationOptions sim_options = cell.options;
       sim_options.placement_seed = random();
       auto simulation = sim::Simulation::create(scene, sim_options);
       addScene(*simulation, model.name() + " scene " + std::to_string(s + 1), 2, model.parameters.svm_label, random(),
@@ -162,19 +187,12 @@ CollectResult collectTrainingData(const CollectOptions& options,
   // 4th), clutter.
   report({3, "", done, total});
   for (int s = 0; s < options.arm_scenes; ++s) {
-    std::unique_ptr<sim::Simulation> simulation;
-    for (int attempt = 0; attempt < 50 && !simulation; ++attempt) {
-      sim::SimulationOptions sim_options;
-      sim_options.initial_arm = armOverTable(random);
-      sim_options.settle_seconds = 0.05;
-      auto candidate = sim::Simulation::create(empty, sim_options);
-      const Eigen::Vector3d tcp = candidate->tcpPose().translation();
-      if (tcp.x() > 0.25 && tcp.x() < 0.75 && std::abs(tcp.y()) < 0.4 && tcp.z() > 0.06 && tcp.z() < 0.3 &&
-          candidate->armTableContactSteps() == 0) {
-        simulation = std::move(candidate);
-      }
-    }
+    sim::SimulationOptions sim_options = cell.options;
+    sim_options.settle_seconds = 0.05;
+    const std::unique_ptr<sim::Simulation> simulation =
+        armOverTableSimulation(cell, *kinematics, empty, sim_options, 0.06, random);
     if (simulation) {
+      simulation->stepTo(simulation->time() + std::chrono::milliseconds(600));  // the fingers
       addScene(*simulation, "robot over the table " + std::to_string(s + 1), 3, 0, random(), s % 4 == 0);
     }
   }
@@ -191,11 +209,47 @@ CollectResult collectTrainingData(const CollectOptions& options,
       request.region = "table";
       scene.parts.push_back(request);
     }
-    sim::SimulationOptions sim_options;
+    sim::SimulationOptions sim_options = cell.options;
     sim_options.data_root = clutter_root;
     sim_options.placement_seed = random();
     auto simulation = sim::Simulation::create(scene, sim_options);
     addScene(*simulation, "clutter scene " + std::to_string(s + 1), 3, 0, random(), false);
+  }
+  // 4. Both at once, labelled point by point from the simulator's truth: cluttered parts, some
+  // touching, links lying across nodes, the arm over them (hiding some of them in part, its
+  // gripper among them).
+  report({4, "", done, total});
+  std::vector<world::ObjectClass> classes;
+  for (const auto& model : models) {
+    classes.push_back(model.object_class);
+  }
+  for (int s = 0; s < options.mixed_scenes; ++s) {
+    std::uniform_int_distribution<int> nodes(3, 6);
+    std::uniform_int_distribution<int> links(1, 3);
+    std::vector<std::pair<std::string, int>> counts;
+    for (const auto& object_class : classes) {
+      counts.emplace_back(object_class.name, object_class.name == "link" ? links(random) : nodes(random));
+    }
+    const std::string label = "mixed scene " + std::to_string(s + 1);
+    sim::Scene scene = sim::clutteredScene(classes, counts, 0.4, random, label).scene;
+    stackLinksOnNodes(scene, classes, 1 + s % 2, random);
+    sim::SimulationOptions sim_options = cell.options;
+    sim_options.settle_seconds = 0.5;
+    const std::unique_ptr<sim::Simulation> simulation =
+        armOverTableSimulation(cell, *kinematics, scene, sim_options, 0.1, random);
+    if (!simulation) {
+      continue;
+    }
+    simulation->stepTo(simulation->time() + std::chrono::milliseconds(600));  // the fingers
+    const camera::RgbdFrame median = perception::medianFrame(captureFrames(*simulation, options.frames, random()));
+    const std::vector<sim::PartState> parts = simulation->parts();
+    const perception::ExamplesAdded added = perception::addLabelledExamples(
+        median, pipeline,
+        [&parts, &bounds_and_label](const Eigen::Vector3d& point) {
+          return truthLabel(point, parts, bounds_and_label);
+        },
+        dataset);
+    report({4, label, ++done, total, added.examples, added.voxels});
   }
   perception::saveTrainingSet(dataset, options.out);
   result.names = dataset.names;

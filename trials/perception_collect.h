@@ -23,15 +23,20 @@ struct CollectOptions {
   std::filesystem::path workspace_file;
   int scenes_per_class = 30;
   int parts_per_scene = 6;
-  int arm_scenes = 24;      // the robot over the table
+  int arm_scenes = 48;      // the robot over the table
   int clutter_scenes = 12;  // objects of no class
-  int frames = 9;           // per placement (median filter)
-  std::uint64_t seed = 1;   // of the placements and the sensor noise
+  /// Parts touching and stacked (links across nodes) with the arm over them, labelled point by
+  /// point from the simulator's truth.
+  int mixed_scenes = 60;
+  /// The simulated cell (workcells/NAME.json) whose arm, gripper and camera are posed.
+  std::string workcell = "ur5-sim";
+  int frames = 9;          // per placement (median filter)
+  std::uint64_t seed = 1;  // of the placements and the sensor noise
 };
 
 /// What is going on: a step begins (`scene` empty), or a placement was added.
 struct CollectProgress {
-  int step = 0;  // 1: workspace centre, 2: positive examples, 3: negative examples
+  int step = 0;  // 1: workspace centre, 2: positive examples, 3: negative examples, 4: mixed
   std::string scene;
   int done = 0;  // placements so far, of `total`
   int total = 0;
@@ -49,7 +54,8 @@ struct CollectResult {
   double seconds = 0.0;
 };
 
-/// @throws std::runtime_error when the marker is not in view or a file cannot be written.
+/// @throws std::runtime_error when the marker is not in view, the cell cannot be read or a file
+/// cannot be written.
 CollectResult collectTrainingData(const CollectOptions& options,
                                   const std::function<void(const CollectProgress&)>& progress = {});
 

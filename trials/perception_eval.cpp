@@ -22,6 +22,8 @@
 #include "sim/drivers.h"
 #include "sim/scene.h"
 #include "sim/simulation.h"
+#include "trials/perception_scenes.h"
+#include "workcell/cell_simulation.h"
 
 namespace costar::trials {
 
@@ -127,6 +129,15 @@ std::vector<world::ObjectClass> classesOf(const perception::Pipeline& pipeline) 
   return classes;
 }
 
+/// The perception configuration of `cell`: its model when it names one.
+perception::PerceptionConfig cellConfig(const workcell::CellSimulation& cell) {
+  perception::PerceptionConfig config;
+  if (!cell.cell.perception_model.empty()) {
+    config.files.svm_file = cell.cell.perception_model;
+  }
+  return config;
+}
+
 /// The table where the parts lie (x 0.25..0.75, y -0.45..0.45 m, up to 6 cm high): the
 /// pictures' close-up.
 perception::WorkspaceOptions pictureArea() {
@@ -207,8 +218,14 @@ void writeSceneFile(const std::filesystem::path& file, sim::Scene scene, const s
   writeOutputFile(file, sim::sceneFileText(scene));
 }
 
+sim::Footprint footprintOf(const world::ObjectClass& object_class, const world::Pose& pose) {
+  return sim::Footprint::of(object_class, pose.translation().x(), pose.translation().y(),
+                            world::rpyOf(pose.linear()).z());
+}
+
 /// The parts of a simulation as a scene with fixed placements (to re-create it after a push).
-sim::Scene sceneOf(const std::vector<sim::PartState>& parts, const std::string& label) {
+sim::Scene sceneOf(const std::vector<sim::PartState>& parts, const std::vector<world::ObjectClass>& classes,
+                   const std::string& label) {
   sim::Scene scene;
   scene.label = label;
   scene.min_gap = 0.0;
@@ -218,14 +235,22 @@ sim::Scene sceneOf(const std::vector<sim::PartState>& parts, const std::string& 
     request.color = part.color;
     const double yaw = world::rpyOf(part.pose.linear()).z();
     request.at = Eigen::Vector3d(part.pose.translation().x(), part.pose.translation().y(), yaw * 180.0 / M_PI);
+    // A part lying on another (a link across a node, or leaning from it onto the table) starts
+    // level just over the parts on the table under it and falls back onto them.
+    const world::ObjectClass& object_class = classNamed(classes, part.object_class);
+    if (part.pose.translation().z() - object_class.rest_height > 0.01) {
+      const sim::Footprint footprint = footprintOf(object_class, part.pose);
+      for (const auto& other : parts) {
+        const world::ObjectClass& other_class = classNamed(classes, other.object_class);
+        if (&other != &part && other.pose.translation().z() - other_class.rest_height <= 0.01 &&
+            sim::closerThan(footprint, footprintOf(other_class, other.pose), 0.0)) {
+          request.height = std::max(request.height, other_class.bounds().sizes().z() + 0.002);
+        }
+      }
+    }
     scene.parts.push_back(request);
   }
   return scene;
-}
-
-sim::Footprint footprintOf(const world::ObjectClass& object_class, const world::Pose& pose) {
-  return sim::Footprint::of(object_class, pose.translation().x(), pose.translation().y(),
-                            world::rpyOf(pose.linear()).z());
 }
 
 /// A small push: one part moved 1-2 cm and turned up to 10 degrees where it touches no other
@@ -418,7 +443,12 @@ double Scores::foundWithinTolerance() const {
 PerceptionEvalSummary evaluatePerception(const PerceptionEvalOptions& options,
                                          const std::function<void(const SceneReport&)>& progress) {
   const auto started = std::chrono::steady_clock::now();
-  perception::PerceptionConfig config;
+  const workcell::CellSimulation cell = workcell::cellSimulation(options.workcell);
+  const std::shared_ptr<const arm::Kinematics> kinematics = arm::makeKinematics(cell.robot);
+  perception::PerceptionConfig config = cellConfig(cell);
+  if (!options.model.empty()) {
+    config.files.svm_file = options.model;
+  }
   const auto pipeline = perception::loadPipeline(config);
   config.frames = options.frames;
   const std::vector<world::ObjectClass> classes = classesOf(*pipeline);
@@ -438,17 +468,36 @@ PerceptionEvalSummary evaluatePerception(const PerceptionEvalOptions& options,
       counts.emplace_back(object_class.name, object_class.name == "link" ? links(random) : nodes(random));
     }
     const std::string label = "scene " + std::to_string(s + 1);
-    const sim::ClutteredScene generated = sim::clutteredScene(classes, counts, options.touching, random, label);
+    sim::ClutteredScene generated = sim::clutteredScene(classes, counts, options.touching, random, label);
     SceneReport report;
     report.scene = s + 1;
     report.touching_parts = generated.touching_parts;
     summary.parts_placed_touching += generated.touching_parts;
+    report.stacked_parts = stackLinksOnNodes(generated.scene, classes, options.stacked, random);
+    summary.parts_stacked += report.stacked_parts;
 
     SwitchableCamera camera;
     SwitchableClock clock;
     auto sim_clock = std::make_unique<SimClock>();
-    auto simulation = sim::Simulation::create(generated.scene);
+    sim::SimulationOptions sim_options = cell.options;
+    std::unique_ptr<sim::Simulation> simulation;
+    if (options.arm_over > 0.0 && std::uniform_real_distribution<double>(0.0, 1.0)(random) < options.arm_over) {
+      sim::SimulationOptions arm_options = sim_options;
+      arm_options.settle_seconds = 0.5;
+      simulation = armOverTableSimulation(cell, *kinematics, generated.scene, arm_options, 0.1, random);
+      if (simulation) {
+        report.arm_over = true;
+        ++summary.scenes_arm_over;
+        sim_options.initial_arm = simulation->armPositions();  // the pushes' scenes keep it there
+      }
+    }
+    if (!simulation) {
+      simulation = sim::Simulation::create(generated.scene, sim_options);
+    }
     simulation->attach(*sim_clock);
+    if (report.arm_over) {
+      sim_clock->advanceBy(std::chrono::milliseconds(600));  // the fingers settle
+    }
     camera.use(*simulation, random());
     clock.use(*sim_clock);
     perception::PerceptionComponent component(camera, clock, pipeline, config);
@@ -517,12 +566,12 @@ PerceptionEvalSummary evaluatePerception(const PerceptionEvalOptions& options,
       // One simulation at a time (destroying one ends the EGL display all renderers share).
       simulation.reset();
       sim_clock = std::make_unique<SimClock>();
-      const sim::Scene pushed_scene = sceneOf(parts, where);
+      const sim::Scene pushed_scene = sceneOf(parts, classes, where);
       if (!options.pictures.empty()) {
         writeSceneFile(options.pictures / formatted("scene_%03d_push_%d.json", s + 1, push + 1), pushed_scene,
                        "perception eval --seed " + std::to_string(options.seed) + ", " + where);
       }
-      simulation = sim::Simulation::create(pushed_scene);
+      simulation = sim::Simulation::create(pushed_scene, sim_options);
       simulation->attach(*sim_clock);
       camera.use(*simulation, random());
       clock.use(*sim_clock);
@@ -562,10 +611,21 @@ nlohmann::json PerceptionEvalSummary::toJson() const {
   nlohmann::json json;
   json["command"] = "costar perception eval --scenes " + std::to_string(options.scenes) + " --seed " +
                     std::to_string(options.seed) + " --repeats " + std::to_string(options.repeats) + " --pushes " +
-                    std::to_string(options.pushes) + " --frames " + std::to_string(options.frames);
+                    std::to_string(options.pushes) + " --frames " + std::to_string(options.frames) + " -w " +
+                    options.workcell + (options.stacked > 0 ? " --stacked " + std::to_string(options.stacked) : "") +
+                    (options.arm_over > 0 ? formatted(" --arm-over %g", options.arm_over) : "");
+  json["workcell"] = options.workcell;
+  json["model"] = options.model.empty() ? "the cell's" : options.model.string();
   json["scenes"] = options.scenes;
   json["parts"] = parts;
   json["parts_placed_touching"] = parts_placed_touching;
+  json["parts_stacked"] = parts_stacked;
+  json["scenes_arm_over"] = scenes_arm_over;
+  int false_detections = 0;
+  for (const auto& [name, score] : scores.classes) {
+    false_detections += score.false_positives;
+  }
+  json["false_detections"] = false_detections;
   json["tolerance"] = {{"translation_mm", kPoseToleranceM * 1000.0}, {"rotation_deg", kPoseToleranceDeg}};
   for (const auto& [name, score] : scores.classes) {
     json["classes"][name] = {{"visible", score.visible},
@@ -601,6 +661,15 @@ nlohmann::json PerceptionEvalSummary::toJson() const {
 
 std::string PerceptionEvalSummary::text() const {
   std::ostringstream out;
+  int false_detections = 0;
+  for (const auto& [name, score] : scores.classes) {
+    false_detections += score.false_positives;
+  }
+  out << formatted(
+      "\n%s: %d parts, %d placed touching, %d links across nodes, the arm over the parts in %d of %d "
+      "scenes; %d false detections\n",
+      options.workcell.c_str(), parts, parts_placed_touching, parts_stacked, scenes_arm_over, options.scenes,
+      false_detections);
   out << "\nper class (every DetectObjects of every scene; parts with >= 30 % of their facing surface in view):\n";
   out << formatted("  %-6s %8s %9s %7s %10s %12s %12s %12s %12s\n", "class", "visible", "precision", "recall",
                    "within tol", "t med (mm)", "t p95 (mm)", "r med (deg)", "r p95 (deg)");
@@ -644,12 +713,14 @@ std::string PerceptionEvalSummary::text() const {
   return out.str();
 }
 
-SceneDetection detectInScene(const std::filesystem::path& scene_file, std::optional<std::uint64_t> seed, int frames) {
-  perception::PerceptionConfig config;
+SceneDetection detectInScene(const std::filesystem::path& scene_file, std::optional<std::uint64_t> seed, int frames,
+                             const std::string& workcell) {
+  const workcell::CellSimulation cell = workcell::cellSimulation(workcell);
+  perception::PerceptionConfig config = cellConfig(cell);
   config.frames = frames;
   const auto pipeline = perception::loadPipeline(config);
   const sim::Scene scene = sim::loadScene(scene_file);
-  sim::SimulationOptions sim_options;
+  sim::SimulationOptions sim_options = cell.options;
   sim_options.placement_seed = seed;
   SimClock clock;
   auto simulation = sim::Simulation::create(scene, sim_options);

@@ -100,6 +100,16 @@ struct PerceptionEvalOptions {
   int pushes = 2;          // per scene: one part moved 1-2 cm and turned up to 10 degrees
   int frames = 15;         // per DetectObjects (the median filter's N)
   double touching = 0.4;   // chance that a part is placed against another
+  /// Links lying across nodes per scene (trials/perception_scenes.h: stackLinksOnNodes).
+  int stacked = 0;
+  /// Chance that a scene has the cell's arm posed over the parts (hiding some of them in part,
+  /// its gripper among them) instead of at home: its points must give no detection.
+  double arm_over = 0.0;
+  /// The simulated cell (workcells/NAME.json): its robot, gripper and camera, and its model
+  /// (perception_model).
+  std::string workcell = "ur5-sim";
+  /// The SVM to use instead of the cell's (to compare models on the same scenes); empty: the cell's.
+  std::filesystem::path model;
   /// A PNG per scene (detections drawn; the SVM's labels) and the scene files (scene_NNN.json,
   /// scene_NNN_push_K.json: `perception detect` runs them again) in this folder; empty: none.
   std::filesystem::path pictures;
@@ -110,6 +120,8 @@ struct SceneReport {
   int scene = 0;  // from 1
   int parts = 0;
   int touching_parts = 0;
+  int stacked_parts = 0;
+  bool arm_over = false;
   int accurate_first_look = 0;
   int names_kept = 0;  // while still
   int name_checks = 0;
@@ -123,6 +135,8 @@ struct PerceptionEvalSummary {
   Scores scores;
   int parts = 0;
   int parts_placed_touching = 0;
+  int parts_stacked = 0;    // links put across nodes
+  int scenes_arm_over = 0;  // scenes with the arm posed over the parts
   /// Per stage of DetectObjects (median_filter, crop_plane, normals, features, svm, pose_wall,
   /// objrecransac_cpu, icp_check_cpu, total): one value (ms) per run.
   std::map<std::string, std::vector<double>> latency_ms;
@@ -157,7 +171,8 @@ struct SceneDetection {
   /// false detection, yellow a missed part's outline), enlarged on the table.
   RgbImage picture;
 };
-SceneDetection detectInScene(const std::filesystem::path& scene, std::optional<std::uint64_t> seed, int frames);
+SceneDetection detectInScene(const std::filesystem::path& scene, std::optional<std::uint64_t> seed, int frames,
+                             const std::string& workcell = "ur5-sim");
 
 /// Percentile (0..100) by linear interpolation; 0 for none.
 double percentile(std::vector<double> values, double p);

@@ -83,7 +83,7 @@ SimCellDescription parse(const json& root, const std::filesystem::path& data_roo
   }
   onlyKnown(root, "",
             {"name", "label", "notes", "robot", "gripper", "robot_base", "cell_model", "scene", "waypoints", "table",
-             "workspace", "part_area", "calibration", "power_tool"});
+             "workspace", "part_area", "calibration", "perception_model", "power_tool"});
   SimCellDescription cell;
   cell.name = text(root, "", "name");
   cell.label = text(root, "", "label");
@@ -100,6 +100,11 @@ SimCellDescription parse(const json& root, const std::filesystem::path& data_roo
     cell.waypoints = file(root, "waypoints", data_root);
   }
   cell.calibration = file(root, "calibration", data_root);
+  if (root.contains("perception_model")) {
+    // Not checked here: `costar perception retrain -w NAME` writes it; DetectObjects names it
+    // when it is missing.
+    cell.perception_model = data_root / text(root, "", "perception_model");
+  }
   const json& table = objectAt(root, "", "table");
   onlyKnown(table, "table", {"centre", "size"});
   cell.table_centre = vec3(table, "table", "centre", kMaxMetres, "m");

@@ -22,6 +22,10 @@
 //                    (calibration/calibration_component.h), when no part's place is known
 //   calibration      the shipped hand-eye calibration of the gripper's marker (the marker's place
 //                    on the flange: one file per gripper and marker, whichever arm carries it)
+//   perception_model optional: the SVM trained for this cell (`costar perception retrain -w NAME`:
+//                    its own arm and gripper seen as background); DetectObjects in the cell loads
+//                    it (a missing file is DetectObjects' error, not the description's: the
+//                    training writes it). Absent: the default model (perception::PipelineFiles).
 //   power_tool       optional {tool: NAME (data/tools/NAME.json), stand: {position, rpy}}: a
 //                    power tool (tool/power_tool.h) and where its stand stands on the table; the
 //                    scene says whether the tool sits on it (sim/scene.h "power_tool")
@@ -45,10 +49,11 @@ struct SimCellDescription {
   std::string robot;
   std::string gripper;
   world::Pose robot_base = world::Pose::Identity();
-  std::filesystem::path cell_model;   // absolute
-  std::filesystem::path scene;        // absolute
-  std::filesystem::path waypoints;    // absolute, or empty
-  std::filesystem::path calibration;  // absolute
+  std::filesystem::path cell_model;        // absolute
+  std::filesystem::path scene;             // absolute
+  std::filesystem::path waypoints;         // absolute, or empty
+  std::filesystem::path calibration;       // absolute
+  std::filesystem::path perception_model;  // absolute, or empty: the default model
   Eigen::Vector3d table_centre = Eigen::Vector3d::Zero();
   Eigen::Vector3d table_size = Eigen::Vector3d::Zero();
   Eigen::AlignedBox3d workspace;

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -30,6 +31,7 @@
 #include "smartmove/smartmove.h"
 #include "testing/test_components.h"
 #include "tool/power_tool.h"
+#include "workcell/cell_simulation.h"
 #include "workcell/grippers.h"
 #include "workcell/sim_cell_description.h"
 
@@ -100,10 +102,12 @@ class SeparationMonitor final : public component::TableComponent {
 };
 
 /// The perception pipeline (models and SVM loaded from the data files, about half a second),
-/// loaded once per thread and shared by the workcells that thread creates: trials create one
-/// workcell per trial, and a pipeline runs one detection at a time.
+/// loaded once per thread and SVM file (each cell has its own) and shared by the workcells that
+/// thread creates: trials create one workcell per trial, and a pipeline runs one detection at a
+/// time.
 std::shared_ptr<perception::Pipeline> threadPipeline(const perception::PerceptionConfig& config) {
-  thread_local std::shared_ptr<perception::Pipeline> pipeline;
+  thread_local std::map<std::filesystem::path, std::shared_ptr<perception::Pipeline>> pipelines;
+  std::shared_ptr<perception::Pipeline>& pipeline = pipelines[config.files.svm_file];
   if (!pipeline) {
     pipeline = perception::loadPipeline(config);
   }
@@ -228,7 +232,7 @@ class SimWorkcell final : public Workcell {
         gripper_model_(gripperModel(cell_.gripper)),
         robot_description_(arm::loadRobotDescription(arm::robotDescriptionFile(cell_.robot))),
         scene_(sim::loadScene(options.scene.empty() ? cell_.scene : options.scene)),
-        simulation_(sim::Simulation::create(scene_, simOptions(options, robot_description_, cell_, gripper_model_))),
+        simulation_(sim::Simulation::create(scene_, simOptions(options, robot_description_, cell_))),
         arm_driver_(*simulation_),
         gripper_driver_(*simulation_),
         camera_(*simulation_, options.seed.value_or(scene_.seed)),
@@ -335,6 +339,9 @@ class SimWorkcell final : public Workcell {
       // DetectObjects: the camera's frames only, never the simulator's true poses.
       perception::PerceptionConfig perception_config;
       perception_config.table_center = tableCenter();
+      if (!cell_.perception_model.empty()) {
+        perception_config.files.svm_file = cell_.perception_model;
+      }
       perception_config.camera_pose = [calibration = calibration_.get()] { return calibration->cameraPose(); };
       add(std::make_shared<perception::PerceptionComponent>(camera, clock(), threadPipeline(perception_config),
                                                             perception_config));
@@ -471,19 +478,11 @@ class SimWorkcell final : public Workcell {
 
  private:
   static sim::SimulationOptions simOptions(const WorkcellOptions& options, const arm::RobotDescription& robot,
-                                           const SimCellDescription& cell, const GripperModel& gripper) {
-    sim::SimulationOptions sim_options;
+                                           const SimCellDescription& cell) {
+    sim::SimulationOptions sim_options = cellSimulation(cell).options;
     sim_options.robot = robot;
-    sim_options.cell_model = cell.cell_model;
-    sim_options.gripper_model = dataRoot() / gripper.mjcf;
-    sim_options.adaptive_gripper = gripper.adaptive;
-    sim_options.robot_base = cell.robot_base;
     sim_options.placement_seed = options.seed;
     sim_options.spare_classes = options.spare_parts;
-    if (cell.power_tool) {
-      sim_options.power_tool = sim::PowerToolSetup{
-          tool::loadPowerToolDescription(tool::powerToolFile(cell.power_tool->tool)), cell.power_tool->stand};
-    }
     if (options.camera_move) {
       sim::CameraOffset offset;
       offset.random = true;

@@ -35,5 +35,37 @@ TEST(TrainingData, EachObjectOnTheTableIsOneExample) {
   EXPECT_THROW(loadTrainingSet(folder), std::runtime_error);
 }
 
+// Point-by-point labels (the simulator's truth in collection): each voxel takes its points'
+// majority label; points labelled -1 (near a boundary) give no example.
+TEST(TrainingData, LabelledExamplesTakeTheirPointsLabelsAndSkipTheUnlearned) {
+  world::ObjectClass block;
+  block.boxes = {{Eigen::Vector3d::Zero(), Eigen::Vector3d(0.025, 0.025, 0.025)}};
+  const camera::RgbdFrame frame = test::renderSynthetic({{&block, world::Pose(Eigen::Translation3d(0.4, -0.2, 0.025))},
+                                                         {&block, world::Pose(Eigen::Translation3d(0.6, 0.2, 0.025))},
+                                                         {&block, world::Pose(Eigen::Translation3d(0.5, 0.0, 0.025))}},
+                                                        0.0005);
+  TrainingSet set;
+  set.names = {{0, "background"}, {1, "left"}, {2, "right"}};
+  const auto label_of = [](const Eigen::Vector3d& point) {
+    return point.y() < -0.1 ? 1 : (point.y() > 0.1 ? 2 : -1);  // the middle block is not learned from
+  };
+  const ExamplesAdded added = addLabelledExamples(frame, PipelineOptions{}, label_of, set);
+  EXPECT_EQ(added.examples, 2);  // labels 1 and 2
+  EXPECT_EQ(static_cast<int>(set.labels.size()), added.voxels);
+  EXPECT_EQ(set.features.rows(), static_cast<Eigen::Index>(set.labels.size()));
+  const auto ones = std::count(set.labels.begin(), set.labels.end(), 1);
+  const auto twos = std::count(set.labels.begin(), set.labels.end(), 2);
+  EXPECT_GT(ones, 20);
+  EXPECT_GT(twos, 20);
+  EXPECT_EQ(ones + twos, static_cast<long>(set.labels.size()));  // nothing of the middle block, no -1
+
+  // Every point labelled the same: as many rows as the three blocks' voxels, one example.
+  TrainingSet all;
+  const ExamplesAdded every = addLabelledExamples(
+      frame, PipelineOptions{}, [](const Eigen::Vector3d&) { return 0; }, all);
+  EXPECT_EQ(every.examples, 1);
+  EXPECT_GT(every.voxels, static_cast<int>(ones + twos));
+}
+
 }  // namespace
 }  // namespace costar::perception

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "core/paths.h"
 #include "workcell/workcell.h"
 
 namespace costar::workcell {
@@ -38,6 +39,15 @@ TEST(SimCellDescription, BothCellsLoadAndAreListed) {
     names.push_back(info.name);
   }
   EXPECT_EQ(names, (std::vector<std::string>{"ur5-sim", "iiwa-3f-sim", "iiwa-sim", "panda-sim", "test", "none"}));
+}
+
+// Each simulated cell has its own SVM (its own arm and gripper seen as background), shipped.
+TEST(SimCellDescription, EachCellNamesItsOwnShippedPerceptionModel) {
+  for (const std::string name : {"ur5-sim", "iiwa-sim", "iiwa-3f-sim"}) {
+    const SimCellDescription cell = loadSimCellDescription(simCellFile(name));
+    EXPECT_EQ(cell.perception_model, dataRoot() / "data/perception/svm" / (name + ".json")) << name;
+    EXPECT_TRUE(std::filesystem::is_regular_file(cell.perception_model)) << name;
+  }
 }
 
 class BadCellFile : public ::testing::Test {
