@@ -1,5 +1,7 @@
 #include "cli/plan_commands.h"
 
+#include <algorithm>
+
 #include <unistd.h>
 
 #include <cerrno>
@@ -334,8 +336,13 @@ void addPlanCommands(CLI::App& app, int& exit_code) {
 
   CLI::App* workcells = app.add_subcommand("workcells", "List the workcells this build knows");
   workcells->callback([&exit_code] {
-    for (const auto& info : workcell::knownWorkcells()) {
-      std::printf("%-8s %s\n", info.name.c_str(), info.description.c_str());
+    const auto known = workcell::knownWorkcells();
+    int width = 0;  // the names in one column, however long the longest
+    for (const auto& info : known) {
+      width = std::max(width, static_cast<int>(info.name.size()));
+    }
+    for (const auto& info : known) {
+      std::printf("%-*s  %s\n", width, info.name.c_str(), info.description.c_str());
     }
     exit_code = kExitSuccess;
   });
