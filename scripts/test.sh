@@ -9,6 +9,10 @@ cd "$(dirname "$0")/.."
 start=$(date +%s)
 bash scripts/setup.sh
 BUILD_DIR="${COSTAR_BUILD_DIR:-build}"
+# The tests keep their state (taught waypoints, the editor's runs) in a folder of their own: what a
+# user taught in ~/.local/state/costar neither changes what they see nor is written by them.
+XDG_STATE_HOME=$(mktemp -d "${TMPDIR:-/tmp}/costar_test_state.XXXXXX")
+export XDG_STATE_HOME
 
 echo
 echo "test: CTest"
@@ -105,3 +109,4 @@ if [[ "${EDITOR_E2E:-1}" != "0" ]]; then
 fi
 echo
 echo "test: all passed in $(( $(date +%s) - start )) s"
+rm -rf "$XDG_STATE_HOME"

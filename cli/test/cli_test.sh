@@ -6,6 +6,8 @@ costar="$1"
 failures=0
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+# A state folder of its own (taught waypoints): the user's ~/.local/state/costar is not this test's.
+export XDG_STATE_HOME="$tmp/state"
 
 check() {  # check NAME EXPECTED_EXIT PATTERN -- COMMAND...
   local name="$1" expected="$2" pattern="$3"
