@@ -298,13 +298,7 @@ void ChainKinematics::inverse(const world::Pose& flange, const JointVector& seed
 
 std::optional<JointVector> ChainKinematics::inverseNearest(const world::Pose& flange, const JointVector& seed,
                                                            const Acceptable& acceptable) const {
-  if (seed.size() != jointCount()) {
-    throw std::invalid_argument("ChainKinematics::inverseNearest: the seed has " + std::to_string(seed.size()) +
-                                " joints, the arm " + std::to_string(jointCount()));
-  }
-  if (!allFinite(seed)) {
-    throw std::invalid_argument("ChainKinematics::inverseNearest: the seed has a non-finite joint angle");
-  }
+  checkSeed(seed, "ChainKinematics::inverseNearest");
   if (!flange.matrix().allFinite()) {
     return std::nullopt;
   }

@@ -28,6 +28,16 @@ Kinematics::Kinematics(JointLimits limits) : limits_(std::move(limits)) {
   JointTrajectory::validate(limits_, "Kinematics");
 }
 
+void Kinematics::checkSeed(const JointVector& seed, const char* who) const {
+  if (seed.size() != jointCount()) {
+    throw std::invalid_argument(std::string(who) + ": the seed has " + std::to_string(seed.size()) +
+                                " joints, the arm " + std::to_string(jointCount()));
+  }
+  if (!allFinite(seed)) {
+    throw std::invalid_argument(std::string(who) + ": the seed has a non-finite joint angle");
+  }
+}
+
 void Kinematics::solutionsNear(const world::Pose& flange, const JointVector& seed, IkSolutions& solutions) const {
   inverse(flange, seed, solutions);
   int kept = 0;
@@ -58,13 +68,7 @@ void Kinematics::solutionsNear(const world::Pose& flange, const JointVector& see
 
 std::optional<JointVector> Kinematics::inverseNearest(const world::Pose& flange, const JointVector& seed,
                                                       const Acceptable& acceptable) const {
-  if (seed.size() != jointCount()) {
-    throw std::invalid_argument("Kinematics::inverseNearest: the seed has " + std::to_string(seed.size()) +
-                                " joints, the arm " + std::to_string(jointCount()));
-  }
-  if (!allFinite(seed)) {
-    throw std::invalid_argument("Kinematics::inverseNearest: the seed has a non-finite joint angle");
-  }
+  checkSeed(seed, "Kinematics::inverseNearest");
   IkSolutions solutions;
   solutionsNear(flange, seed, solutions);
   for (const JointVector& q : solutions) {

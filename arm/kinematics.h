@@ -98,6 +98,10 @@ class Kinematics {
   void solutionsNear(const world::Pose& flange, const JointVector& seed, IkSolutions& solutions) const;
 
  protected:
+  /// Throws std::invalid_argument "WHO: the seed has ..." unless `seed` has jointCount() finite
+  /// angles (the check every inverseNearest makes).
+  void checkSeed(const JointVector& seed, const char* who) const;
+
   /// Throws std::invalid_argument when `limits` are not valid (see JointTrajectory::validate:
   /// one finite interval, a positive velocity and acceleration per joint, 1 to kMaxJoints
   /// joints).

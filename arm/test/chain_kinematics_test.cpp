@@ -160,6 +160,7 @@ TEST(ChainKinematics, AnswersAreReproducibleAndUnreachablePosesHaveNone) {
   for (int s = 0; s < first.size(); ++s) {
     EXPECT_EQ(maxAbsDifference(first[s], second[s]), 0.0);
   }
+  EXPECT_THROW(chain.inverseNearest(target, JointVector::zero(6)), std::invalid_argument);
   target.translation() = Eigen::Vector3d(2.0, 0.0, 0.5);  // 2 m away: beyond the 1.3 m reach
   chain.inverse(target, home, first);
   EXPECT_TRUE(first.empty());
