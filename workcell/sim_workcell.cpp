@@ -453,9 +453,37 @@ class SimWorkcell final : public Workcell {
         gripper["finger_links"].push_back(gripper_model_.finger_link);
       }
     }
+    // What the scene fixes on the table beside the parts (the workpiece with its marked area,
+    // the power tool's stand): boxes the page draws where the planner avoids them.
+    nlohmann::json fixtures = nlohmann::json::array();
+    const auto fixture = [&fixtures](const std::string& name, const world::Pose& pose, const Eigen::Vector3d& size,
+                                     const Eigen::Vector3d& rgb) {
+      const Eigen::Quaterniond turn(pose.linear());
+      const Eigen::Vector3d& at = pose.translation();
+      fixtures.push_back({{"name", name},
+                          {"p", {at.x(), at.y(), at.z()}},
+                          {"q", {turn.x(), turn.y(), turn.z(), turn.w()}},
+                          {"size", {size.x(), size.y(), size.z()}},
+                          {"rgb", {rgb.x(), rgb.y(), rgb.z()}}});
+    };
+    if (scene_.workpiece) {
+      const world::Pose top = sim::workpieceTop(*scene_.workpiece);
+      const Eigen::Vector3d& size = scene_.workpiece->size;
+      fixture("workpiece", top * Eigen::Translation3d(0, 0, -size.z() / 2), size, {0.72, 0.56, 0.36});
+      const Eigen::Vector2d& marked = scene_.workpiece->marked;
+      fixture("marked area", top * Eigen::Translation3d(0, 0, 0.0005), {marked.x(), marked.y(), 0.001},
+              {0.3, 0.55, 0.85});
+    }
+    if (const sim::SimPowerTool* tool = simulation_->powerTool();
+        tool != nullptr && tool->setup() && scene_.power_tool) {
+      const sim::PowerToolSetup& setup = *tool->setup();
+      fixture("tool stand", setup.stand * Eigen::Translation3d(0, 0, setup.tool.stand_size.z() / 2),
+              setup.tool.stand_size, {0.45, 0.47, 0.5});
+    }
     const Eigen::Quaterniond q(cell_.robot_base.linear());
     const Eigen::Vector3d& p = cell_.robot_base.translation();
-    return {{"urdf",
+    return {{"fixtures", std::move(fixtures)},
+            {"urdf",
              planning::mountUrdf(text(robot_description_.urdf), text(gripper_urdf), robot_description_.urdf_tool_link,
                                  robot_description_.urdf.string() + "' + '" + gripper_urdf.string())},
             {"name", robot_description_.name},

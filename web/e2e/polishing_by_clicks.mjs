@@ -28,6 +28,9 @@ async function main() {
   const { page } = await openPage(browser, open, pageErrors);
   await page.waitForSelector('.palette-item[data-node-type="PressAndFollow"]');
 
+  const robot = await api(url, token, 'GET', '/api/robot');
+  const fixtures = (robot.json.fixtures ?? []).map((f) => f.name);
+  check(['workpiece', 'marked area', 'tool stand'].every((f) => fixtures.includes(f)), `the 3D view is given the scene's fixtures to draw: ${fixtures.join(', ')}`);
   const newOperations = ['MoveUntilContact', 'PressAndFollow', 'ReleaseContact', 'Tare', 'ForgetPressed', 'ToolOn', 'ToolOff'];
   const offered = await page.$$eval('.palette-item', (items) => items.map((i) => i.getAttribute('data-node-type')));
   check(newOperations.every((id) => offered.includes(id)), `the force and tool operations are in the palette: ${newOperations.join(', ')}`);

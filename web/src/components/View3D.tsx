@@ -267,10 +267,22 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       setError(`the robot cannot be drawn: ${(e as Error).message}`);
       return;
     }
+    // The scene's fixtures (a workpiece, a tool stand), where the planner avoids them.
+    const fixtures = new THREE.Group();
+    for (const f of robot.fixtures ?? []) {
+      const box = new THREE.Mesh(new THREE.BoxGeometry(...f.size), new THREE.MeshStandardMaterial({ color: new THREE.Color(...f.rgb) }));
+      box.position.set(...f.p);
+      box.quaternion.set(...f.q);
+      box.name = f.name;
+      fixtures.add(box);
+    }
+    s.robot.add(fixtures);
     s.robot.add(built.object);
     setDrawn(built);
     framed.current = false;
     return () => {
+      s.robot.remove(fixtures);
+      fixtures.traverse((o) => o instanceof THREE.Mesh && (o.geometry.dispose(), (o.material as THREE.Material).dispose()));
       s.robot.remove(built.object);
       built.dispose();
       setDrawn(null);

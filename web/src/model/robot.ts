@@ -41,6 +41,8 @@ export interface RobotDescription {
     description?: AdaptiveDescription;
   };
   table?: { centre: [number, number, number]; size: [number, number, number] };
+  /** What the scene fixes on the table (a workpiece and its marked area, a tool stand): boxes in the world. */
+  fixtures?: { name: string; p: [number, number, number]; q: [number, number, number, number]; size: [number, number, number]; rgb: [number, number, number] }[];
 }
 
 /** The gripper's reading as the stream carries it (the `gripper_fingers` symbol). */
