@@ -7,6 +7,7 @@
 #include <random>
 
 #include "arm/chain_kinematics.h"
+#include "arm/test/dh_chain.h"
 #include "arm/trajectory.h"
 #include "arm/ur5_kinematics.h"
 #include "bench/alloc_counter.h"
@@ -56,17 +57,7 @@ TEST(ArmAllocation, NoneInInverseKinematics) {
 // The general chain solver (6 joints here: the UR5's DH table as a chain), through the
 // interface; its geometry is built before counting.
 TEST(ArmAllocation, NoneInTheChainSolver) {
-  const DhParameters dh = DhParameters::ur5();
-  ChainGeometry chain;
-  world::Pose previous = world::Pose::Identity();
-  for (int i = 0; i < kJointCount; ++i) {
-    chain.joints.push_back({previous, Eigen::Vector3d::UnitZ()});
-    previous = world::Pose::Identity();
-    previous.translate(Eigen::Vector3d(dh.a[i], 0, dh.d[i]));
-    previous.rotate(Eigen::AngleAxisd(dh.alpha[i], Eigen::Vector3d::UnitX()));
-  }
-  chain.flange = previous;
-  const ChainKinematics kinematics(chain, JointLimits::ur5());
+  const ChainKinematics kinematics(testing::chainFromDh(DhParameters::ur5()), JointLimits::ur5());
   std::mt19937_64 random(22);
   std::uniform_real_distribution<double> angle(-3.0, 3.0);
   std::vector<world::Pose> poses;

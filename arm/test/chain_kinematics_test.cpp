@@ -13,28 +13,13 @@
 
 #include "arm/robot_description.h"
 #include "arm/srs_kinematics.h"
+#include "arm/test/dh_chain.h"
 #include "arm/ur5_kinematics.h"
 
 namespace costar::arm {
 namespace {
 
-/// A standard-DH arm as a chain: joint i's frame is row i-1's Tz(d) Tx(a) Rx(alpha) after joint
-/// i-1's rotation; the flange is the last row's.
-ChainGeometry chainFromDh(const DhParameters& dh) {
-  const auto row = [&dh](int i) {
-    world::Pose pose = world::Pose::Identity();
-    pose.translate(Eigen::Vector3d(0, 0, dh.d[i]));
-    pose.translate(Eigen::Vector3d(dh.a[i], 0, 0));
-    pose.rotate(Eigen::AngleAxisd(dh.alpha[i], Eigen::Vector3d::UnitX()));
-    return pose;
-  };
-  ChainGeometry chain;
-  for (int i = 0; i < 6; ++i) {
-    chain.joints.push_back({i == 0 ? world::Pose::Identity() : row(i - 1), Eigen::Vector3d::UnitZ()});
-  }
-  chain.flange = row(5);
-  return chain;
-}
+using testing::chainFromDh;
 
 JointVector randomWithin(const JointLimits& limits, std::mt19937_64& random) {
   JointVector q(limits.size());
