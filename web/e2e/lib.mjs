@@ -108,6 +108,27 @@ export function actionCounter(page, log) {
   counter.key = (combo) => counter.act(`press ${combo}`, () => page.keyboard.press(combo));
   counter.fill = (what, selector, value) => counter.act(what, () => page.fill(selector, value));
   counter.click = (what, selector) => counter.act(what, () => page.click(selector));
+  // The tree pans to keep the selected node in view: a drag waits until its target stands still.
+  counter.still = async (selector) => {
+    let last = '';
+    for (let i = 0; i < 50; i += 1) {
+      const box = JSON.stringify(await page.locator(selector).boundingBox());
+      if (box === last) return box;
+      last = box;
+      await page.waitForTimeout(100);
+    }
+    return last;
+  };
+  /**
+   * Drags a palette item onto a tree box's leading ('before') or trailing ('after') edge. The
+   * point is a fraction of the box as drawn: the tree zooms out below 1 on a large plan, and a
+   * point in pixels of the unzoomed box lands on the box below it (inside its parent).
+   */
+  counter.dropOnEdge = async (type, selector, edge, what) => {
+    const { height } = JSON.parse(await counter.still(selector));
+    const y = edge === 'before' ? Math.max(1, height * 0.1) : Math.min(height - 1, height * 0.9);
+    await counter.act(what, () => page.dragAndDrop(`.palette-item[data-node-type="${type}"]`, selector, { targetPosition: { x: 40, y } }));
+  };
   return counter;
 }
 

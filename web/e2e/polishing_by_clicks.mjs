@@ -39,19 +39,9 @@ async function main() {
 
   // --- the plan by clicks: every UI action counted -----------------------------------------
   const counter = actionCounter(page, log);
-  const { act, palette, choose, key } = counter;
+  const { act, palette, choose, key, dropOnEdge } = counter;
   const fill = (what, selector, value) => act(what, () => page.fill(selector, value));
 
-  // The tree pans to keep the selected node in view: the drag waits until its box stands still.
-  const still = async (selector) => {
-    let last = '';
-    for (let i = 0; i < 50; i += 1) {
-      const box = JSON.stringify(await page.locator(selector).boundingBox());
-      if (box === last) return;
-      last = box;
-      await page.waitForTimeout(100);
-    }
-  };
   // The new plan's root Sequence is selected: operations go in it one after another; a node
   // that takes children takes the next one inside.
   await palette('ForgetPressed');
@@ -69,10 +59,7 @@ async function main() {
   await act('open the palette group Other', () => page.locator('details.palette-group summary', { hasText: /^Other/ }).click());
   await palette('AlwaysFailure');
   // the guarded procedure before it: RESET dragged onto the wait's leading edge
-  await still('.tree-node[data-node-type="Sequence"] >> nth=1');
-  await act('drag Reset onto the leading edge of the wait Sequence', () =>
-    page.dragAndDrop('.palette-item[data-node-type="Reset"]', '.tree-node[data-node-type="Sequence"] >> nth=1', { targetPosition: { x: 40, y: 3 } }),
-  );
+  await dropOnEdge('Reset', '.tree-node[data-node-type="Sequence"] >> nth=1', 'before', 'drag Reset onto the leading edge of the wait Sequence');
   check((await page.getAttribute('.tree-node.selected', 'data-node-type')) === 'Reset', 'the RESET dropped before the wait is selected');
   await fill('type num_resets -1 (always)', '#port-num_resets', '-1');
   await palette('ReactiveSequence');
@@ -89,12 +76,8 @@ async function main() {
   await palette('SmartGrasp');
   await choose('object_class', 'orbital_sander');
   // after the pick-up's Fallback (a click on it would insert inside it): dropped on its trailing edge
-  const dropAfter = async (type, target, n) => {
-    await still(`.tree-node[data-node-type="${target}"] >> nth=${n}`);
-    await act(`drag ${type} onto the trailing edge of ${target} #${n + 1}`, () =>
-      page.dragAndDrop(`.palette-item[data-node-type="${type}"]`, `.tree-node[data-node-type="${target}"] >> nth=${n}`, { targetPosition: { x: 40, y: 31 } }),
-    );
-  };
+  const dropAfter = (type, target, n) =>
+    dropOnEdge(type, `.tree-node[data-node-type="${target}"] >> nth=${n}`, 'after', `drag ${type} onto the trailing edge of ${target} #${n + 1}`);
   // the deeper of the two Fallbacks (further right in the left-to-right tree)
   const lefts = await page.$$eval('.tree-node[data-node-type="Fallback"]', (n) => n.map((x) => x.getBoundingClientRect().left));
   await dropAfter('ToolOn', 'Fallback', lefts.indexOf(Math.max(...lefts)));

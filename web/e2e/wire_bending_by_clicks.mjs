@@ -27,24 +27,10 @@ async function main() {
   await page.waitForSelector('.palette-item[data-node-type="Move"]');
 
   const counter = actionCounter(page, log);
-  const { act, palette, choose } = counter;
+  const { act, palette, choose, dropOnEdge } = counter;
   const fill = (what, selector, value) => act(what, () => page.fill(selector, value));
-  // The tree pans to keep the selected node in view: a drag waits until its box stands still.
-  const still = async (selector) => {
-    let last = '';
-    for (let i = 0; i < 50; i += 1) {
-      const box = JSON.stringify(await page.locator(selector).boundingBox());
-      if (box === last) return;
-      last = box;
-      await page.waitForTimeout(100);
-    }
-  };
-  const dropAfter = async (type, target, n) => {
-    await still(`.tree-node[data-node-type="${target}"] >> nth=${n}`);
-    await act(`drag ${type} onto the trailing edge of ${target} #${n + 1}`, () =>
-      page.dragAndDrop(`.palette-item[data-node-type="${type}"]`, `.tree-node[data-node-type="${target}"] >> nth=${n}`, { targetPosition: { x: 40, y: 31 } }),
-    );
-  };
+  const dropAfter = (type, target, n) =>
+    dropOnEdge(type, `.tree-node[data-node-type="${target}"] >> nth=${n}`, 'after', `drag ${type} onto the trailing edge of ${target} #${n + 1}`);
   const along = (prefix) => act(`a Move to each waypoint of the path ${prefix}…`, () => page.selectOption('select[aria-label="along a path"]', prefix));
   /** The index among the boxes of a type of the one lowest in the pane, of those furthest right. */
   const deepestLowest = (type) =>
