@@ -27,6 +27,8 @@ PACKAGES=(
   libsqlite3-dev
   # perception: point clouds and ObjRecRANSAC (PCL), ArUco (OpenCV contrib), the SVM (libsvm)
   libpcl-dev libopencv-dev libopencv-contrib-dev libsvm-dev
+  # components in other processes and machines over DDS (dds/): Eclipse CycloneDDS and its idlc
+  cyclonedds-dev cyclonedds-tools
 )
 
 SUDO=""

@@ -1,0 +1,283 @@
+#include "dds/host.h"
+
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <map>
+#include <random>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+#include "component/description.h"
+#include "dds/bus.h"
+#include "dds/report_json.h"
+
+namespace costar::dds {
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+using GoalKey = std::pair<std::uint64_t, std::uint64_t>;  // (client, number)
+
+/// How often running operations are polled.
+constexpr std::chrono::milliseconds kPollPeriod{1};
+/// How often each component's report is read (and published when it changed).
+constexpr std::chrono::milliseconds kReportPeriod{20};
+
+std::uint64_t randomId() {
+  std::random_device device;
+  return (static_cast<std::uint64_t>(device()) << 32U) ^ device() ^ static_cast<std::uint64_t>(::getpid());
+}
+
+std::string hostName() {
+  char name[256] = {};
+  return ::gethostname(name, sizeof(name) - 1) == 0 ? std::string(name) : std::string("unknown");
+}
+
+}  // namespace
+
+struct ComponentHost::State {
+  struct Running {
+    component::Component* component;
+    component::OperationId id;
+    std::string operation;
+    std::string last_sent;  // the feedback last published (reason and data), to send changes only
+  };
+
+  explicit State(const RemoteConfig& config) : bus(config) {}
+
+  Bus bus;
+  std::uint64_t id = randomId();
+  std::map<std::string, std::shared_ptr<component::Component>, std::less<>> components;
+  std::vector<std::string> names;
+  std::map<GoalKey, Running> running;
+  std::map<std::string, std::string> last_reports;
+  /// Cancels that came before their goal (the two travel on different topics, in no set
+  /// order): the goal is then never started. Bounded: the oldest are dropped.
+  std::set<GoalKey> cancelled_early;
+  static constexpr std::size_t kCancelledEarlyLimit = 1024;
+  dds_entity_t goal_reader = 0, cancel_reader = 0;
+  dds_entity_t reply_writer = 0, feedback_writer = 0, result_writer = 0;
+  dds_entity_t description_writer = 0, report_writer = 0, heartbeat_writer = 0;
+  std::uint64_t heartbeats = 0;
+
+  void sendStatus(dds_entity_t writer, const GoalKey& goal, const std::string& component, std::uint8_t status,
+                  const std::string& reason, const std::string& data_json) const {
+    costar_msgs_action_dds__Operation_Status_ message{};
+    message.goal_id = {goal.first, goal.second};
+    message.component = wire(component);
+    message.host_id = id;
+    message.status = status;
+    message.reason = wire(reason);
+    message.data_json = wire(data_json);
+    Bus::write(writer, &message);
+  }
+
+  void reply(const GoalKey& goal, const std::string& component, bool accepted, const std::string& reason) const {
+    costar_msgs_action_dds__Operation_SendGoal_Response_ message{};
+    message.goal_id = {goal.first, goal.second};
+    message.component = wire(component);
+    message.host_id = id;
+    message.accepted = accepted;
+    message.reason = wire(reason);
+    Bus::write(reply_writer, &message);
+  }
+
+  void startGoal(const costar_msgs_action_dds__Operation_SendGoal_Request_& goal) {
+    const auto found = components.find(goal.component);
+    if (found == components.end()) {
+      return;  // another host's component
+    }
+    const GoalKey key{goal.goal_id.client, goal.goal_id.number};
+    if (cancelled_early.erase(key) > 0) {
+      sendStatus(result_writer, key, found->first, costar_msgs_action_dds__STATUS_CANCELED, "cancelled", "null");
+      return;
+    }
+    component::Component& component = *found->second;
+    const std::string operation = goal.operation;
+    try {
+      const component::OperationSpec* spec = component.description().operation(operation);
+      if (spec == nullptr) {
+        throw std::invalid_argument(component.description().name + " has no operation '" + operation + "'");
+      }
+      const auto params = component::paramsFromJson(spec->params, nlohmann::json::parse(goal.params_json));
+      const component::OperationId started = component.start(operation, params);
+      running.emplace(key, Running{&component, started, operation, {}});
+      reply(key, found->first, true, {});
+    } catch (const std::exception& error) {
+      reply(key, found->first, false, error.what());
+    }
+  }
+
+  void cancelGoal(const costar_msgs_action_dds__Operation_CancelGoal_Request_& cancel) {
+    const GoalKey key{cancel.goal_id.client, cancel.goal_id.number};
+    const auto it = running.find(key);
+    if (it == running.end()) {
+      if (components.contains(std::string_view(cancel.component))) {
+        cancelled_early.insert(key);
+        if (cancelled_early.size() > kCancelledEarlyLimit) {
+          cancelled_early.erase(cancelled_early.begin());
+        }
+      }
+      return;
+    }
+    it->second.component->cancel(it->second.id);
+    sendStatus(result_writer, it->first, it->second.component->description().name,
+               costar_msgs_action_dds__STATUS_CANCELED, "cancelled", "null");
+    running.erase(it);
+  }
+
+  void pollRunning() {
+    for (auto it = running.begin(); it != running.end();) {
+      Running& goal = it->second;
+      const std::string& name = goal.component->description().name;
+      component::OperationResult result;
+      try {
+        result = goal.component->poll(goal.id);
+      } catch (const std::exception& error) {
+        result = component::OperationResult::failure(name + ": " + goal.operation + " failed: " + error.what());
+      }
+      const std::string data = result.data.dump();
+      if (result.state == component::OperationState::kRunning) {
+        if (result.reason + '\n' + data != goal.last_sent) {
+          goal.last_sent = result.reason + '\n' + data;
+          sendStatus(feedback_writer, it->first, name, costar_msgs_action_dds__STATUS_EXECUTING, result.reason, data);
+        }
+        ++it;
+        continue;
+      }
+      const bool success = result.state == component::OperationState::kSuccess;
+      sendStatus(result_writer, it->first, name,
+                 success ? costar_msgs_action_dds__STATUS_SUCCEEDED : costar_msgs_action_dds__STATUS_ABORTED,
+                 result.reason, data);
+      it = running.erase(it);
+    }
+  }
+
+  void publishReports() {
+    for (const auto& [name, component] : components) {
+      std::string text;
+      try {
+        text = toJson(component->report()).dump();
+      } catch (const std::exception& error) {
+        // A report that cannot be read is a component that cannot be trusted: the proxy's
+        // report() throws with this reason, which stops the executor's cell.
+        text = nlohmann::json{{"error", name + ": " + error.what()}}.dump();
+      }
+      std::string& last = last_reports[name];
+      if (text == last) {
+        continue;
+      }
+      last = text;
+      costar_msgs_msg_dds__ComponentReport_ message{};
+      message.component = wire(name);
+      message.host_id = id;
+      message.report_json = wire(text);
+      Bus::write(report_writer, &message);
+    }
+  }
+
+  void heartbeat() {
+    static const std::string kHostName = hostName();
+    std::vector<char*> listed;
+    for (const auto& name : names) {
+      listed.push_back(wire(name));
+    }
+    costar_msgs_msg_dds__HostHeartbeat_ message{};
+    message.host_id = id;
+    message.pid = static_cast<std::int32_t>(::getpid());
+    message.hostname = wire(kHostName);
+    message.components._length = message.components._maximum = static_cast<std::uint32_t>(listed.size());
+    message.components._buffer = listed.data();
+    message.components._release = false;
+    message.sequence_number = heartbeats++;
+    Bus::write(heartbeat_writer, &message);
+  }
+};
+
+ComponentHost::ComponentHost(const RemoteConfig& config,
+                             std::vector<std::shared_ptr<component::Component>> components) {
+  if (components.empty()) {
+    throw std::invalid_argument("a component host needs at least one component to serve");
+  }
+  state_ = std::make_unique<State>(config);
+  for (auto& component : components) {
+    const std::string name = component->description().name;
+    if (!state_->components.emplace(name, std::move(component)).second) {
+      throw std::invalid_argument("component '" + name + "' given twice to one host");
+    }
+    state_->names.push_back(name);
+  }
+  Bus& bus = state_->bus;
+  state_->reply_writer = bus.writer(Topic::kSendGoalReply);
+  state_->feedback_writer = bus.writer(Topic::kFeedback);
+  state_->result_writer = bus.writer(Topic::kResult);
+  state_->description_writer = bus.writer(Topic::kDescription);
+  state_->report_writer = bus.writer(Topic::kReport);
+  state_->heartbeat_writer = bus.writer(Topic::kHeartbeat);
+  state_->goal_reader = bus.reader(Topic::kSendGoalRequest, nullptr);
+  state_->cancel_reader = bus.reader(Topic::kCancelGoalRequest, nullptr);
+  for (const auto& [name, component] : state_->components) {
+    const std::string description = component::toJson(component->description()).dump();
+    costar_msgs_msg_dds__ComponentDescription_ message{};
+    message.component = wire(name);
+    message.host_id = state_->id;
+    message.description_json = wire(description);
+    Bus::write(state_->description_writer, &message);
+  }
+  state_->publishReports();
+  state_->heartbeat();
+}
+
+ComponentHost::~ComponentHost() = default;
+
+std::uint64_t ComponentHost::id() const { return state_->id; }
+
+void ComponentHost::serve(const std::atomic<bool>& stop) {
+  State& state = *state_;
+  const dds_entity_t waitset = dds_create_waitset(state.bus.participant());
+  const dds_entity_t goals = dds_create_readcondition(state.goal_reader, DDS_ANY_STATE);
+  const dds_entity_t cancels = dds_create_readcondition(state.cancel_reader, DDS_ANY_STATE);
+  dds_waitset_attach(waitset, goals, 0);
+  dds_waitset_attach(waitset, cancels, 0);
+  auto next_heartbeat = SteadyClock::now() + kHeartbeatPeriod;
+  auto next_report = SteadyClock::now() + kReportPeriod;
+  while (!stop.load()) {
+    // Sleep until a goal or cancel arrives, the next poll of running operations or the next
+    // heartbeat, whichever is first.
+    const auto now = SteadyClock::now();
+    auto wake = std::min(next_heartbeat, next_report);
+    if (!state.running.empty()) {
+      wake = std::min(wake, now + kPollPeriod);
+    }
+    const auto wait = std::max(std::chrono::nanoseconds(0), wake - now);
+    dds_waitset_wait(waitset, nullptr, 0, static_cast<dds_duration_t>(wait.count()));
+    try {
+      Bus::takeAll<costar_msgs_action_dds__Operation_SendGoal_Request_>(
+          state.goal_reader, [&](const auto& goal) { state.startGoal(goal); });
+      Bus::takeAll<costar_msgs_action_dds__Operation_CancelGoal_Request_>(
+          state.cancel_reader, [&](const auto& cancel) { state.cancelGoal(cancel); });
+      state.pollRunning();
+      if (SteadyClock::now() >= next_report) {
+        state.publishReports();
+        next_report = SteadyClock::now() + kReportPeriod;
+      }
+      if (SteadyClock::now() >= next_heartbeat) {
+        state.heartbeat();
+        next_heartbeat = SteadyClock::now() + kHeartbeatPeriod;
+      }
+    } catch (const std::exception& error) {
+      spdlog::error("component host: {}", error.what());
+    }
+  }
+  for (auto& [key, goal] : state.running) {
+    goal.component->cancel(goal.id);
+  }
+  state.running.clear();
+  dds_delete(waitset);
+  dds_delete(goals);
+  dds_delete(cancels);
+}
+
+}  // namespace costar::dds

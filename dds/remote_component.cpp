@@ -1,0 +1,368 @@
+#include "dds/remote_component.h"
+
+#include <unistd.h>
+
+#include <condition_variable>
+#include <cstdio>
+#include <map>
+#include <mutex>
+#include <random>
+#include <set>
+#include <stdexcept>
+
+#include "component/description.h"
+#include "dds/bus.h"
+#include "dds/report_json.h"
+
+namespace costar::dds {
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+
+/// A goal that a live host has not answered in this long is given up.
+constexpr std::chrono::seconds kAnswerTimeout{2};
+
+std::uint64_t randomId() {
+  std::random_device device;
+  return (static_cast<std::uint64_t>(device()) << 32U) ^ device() ^ static_cast<std::uint64_t>(::getpid());
+}
+
+std::string seconds(SteadyClock::duration duration) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.2f", std::chrono::duration<double>(duration).count());
+  return text;
+}
+
+}  // namespace
+
+struct RemoteClient::State {
+  struct Host {
+    std::int32_t pid = 0;
+    std::string hostname;
+    SteadyClock::time_point heard;
+  };
+  struct Served {
+    std::string description_json;
+    std::uint64_t host_id = 0;
+    world::Report report;
+    std::string report_error;
+  };
+  struct Goal {
+    std::string component;
+    std::string operation;
+    std::uint64_t host_id = 0;
+    bool answered = false;
+    bool ended = false;
+    component::OperationResult latest;
+    SteadyClock::time_point sent;
+  };
+
+  explicit State(const RemoteConfig& remote) : config(remote), bus(remote) {}
+
+  RemoteConfig config;
+  Bus bus;
+  std::uint64_t client_id = randomId();
+  dds_entity_t goal_writer = 0, cancel_writer = 0;
+
+  mutable std::mutex mutex;
+  std::condition_variable heard;
+  std::map<std::uint64_t, Host> hosts;
+  std::map<std::string, Served, std::less<>> served;
+  std::map<component::OperationId, Goal> goals;
+  std::set<component::OperationId> cancelling;
+  std::set<component::OperationId> cancel_confirmed;
+  component::OperationId next_goal = 1;
+
+  /// Why `component`'s host `host_id` counts as gone, or empty while it answers. Under `mutex`.
+  std::string lost(const std::string& component, std::uint64_t host_id, SteadyClock::time_point now) const {
+    const auto host = hosts.find(host_id);
+    if (host == hosts.end()) {
+      return "component '" + component + "' has no host: none was heard on DDS domain " +
+             std::to_string(config.domain) + ", partition '" + config.partition + "'";
+    }
+    if (now - host->second.heard > kHostTimeout) {
+      return "component '" + component + "' stopped answering: its host (pid " + std::to_string(host->second.pid) +
+             " on " + host->second.hostname + ") has sent nothing for " + seconds(now - host->second.heard) + " s";
+    }
+    return {};
+  }
+
+  // The listeners, on DDS's receive thread.
+  void onReply(const costar_msgs_action_dds__Operation_SendGoal_Response_& reply) {
+    if (reply.goal_id.client != client_id) {
+      return;
+    }
+    std::lock_guard lock(mutex);
+    const auto goal = goals.find(reply.goal_id.number);
+    if (goal == goals.end()) {
+      return;
+    }
+    goal->second.answered = true;
+    goal->second.host_id = reply.host_id;
+    if (!reply.accepted) {
+      goal->second.ended = true;
+      goal->second.latest = component::OperationResult::failure(std::string(reply.component) + " rejected " +
+                                                                goal->second.operation + ": " + reply.reason);
+    }
+  }
+
+  void onStatus(const costar_msgs_action_dds__Operation_Status_& status, bool final) {
+    if (status.goal_id.client != client_id) {
+      return;
+    }
+    std::lock_guard lock(mutex);
+    if (cancelling.erase(status.goal_id.number) > 0) {
+      if (final) {
+        cancel_confirmed.insert(status.goal_id.number);
+      } else {
+        cancelling.insert(status.goal_id.number);
+      }
+      return;
+    }
+    const auto goal = goals.find(status.goal_id.number);
+    if (goal == goals.end() || goal->second.ended) {
+      return;
+    }
+    component::OperationResult result;
+    try {
+      result.data = nlohmann::json::parse(status.data_json);
+    } catch (const nlohmann::json::exception& error) {
+      result = component::OperationResult::failure(std::string(status.component) +
+                                                   ": the host sent a result that is not JSON: " + error.what());
+      goal->second.ended = true;
+      goal->second.latest = std::move(result);
+      return;
+    }
+    result.reason = status.reason;
+    switch (status.status) {
+      case costar_msgs_action_dds__STATUS_SUCCEEDED:
+        result.state = component::OperationState::kSuccess;
+        break;
+      case costar_msgs_action_dds__STATUS_ABORTED:
+        result.state = component::OperationState::kFailure;
+        break;
+      case costar_msgs_action_dds__STATUS_CANCELED:
+        result.state = component::OperationState::kFailure;
+        result.reason = std::string(status.component) + ": " + goal->second.operation + " was cancelled on its host";
+        break;
+      default:
+        result.state = component::OperationState::kRunning;
+        break;
+    }
+    goal->second.answered = true;
+    goal->second.host_id = status.host_id;
+    goal->second.ended = final;
+    goal->second.latest = std::move(result);
+  }
+
+  void onDescription(const costar_msgs_msg_dds__ComponentDescription_& description) {
+    std::lock_guard lock(mutex);
+    Served& entry = served[description.component];
+    entry.description_json = description.description_json;
+    entry.host_id = description.host_id;
+    heard.notify_all();
+  }
+
+  void onReport(const costar_msgs_msg_dds__ComponentReport_& report) {
+    world::Report parsed;
+    std::string error;
+    try {
+      const auto json = nlohmann::json::parse(report.report_json);
+      if (json.contains("error")) {
+        error = json["error"].get<std::string>();
+      } else {
+        parsed = reportFromJson(json);
+      }
+    } catch (const std::exception& failure) {
+      error = std::string(report.component) + ": its host sent a report that cannot be read: " + failure.what();
+    }
+    std::lock_guard lock(mutex);
+    Served& entry = served[report.component];
+    entry.report = std::move(parsed);
+    entry.report_error = std::move(error);
+  }
+
+  void onHeartbeat(const costar_msgs_msg_dds__HostHeartbeat_& heartbeat) {
+    std::lock_guard lock(mutex);
+    Host& host = hosts[heartbeat.host_id];
+    host.pid = heartbeat.pid;
+    host.hostname = heartbeat.hostname;
+    host.heard = SteadyClock::now();
+    heard.notify_all();
+  }
+
+  template <typename T, void (State::*Handle)(const T&)>
+  static void listen(dds_entity_t reader, void* self) {
+    Bus::takeAll<T>(reader, [self](const T& sample) { (static_cast<State*>(self)->*Handle)(sample); });
+  }
+  void onFeedback(const costar_msgs_action_dds__Operation_Status_& status) { onStatus(status, false); }
+  void onResult(const costar_msgs_action_dds__Operation_Status_& status) { onStatus(status, true); }
+};
+
+RemoteClient::RemoteClient(const RemoteConfig& config) : state_(std::make_unique<State>(config)) {
+  State& state = *state_;
+  state.goal_writer = state.bus.writer(Topic::kSendGoalRequest);
+  state.cancel_writer = state.bus.writer(Topic::kCancelGoalRequest);
+  const auto reader = [&](Topic topic, dds_on_data_available_fn on_data) {
+    dds_listener_t* listener = dds_create_listener(&state);
+    dds_lset_data_available(listener, on_data);
+    state.bus.reader(topic, listener);
+    dds_delete_listener(listener);
+  };
+  using S = State;
+  reader(Topic::kSendGoalReply, &S::listen<costar_msgs_action_dds__Operation_SendGoal_Response_, &S::onReply>);
+  reader(Topic::kFeedback, &S::listen<costar_msgs_action_dds__Operation_Status_, &S::onFeedback>);
+  reader(Topic::kResult, &S::listen<costar_msgs_action_dds__Operation_Status_, &S::onResult>);
+  reader(Topic::kDescription, &S::listen<costar_msgs_msg_dds__ComponentDescription_, &S::onDescription>);
+  reader(Topic::kReport, &S::listen<costar_msgs_msg_dds__ComponentReport_, &S::onReport>);
+  reader(Topic::kHeartbeat, &S::listen<costar_msgs_msg_dds__HostHeartbeat_, &S::onHeartbeat>);
+}
+
+// Deleting the participant first stops the listeners before the state they use goes.
+RemoteClient::~RemoteClient() { dds_delete(state_->bus.participant()); }
+
+std::shared_ptr<RemoteClient> RemoteClient::create(const RemoteConfig& config) {
+  return std::shared_ptr<RemoteClient>(new RemoteClient(config));
+}
+
+std::shared_ptr<RemoteComponent> RemoteClient::connect(const std::string& component,
+                                                       std::chrono::milliseconds timeout) {
+  State& state = *state_;
+  const auto deadline = SteadyClock::now() + timeout;
+  const auto matched = [&](dds_entity_t writer) {
+    dds_publication_matched_status_t status{};
+    return dds_get_publication_matched_status(writer, &status) == DDS_RETCODE_OK && status.current_count > 0;
+  };
+  std::unique_lock lock(state.mutex);
+  for (;;) {
+    const auto served = state.served.find(component);
+    if (served != state.served.end() && !served->second.description_json.empty() &&
+        state.lost(component, served->second.host_id, SteadyClock::now()).empty() && matched(state.goal_writer) &&
+        matched(state.cancel_writer)) {
+      try {
+        auto description = component::descriptionFromJson(nlohmann::json::parse(served->second.description_json));
+        lock.unlock();
+        return std::make_shared<RemoteComponent>(shared_from_this(), std::move(description));
+      } catch (const std::exception& error) {
+        throw std::runtime_error("component '" + component +
+                                 "': its host sent a description that cannot be read: " + error.what());
+      }
+    }
+    if (SteadyClock::now() >= deadline) {
+      throw std::runtime_error("component '" + component + "': no host serves it on DDS domain " +
+                               std::to_string(state.config.domain) + ", partition '" + state.config.partition +
+                               "', interface '" + state.config.network_interface + "' (waited " + seconds(timeout) +
+                               " s; start one with `costar host " + component + "`)");
+    }
+    state.heard.wait_for(lock, std::chrono::milliseconds(10));
+  }
+}
+
+RemoteComponent::RemoteComponent(std::shared_ptr<RemoteClient> client, component::ComponentDescription description)
+    : client_(std::move(client)), description_(std::move(description)) {}
+
+component::OperationId RemoteComponent::start(const std::string& operation, const component::ParamMap& params) {
+  RemoteClient::State& state = *client_->state_;
+  const std::string params_json = component::toJson(params).dump();
+  component::OperationId id = 0;
+  {
+    std::lock_guard lock(state.mutex);
+    const auto served = state.served.find(description_.name);
+    const std::uint64_t host_id = served == state.served.end() ? 0 : served->second.host_id;
+    if (std::string reason = state.lost(description_.name, host_id, SteadyClock::now()); !reason.empty()) {
+      throw std::runtime_error(reason);
+    }
+    id = state.next_goal++;
+    RemoteClient::State::Goal& goal = state.goals[id];
+    goal.component = description_.name;
+    goal.operation = operation;
+    goal.host_id = host_id;
+    goal.sent = SteadyClock::now();
+  }
+  costar_msgs_action_dds__Operation_SendGoal_Request_ message{};
+  message.goal_id = {state.client_id, id};
+  message.component = wire(description_.name);
+  message.operation = wire(operation);
+  message.params_json = wire(params_json);
+  try {
+    Bus::write(state.goal_writer, &message);
+  } catch (...) {
+    std::lock_guard lock(state.mutex);
+    state.goals.erase(id);
+    throw;
+  }
+  return id;
+}
+
+component::OperationResult RemoteComponent::poll(component::OperationId id) {
+  RemoteClient::State& state = *client_->state_;
+  std::lock_guard lock(state.mutex);
+  const auto it = state.goals.find(id);
+  if (it == state.goals.end()) {
+    throw std::invalid_argument(description_.name + ": unknown operation id " + std::to_string(id));
+  }
+  const RemoteClient::State::Goal& goal = it->second;
+  component::OperationResult result = goal.latest;
+  const auto now = SteadyClock::now();
+  if (!goal.ended) {
+    const auto served = state.served.find(description_.name);
+    if (std::string reason = state.lost(description_.name, goal.host_id, now); !reason.empty()) {
+      result = component::OperationResult::failure(reason + "; " + goal.operation + " ended with it");
+    } else if (served != state.served.end() && served->second.host_id != goal.host_id) {
+      result = component::OperationResult::failure("component '" + description_.name + "': its host was replaced; " +
+                                                   goal.operation + " ended with the old one");
+    } else if (!goal.answered && now - goal.sent > kAnswerTimeout) {
+      result = component::OperationResult::failure("component '" + description_.name + "': its host did not answer " +
+                                                   goal.operation + " within " + seconds(kAnswerTimeout) + " s");
+    } else {
+      return result;
+    }
+  }
+  state.goals.erase(it);
+  return result;
+}
+
+void RemoteComponent::cancel(component::OperationId id) {
+  RemoteClient::State& state = *client_->state_;
+  {
+    std::lock_guard lock(state.mutex);
+    const auto it = state.goals.find(id);
+    if (it == state.goals.end()) {
+      return;
+    }
+    const bool ended = it->second.ended;
+    state.goals.erase(it);
+    if (ended) {
+      return;
+    }
+    state.cancelling.insert(id);
+  }
+  costar_msgs_action_dds__Operation_CancelGoal_Request_ message{};
+  message.goal_id = {state.client_id, id};
+  message.component = wire(description_.name);
+  // A cancel that cannot be sent leaves the host's operation to the host's own end (its
+  // heartbeat is checked by the next start); cancel() itself never throws.
+  dds_write(state.cancel_writer, &message);
+}
+
+bool RemoteComponent::cancelConfirmed(component::OperationId id) const {
+  const RemoteClient::State& state = *client_->state_;
+  std::lock_guard lock(state.mutex);
+  return state.cancel_confirmed.contains(id);
+}
+
+world::Report RemoteComponent::report() const {
+  const RemoteClient::State& state = *client_->state_;
+  std::lock_guard lock(state.mutex);
+  const auto served = state.served.find(description_.name);
+  const std::uint64_t host_id = served == state.served.end() ? 0 : served->second.host_id;
+  if (std::string reason = state.lost(description_.name, host_id, SteadyClock::now()); !reason.empty()) {
+    throw std::runtime_error(reason);
+  }
+  if (!served->second.report_error.empty()) {
+    throw std::runtime_error(served->second.report_error);
+  }
+  return served->second.report;
+}
+
+}  // namespace costar::dds
