@@ -59,6 +59,7 @@ std::string personBodiesMjcf(const PersonSpec& spec) {
   const std::string hand =
       R"(contype="1" conaffinity="2" condim="4" friction="1.2 0.02 0.001" rgba="0.87 0.68 0.55 1")";
   const std::string limb = R"(contype="0" conaffinity="2" rgba="0.87 0.68 0.55 1")";
+  const std::string palm = R"(contype="0" conaffinity="0" mass="0.001" rgba="0.7 0.48 0.48 1")";
   const std::string cloth = R"(contype="0" conaffinity="2" rgba="0.25 0.35 0.55 1")";
   std::string xml;
   // The hand is a free body welded to its mocap target (person_hand_target): it moves with real
@@ -67,6 +68,9 @@ std::string personBodiesMjcf(const PersonSpec& spec) {
          "\"/>\n";
   xml += "<body name=\"person_hand\" pos=\"" + vec(rest.wrist) + "\" quat=\"" + quat(rest.hand) + "\"><freejoint/>";
   xml += "<geom name=\"person_palm\" type=\"box\" pos=\"0.05 0 0\" size=\"0.05 0.042 0.012\" " + hand + "/>";
+  // The palm's pinker skin on its palm side (-z), seen only: the camera tells a palm turned up by it.
+  xml +=
+      "<geom name=\"person_palm_skin\" type=\"box\" pos=\"0.05 0 -0.0122\" size=\"0.048 0.04 0.0004\" " + palm + "/>";
   xml += "<body name=\"person_fingers\" pos=\"0.1 0 0\">";
   xml += "<joint name=\"person_fingers_joint\" type=\"hinge\" axis=\"0 1 0\" range=\"0 " +
          format(kFingersClosed + 0.2) + "\" damping=\"0.05\" armature=\"0.0005\"/>";

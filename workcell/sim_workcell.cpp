@@ -19,6 +19,7 @@
 #include "component/operation_table.h"
 #include "core/paths.h"
 #include "faults/injector.h"
+#include "perception/hand_component.h"
 #include "perception/perception_component.h"
 #include "perception/pipeline.h"
 #include "planning/collision_world.h"
@@ -345,6 +346,13 @@ class SimWorkcell final : public Workcell {
       perception_config.camera_pose = [calibration = calibration_.get()] { return calibration->cameraPose(); };
       add(std::make_shared<perception::PerceptionComponent>(camera, clock(), threadPipeline(perception_config),
                                                             perception_config));
+      if (scene_.person) {
+        // The person's hand as the camera sees it (hand_1, gesture(hand_1, offer), in_zone).
+        perception::HandComponentConfig hand_config;
+        hand_config.detector.table_center = tableCenter();
+        hand_config.camera_pose = perception_config.camera_pose;
+        add(std::make_shared<perception::HandComponent>(camera, clock(), hand_config));
+      }
     }
     smartmove::SmartMoveConfig smartmove_config;
     smartmove_config.gripper_links = gripperLinks(robot_description_, gripper_model_);

@@ -1,5 +1,5 @@
 // The simulated cell with a person (docs/PERSON.md): the speed and separation monitor's
-// reading in the world state, as the editor and plans see it.
+// reading and the hand the camera sees in the world state, as the editor and plans see them.
 #include <gtest/gtest.h>
 
 #include "core/paths.h"
@@ -41,6 +41,35 @@ TEST(PersonSimWorkcell, TheMonitorsReadingIsInTheWorldStateWhenTheSceneHasAPerso
       makeWorkcell({.name = "iiwa-3f-sim", .scene = dataRoot() / "sim/scenes/one_node.json", .memory_only = true});
   none->beforeTick();
   EXPECT_EQ(none->components().world().symbol("person_separation"), nullptr);
+  EXPECT_EQ(none->components().world().symbol("hand_1"), nullptr);
+}
+
+bool holds(const world::WorldState& world, const std::string& name, std::vector<std::string> args) {
+  return world.holds(name, args);
+}
+
+TEST(PersonSimWorkcell, TheHandAndItsGestureAreInTheWorldStateAsTheCameraSeesThem) {
+  // The person reaches into the hand-over zone (1.2 s) and offers an open palm for 3 s.
+  const auto cell =
+      makeWorkcell({.name = "iiwa-3f-sim", .scene = dataRoot() / "sim/scenes/person_offer.json", .memory_only = true});
+  const world::WorldState& world = cell->components().world();
+  bool gesture_before_the_offer = false;
+  for (int i = 0; i < 56; ++i) {  // to 2.8 s
+    static_cast<SimClock&>(cell->clock()).advanceBy(std::chrono::milliseconds(50));
+    cell->beforeTick();
+    gesture_before_the_offer = gesture_before_the_offer || (i < 20 && holds(world, "gesture", {"hand_1", "offer"}));
+  }
+  EXPECT_FALSE(gesture_before_the_offer);  // reaching: the hand moves
+  const world::Symbol* hand = world.symbol("hand_1");
+  ASSERT_NE(hand, nullptr);
+  ASSERT_NE(hand->frame(), nullptr);
+  EXPECT_LT((hand->frame()->pose.translation() - Eigen::Vector3d(0.5, 0.24, 0.2)).norm(),
+            0.04);  // 6 cm from the wrist along the hand
+  EXPECT_TRUE(holds(world, "gesture", {"hand_1", "offer"}));
+  EXPECT_TRUE(holds(world, "in_zone", {"hand_1", "handover"}));
+  EXPECT_TRUE(holds(world, "hand_still", {"hand_1"}));
+  EXPECT_GT(number(*cell, "hand_still_seconds"), 0.5);
+  EXPECT_FALSE(holds(world, "is_a", {"hand_1", "node"}));
 }
 
 }  // namespace
