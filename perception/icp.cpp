@@ -59,7 +59,14 @@ IcpResult refinePose(const ObjectModel& model, const std::vector<Eigen::Vector3f
       const double weight = std::abs(r) < knee ? 1.0 : knee / std::abs(r);
       Eigen::Matrix<double, 6, 1> j;
       j << qd.cross(n), n;
-      a.noalias() += weight * j * j.transpose();
+      // The lower triangle only (all the LDLT solve below reads), each term as Eigen's outer
+      // product forms it: the same sums as the whole matrix's lower half.
+      const Eigen::Matrix<double, 6, 1> weighted = weight * j;
+      for (int col = 0; col < 6; ++col) {
+        for (int row = col; row < 6; ++row) {
+          a(row, col) += j(col) * weighted(row);
+        }
+      }
       b.noalias() += weight * j * r;
       // An optional weak point-to-point term: past an edge, the nearest sample of a face says
       // nothing along the face, and this term still pulls (an elongated object sliding along
@@ -81,7 +88,8 @@ IcpResult refinePose(const ObjectModel& model, const std::vector<Eigen::Vector3f
     if (inliers < 6) {
       break;
     }
-    // Damped normal equations: directions the visible surface does not constrain stay put.
+    // Damped normal equations: directions the visible surface does not constrain stay put. (Only
+    // the lower triangle of `a` is filled: LDLT reads no more.)
     a.diagonal().array() += 1e-9 + 1e-6 * a.trace() / 6.0;
     const Eigen::Matrix<double, 6, 1> x = a.ldlt().solve(-b);
     Eigen::Isometry3d step = Eigen::Isometry3d::Identity();

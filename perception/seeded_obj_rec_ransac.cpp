@@ -1,5 +1,7 @@
 #include "perception/seeded_obj_rec_ransac.h"
 
+#include "perception/transform_votes.h"
+
 #include <pcl/recognition/ransac_based/obj_rec_ransac.h>
 
 #include <Eigen/SVD>
@@ -18,7 +20,6 @@ namespace {
 using pcl::recognition::ModelLibrary;
 using pcl::recognition::ORROctree;
 using pcl::recognition::ORROctreeZProjection;
-using pcl::recognition::RigidTransformSpace;
 
 /// The protected parts of PCL's ModelLibrary that adding a model uses, reached through the
 /// library's own type (no copy of its code): the models, and the hash table of point pairs.
@@ -68,25 +69,6 @@ class ProjectionRelease final : public ORROctreeZProjection {
     }
     projection.*(&ProjectionRelease::num_pixels_x_) = 0;
     projection.*(&ProjectionRelease::num_pixels_y_) = 0;
-  }
-};
-
-/// The rigid transform space, adding a transform only where it has a cell: PCL's
-/// addRigidTransform prints a warning for a position outside the space (a hypothesis whose
-/// model centre falls outside the enlarged scene bounds), which is dropped either way.
-class TransformSpace final : public RigidTransformSpace {
- public:
-  void add(const ModelLibrary::Model* model, const float position[3], const float rigid_transform[12]) {
-    pcl::recognition::RotationSpaceOctree::Node* leaf = pos_octree_.createLeaf(position[0], position[1], position[2]);
-    if (leaf == nullptr) {
-      return;
-    }
-    float angle = 0.0f;
-    float axis_angle[3];
-    pcl::recognition::aux::rotationMatrixToAxisAngle(rigid_transform, axis_angle, angle);
-    pcl::recognition::aux::mult3(axis_angle, angle);
-    // Inside [-pi, pi]^3, which the rotation space's octree holds with room to spare.
-    leaf->getData().addRigidTransform(model, axis_angle, rigid_transform + 9);
   }
 };
 
@@ -278,7 +260,7 @@ class SeededObjRecRansac::Recognizer final : public pcl::recognition::ObjRecRANS
   /// The hypotheses voted into the rigid transform space (the scene's bounds, enlarged); of each
   /// occupied rotation space, the transform with the most votes (its neighbours' counting), if
   /// it passes the visibility and penalty tests, goes into `grouped` at the space's centre.
-  void group(const std::list<pcl::recognition::HypothesisBase>& hypotheses, HypothesisOctree& grouped) const {
+  void group(const std::list<pcl::recognition::HypothesisBase>& hypotheses, HypothesisOctree& grouped) {
     float b[6];
     scene_octree_.getBounds(b);
     const float enlarge = scene_bounds_enlargement_factor_ * std::max(std::max(b[1] - b[0], b[3] - b[2]), b[5] - b[4]);
@@ -290,28 +272,27 @@ class SeededObjRecRansac::Recognizer final : public pcl::recognition::ObjRecRANS
     b[5] += enlarge;
     HypothesisCreator creator;
     grouped.build(b, position_discretization_, &creator);
-    TransformSpace space;
+    // PCL's RigidTransformSpace without its nodes (transform_votes.h); every hypothesis is of
+    // the one model. A position outside the space is dropped (PCL prints a warning for it).
+    TransformVotes& space = votes_;
     space.build(b, position_discretization_, rotation_discretization_);
     float centre[3];
     for (const pcl::recognition::HypothesisBase& hypothesis : hypotheses) {
       pcl::recognition::aux::transform(hypothesis.rigid_transform_, hypothesis.obj_model_->getOctreeCenterOfMass(),
                                        centre);
-      space.add(hypothesis.obj_model_, centre, hypothesis.rigid_transform_);
+      space.add(centre, hypothesis.rigid_transform_);
     }
     const float leaves = static_cast<float>(model_->getOctree().getFullLeaves().size());
     const float match_threshold = leaves * visibility_;
     const int penalty_threshold = static_cast<int>(leaves * relative_num_of_illegal_pts_ + 0.5f);
-    for (pcl::recognition::RotationSpace* rotation_space : space.getRotationSpaces()) {
+    for (const TransformVotes::Winner& winner : space.winners()) {
       pcl::recognition::Hypothesis hypothesis(model_);
-      if (!rotation_space->getTransformWithMostVotes(model_, hypothesis.rigid_transform_)) {
-        continue;
-      }
+      std::copy(winner.rigid_transform.begin(), winner.rigid_transform.end(), hypothesis.rigid_transform_);
       int match = 0;
       int penalty = 0;
       test(hypothesis, match, penalty);
       if (match >= match_threshold && penalty <= penalty_threshold && hypothesis.match_confidence_ > 0.0f) {
-        const float* c = rotation_space->getCenter();
-        grouped.createLeaf(c[0], c[1], c[2])->setData(hypothesis);
+        grouped.createLeaf(winner.centre[0], winner.centre[1], winner.centre[2])->setData(hypothesis);
       }
     }
   }
@@ -337,6 +318,8 @@ class SeededObjRecRansac::Recognizer final : public pcl::recognition::ObjRecRANS
   }
 
   const ModelLibrary::Model* model_ = nullptr;
+  /// Kept from run to run: it remembers its rotation octree's neighbour lookups.
+  TransformVotes votes_;
 };
 
 SeededObjRecRansac::SeededObjRecRansac(const std::vector<Eigen::Vector3f>& points,
