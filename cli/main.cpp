@@ -6,6 +6,7 @@
 
 #include "cli/calibrate_command.h"
 #include "cli/describe_command.h"
+#include "cli/host_command.h"
 #include "cli/perception_commands.h"
 #include "cli/plan_commands.h"
 #include "cli/serve_command.h"
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
   costar::cli::addTrialsCommand(app, exit_code);
   costar::cli::addCalibrateCommand(app, exit_code);
   costar::cli::addServeCommand(app, exit_code);
+  costar::cli::addHostCommand(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

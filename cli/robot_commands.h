@@ -31,6 +31,7 @@ inline constexpr std::array kRobotCommands = {
                  "Calibrate the camera: the arm shows the marker on its gripper to the camera from poses it chooses, "
                  "and the camera's pose is saved with the cell (the editor's Calibrate button)"},
     RobotCommand{"serve", "Serve the task editor (a web page) and its API: build, run and watch plans on a workcell"},
+    RobotCommand{"host", "Serve components of a workcell to an executor in another process or machine (DDS)"},
 };
 
 }  // namespace costar::cli

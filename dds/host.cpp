@@ -234,7 +234,7 @@ ComponentHost::~ComponentHost() = default;
 
 std::uint64_t ComponentHost::id() const { return state_->id; }
 
-void ComponentHost::serve(const std::atomic<bool>& stop) {
+void ComponentHost::serve(const std::atomic<bool>& stop, const std::function<void()>& each_cycle) {
   State& state = *state_;
   const dds_entity_t waitset = dds_create_waitset(state.bus.participant());
   const dds_entity_t goals = dds_create_readcondition(state.goal_reader, DDS_ANY_STATE);
@@ -254,6 +254,9 @@ void ComponentHost::serve(const std::atomic<bool>& stop) {
     const auto wait = std::max(std::chrono::nanoseconds(0), wake - now);
     dds_waitset_wait(waitset, nullptr, 0, static_cast<dds_duration_t>(wait.count()));
     try {
+      if (each_cycle) {
+        each_cycle();
+      }
       Bus::takeAll<costar_msgs_action_dds__Operation_SendGoal_Request_>(
           state.goal_reader, [&](const auto& goal) { state.startGoal(goal); });
       Bus::takeAll<costar_msgs_action_dds__Operation_CancelGoal_Request_>(

@@ -28,9 +28,11 @@ class ComponentHost {
   ComponentHost& operator=(const ComponentHost&) = delete;
   ~ComponentHost();
 
-  /// Serves until `stop` is set (noticed within kHeartbeatPeriod). Cancels the operations still
+  /// Serves until `stop` is set (noticed within kHeartbeatPeriod). `each_cycle` (if given) runs
+  /// on this thread before the goals and running operations of each cycle are handled (a
+  /// workcell refreshes its world and advances its clock there). Cancels the operations still
   /// running when it returns.
-  void serve(const std::atomic<bool>& stop);
+  void serve(const std::atomic<bool>& stop, const std::function<void()>& each_cycle = {});
 
   /// This host's identity on the wire (random, new for every host).
   std::uint64_t id() const;

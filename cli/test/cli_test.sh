@@ -58,6 +58,8 @@ printf '<root BTCPP_format="4"><BehaviorTree ID="m">\n<AlwaysSuccess name="a&#xD
 check "surrogate reference"     2 "surrogate\.xml:2: column 23: the character reference '&#xD800;' is not a character XML allows" \
   -- "$costar" run "$tmp/surrogate.xml" -w none
 check "calibrate: bad cell" 2 "unknown workcell .nosuch." -- "$costar" calibrate -w nosuch
+check "host: unknown component" 2 "workcell .test. has no component .gripper. \(it has: test_logger, test_actions" \
+  -- "$costar" host gripper -w test
 check "help"                0 'Exit code: 0 SUCCESS' -- "$costar" run --help
 check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit 0.1
 check "inject: bad spec"    2 "fault 'melt:arm@t=1': unknown kind 'melt'" \
