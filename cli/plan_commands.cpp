@@ -94,6 +94,11 @@ void addWorkcellOptions(CLI::App* command, workcell::WorkcellOptions& options) {
       ->check(wholeNumber());
   command->add_option("--waypoints", options.waypoints,
                       "waypoint file (default " + workcell::defaultWaypointFile("<workcell>").string() + ")");
+  command
+      ->add_option("--remote", options.remote,
+                   "JSON file naming the components served by `costar host` elsewhere, over DDS: {\"components\": "
+                   "[...], \"domain\", \"partition\", \"interface\"} (test cell only)")
+      ->check(CLI::ExistingFile);
 }
 
 std::unique_ptr<workcell::Workcell> openWorkcell(const workcell::WorkcellOptions& options, WorkcellUse use) {

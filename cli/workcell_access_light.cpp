@@ -10,8 +10,8 @@ std::unique_ptr<workcell::Workcell> openWorkcellFor(const workcell::WorkcellOpti
   if (auto cell = workcell::makeLightWorkcell(options)) {
     return cell;
   }
-  if (!options.inject.empty() || options.faults) {
-    runInRobotBinary();  // the fault injector lives with the robot libraries
+  if (!options.inject.empty() || options.faults || !options.remote.empty()) {
+    runInRobotBinary();  // the fault injector and DDS live with the robot libraries
   }
   // A robot cell. Its description (written at build time by `costar-robot describe-workcell`)
   // holds its node types for the default scene; another scene may have other object classes.

@@ -52,7 +52,11 @@ struct ComponentHost::State {
   std::map<std::string, std::shared_ptr<component::Component>, std::less<>> components;
   std::vector<std::string> names;
   std::map<GoalKey, Running> running;
-  std::map<std::string, std::string> last_reports;
+  struct SentReport {
+    std::string json;
+    std::uint64_t number = 0;
+  };
+  std::map<std::string, SentReport, std::less<>> last_reports;
   /// Cancels that came before their goal (the two travel on different topics, in no set
   /// order): the goal is then never started. Bounded: the oldest are dropped.
   std::set<GoalKey> cancelled_early;
@@ -71,6 +75,8 @@ struct ComponentHost::State {
     message.status = status;
     message.reason = wire(reason);
     message.data_json = wire(data_json);
+    const auto report = last_reports.find(component);
+    message.report_number = report == last_reports.end() ? 0 : report->second.number;
     Bus::write(writer, &message);
   }
 
@@ -147,6 +153,8 @@ struct ComponentHost::State {
         ++it;
         continue;
       }
+      // Its effect first: the report as the operation left it, then its end.
+      publishReport(name, *goal.component);
       const bool success = result.state == component::OperationState::kSuccess;
       sendStatus(result_writer, it->first, name,
                  success ? costar_msgs_action_dds__STATUS_SUCCEEDED : costar_msgs_action_dds__STATUS_ABORTED,
@@ -157,22 +165,31 @@ struct ComponentHost::State {
 
   void publishReports() {
     for (const auto& [name, component] : components) {
+      publishReport(name, *component);
+    }
+  }
+
+  /// Publishes the component's report when it changed since the last one sent.
+  void publishReport(const std::string& name, const component::Component& component) {
+    {
       std::string text;
       try {
-        text = toJson(component->report()).dump();
+        text = toJson(component.report()).dump();
       } catch (const std::exception& error) {
         // A report that cannot be read is a component that cannot be trusted: the proxy's
         // report() throws with this reason, which stops the executor's cell.
         text = nlohmann::json{{"error", name + ": " + error.what()}}.dump();
       }
-      std::string& last = last_reports[name];
-      if (text == last) {
-        continue;
+      SentReport& last = last_reports[name];
+      if (text == last.json) {
+        return;
       }
-      last = text;
+      last.json = text;
+      ++last.number;
       costar_msgs_msg_dds__ComponentReport_ message{};
       message.component = wire(name);
       message.host_id = id;
+      message.number = last.number;
       message.report_json = wire(text);
       Bus::write(report_writer, &message);
     }

@@ -45,6 +45,8 @@ struct RemoteClient::State {
     std::string description_json;
     std::uint64_t host_id = 0;
     world::Report report;
+    std::uint64_t report_host = 0;  // the host that sent the report held, and its count
+    std::uint64_t report_number = 0;
     std::string report_error;
   };
   struct Goal {
@@ -54,6 +56,8 @@ struct RemoteClient::State {
     bool answered = false;
     bool ended = false;
     component::OperationResult latest;
+    /// The report the latest state needs (shown once the component's report has it).
+    std::uint64_t report_number = 0;
     SteadyClock::time_point sent;
   };
 
@@ -153,6 +157,7 @@ struct RemoteClient::State {
     goal->second.host_id = status.host_id;
     goal->second.ended = final;
     goal->second.latest = std::move(result);
+    goal->second.report_number = status.report_number;
   }
 
   void onDescription(const costar_msgs_msg_dds__ComponentDescription_& description) {
@@ -178,6 +183,11 @@ struct RemoteClient::State {
     }
     std::lock_guard lock(mutex);
     Served& entry = served[report.component];
+    if (entry.report_host == report.host_id && report.number <= entry.report_number) {
+      return;  // an older report of this host than the one held
+    }
+    entry.report_host = report.host_id;
+    entry.report_number = report.number;
     entry.report = std::move(parsed);
     entry.report_error = std::move(error);
   }
@@ -304,8 +314,12 @@ component::OperationResult RemoteComponent::poll(component::OperationId id) {
   const RemoteClient::State::Goal& goal = it->second;
   component::OperationResult result = goal.latest;
   const auto now = SteadyClock::now();
-  if (!goal.ended) {
-    const auto served = state.served.find(description_.name);
+  const auto served = state.served.find(description_.name);
+  // An end is shown with the report it left (until then the operation is still running here).
+  const bool report_in =
+      goal.report_number == 0 || (served != state.served.end() && served->second.report_host == goal.host_id &&
+                                  served->second.report_number >= goal.report_number);
+  if (!goal.ended || !report_in) {
     if (std::string reason = state.lost(description_.name, goal.host_id, now); !reason.empty()) {
       result = component::OperationResult::failure(reason + "; " + goal.operation + " ended with it");
     } else if (served != state.served.end() && served->second.host_id != goal.host_id) {
@@ -315,7 +329,7 @@ component::OperationResult RemoteComponent::poll(component::OperationId id) {
       result = component::OperationResult::failure("component '" + description_.name + "': its host did not answer " +
                                                    goal.operation + " within " + seconds(kAnswerTimeout) + " s");
     } else {
-      return result;
+      return goal.ended ? component::OperationResult::running() : result;
     }
   }
   state.goals.erase(it);

@@ -137,8 +137,8 @@ std::unique_ptr<Workcell> makeBareWorkcell() { return std::make_unique<BareWorkc
 
 std::unique_ptr<Workcell> makeLightWorkcell(const WorkcellOptions& options) {
   const std::string& name = options.name;
-  if (options.faults || !options.inject.empty()) {
-    return nullptr;  // faults are injected by makeWorkcell (costar_workcell links the injector)
+  if (options.faults || !options.inject.empty() || !options.remote.empty()) {
+    return nullptr;  // faults and remote components: makeWorkcell (costar_workcell links them)
   }
   if (name == "test") {
     return std::make_unique<TestWorkcell>(ComponentWrapper{}, nullptr);

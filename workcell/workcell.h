@@ -63,6 +63,11 @@ struct WorkcellOptions {
   /// The same as fault specs (faults/fault.h grammar), for the CLI: the executable that builds
   /// the cell makes the injector from them (seeded with `seed`, else 1) when `faults` is null.
   std::vector<std::string> inject;
+  /// A JSON file naming the components that run in hosts elsewhere (`costar host`), reached over
+  /// DDS: {"domain", "partition", "interface", "components"} (dds/remote_config.h). Empty: every
+  /// component runs in this process. Only the "test" cell for now: a simulated cell's components
+  /// share its simulation in one process.
+  std::filesystem::path remote;
   /// Simulated cells: a spare part of each class named here, parked off the table, for a
   /// disturbance that puts a part on it mid-task (sim::SimulationOptions::spare_classes).
   std::vector<std::string> spare_parts;
@@ -127,8 +132,8 @@ void requireKnownWorkcell(const std::string& name);
 std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& options);
 
 /// Creates a workcell that needs none of the robot libraries ("test", "none"), or returns
-/// nullptr for a known robot cell ("ur5-sim") and for any cell with faults to inject, which
-/// only makeWorkcell() builds. In
+/// nullptr for a known robot cell ("ur5-sim") and for any cell with faults to inject or remote
+/// components, which only makeWorkcell() builds. In
 /// costar_workcell_base, with the light `costar` executable.
 /// @throws std::invalid_argument naming the known ones for an unknown name.
 std::unique_ptr<Workcell> makeLightWorkcell(const WorkcellOptions& options);

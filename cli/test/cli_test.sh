@@ -60,6 +60,32 @@ check "surrogate reference"     2 "surrogate\.xml:2: column 23: the character re
 check "calibrate: bad cell" 2 "unknown workcell .nosuch." -- "$costar" calibrate -w nosuch
 check "host: unknown component" 2 "workcell .test. has no component .gripper. \(it has: test_logger, test_actions" \
   -- "$costar" host gripper -w test
+# Components served by `costar host` in another process, over DDS on loopback, in a partition
+# of this test's own.
+cat >"$tmp/remote.xml" <<'XML'
+<root BTCPP_format="4"><BehaviorTree ID="main"><Sequence>
+  <TestLog message="remote"/><TestAction polls="3"/><TestCount counter="parts"/>
+  <Fallback><TestAction result="failure" reason="jammed" polls="2"/><TestAction polls="1"/></Fallback>
+</Sequence></BehaviorTree></root>
+XML
+cat >"$tmp/remote_fails.xml" <<'XML'
+<root BTCPP_format="4"><BehaviorTree ID="main"><TestAction result="failure" reason="remote jam" polls="2"/></BehaviorTree></root>
+XML
+partition="cli-test-$$"
+printf '{"partition": "%s", "components": ["test_actions", "test_counter"]}' "$partition" >"$tmp/remote.json"
+"$costar" host test_actions test_counter -w test --partition "$partition" 2>"$tmp/host.log" &
+host_pid=$!
+check "remote: run"         0 '^SUCCESS' -- "$costar" run "$tmp/remote.xml" -w test --remote "$tmp/remote.json"
+check "remote: failure"     1 'FAILURE at .*remote jam' -- "$costar" run "$tmp/remote_fails.xml" -w test --remote "$tmp/remote.json"
+kill "$host_pid"; wait "$host_pid"
+check "remote: host ended"  0 'serving test_actions test_counter of test on DDS domain 0' -- cat "$tmp/host.log"
+check "remote: no host"     2 "component 'test_actions': no host serves it on DDS domain 0, partition 'cli-test-" \
+  -- "$costar" run "$tmp/remote.xml" -w test --remote "$tmp/remote.json"
+printf '{"partition": "%s", "components": ["gripper"]}' "$partition" >"$tmp/remote_bad.json"
+check "remote: unknown"     2 "remote_bad.json: components: the test cell has no component 'gripper'" \
+  -- "$costar" run "$tmp/remote.xml" -w test --remote "$tmp/remote_bad.json"
+check "remote: sim cell"    2 "the components of 'ur5-sim' cannot run in other processes yet" \
+  -- "$costar" run "$tmp/remote.xml" -w ur5-sim --remote "$tmp/remote.json"
 check "help"                0 'Exit code: 0 SUCCESS' -- "$costar" run --help
 check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit 0.1
 check "inject: bad spec"    2 "fault 'melt:arm@t=1': unknown kind 'melt'" \
