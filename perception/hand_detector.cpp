@@ -93,13 +93,17 @@ std::optional<HandObservation> detectHand(const camera::RgbdFrame& frame, const 
   const Eigen::Vector3d tip_t = table_points[tip].cast<double>();
   std::vector<Eigen::Vector3d> hand;
   int palm_coloured = 0;
+  Eigen::Vector3d palm_sum = Eigen::Vector3d::Zero();
   for (const int i : *largest) {
     const Eigen::Vector3d p = table_points[i].cast<double>();
     const double from_tip = (p - tip_t).norm();
     if (from_tip <= options.hand_radius) {
       hand.push_back(p);
       const Chromaticity c = chromaticity(frame.rgb.pixels.data() + static_cast<std::size_t>(pixels[i]) * 3);
-      palm_coloured += c.g - c.b < options.palm_max_green_minus_blue ? 1 : 0;
+      if (c.g - c.b < options.palm_max_green_minus_blue) {
+        ++palm_coloured;
+        palm_sum += p;
+      }
     }
   }
   HandObservation seen;
@@ -112,7 +116,9 @@ std::optional<HandObservation> detectHand(const camera::RgbdFrame& frame, const 
   seen.tip = options.table_center * tip_t;
   seen.direction = options.table_center.linear() * (tip_t - table_points[root].cast<double>()).normalized();
   seen.palm_fraction = static_cast<double>(palm_coloured) / static_cast<double>(hand.size());
-  seen.open_palm_up = seen.palm_fraction >= options.palm_up_min_fraction;
+  seen.palm_to_tip = palm_coloured > 0 ? (palm_sum / palm_coloured - tip_t).norm() : 0.0;
+  seen.open_palm_up =
+      seen.palm_fraction >= options.palm_up_min_fraction && seen.palm_to_tip >= options.open_min_palm_to_tip;
   seen.hand_points = static_cast<int>(hand.size());
   seen.group_points = static_cast<int>(largest->size());
   return seen;

@@ -4,8 +4,9 @@
 // the table is the forearm and hand; its root is where it enters the view (the point farthest from
 // the table's centre), its tip the point farthest from the root; the hand is the group's end
 // around the tip. An open palm turned up shows its pinker skin (a palm is less yellow than the
-// back of a hand); a fist hides most of it under the fingers. An open hand palm down and a fist
-// palm down are not told apart. Only the frame's points and colours and the table's frame
+// back of a hand), its fingers reaching past it to the tip; a fist's fingers curl back over the
+// palm, hiding part of it and bringing the tip near it. An open hand palm down and a fist palm
+// down are not told apart. Only the frame's points and colours and the table's frame
 // are used, never the simulator's truth.
 
 #include <optional>
@@ -46,6 +47,9 @@ struct HandOptions {
   /// with its palm up, 0 palm down).
   double palm_max_green_minus_blue = 0.03;
   double palm_up_min_fraction = 0.25;
+  /// An open hand: the palm's centre at least this far from the tip (measured: 0.124-0.129 m
+  /// open, 0.07-0.09 m a fist, 0.11 half closed).
+  double open_min_palm_to_tip = 0.11;
 };
 
 /// What the camera shows of the hand, in the world frame.
@@ -55,8 +59,11 @@ struct HandObservation {
   Eigen::Vector3d tip = Eigen::Vector3d::Zero();
   /// From the root of the forearm towards the tip (unit).
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
-  /// The fraction of the hand's points of palm colour, and whether that shows an open palm up.
+  /// The fraction of the hand's points of palm colour; from their centre to the tip (m): an open
+  /// hand's fingers reach past the palm, a fist's curl back over it; whether both show an open
+  /// palm up.
   double palm_fraction = 0.0;
+  double palm_to_tip = 0.0;
   bool open_palm_up = false;
   /// Points of the hand and of the whole group (forearm included).
   int hand_points = 0;

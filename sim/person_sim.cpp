@@ -171,6 +171,14 @@ SimPerson::SimPerson(mjModel* model, mjData* data, const PersonSpec& spec, std::
 
 bool SimPerson::isPersonGeom(int geom) const { return std::binary_search(geoms_.begin(), geoms_.end(), geom); }
 
+bool SimPerson::isHandGeom(int geom) const {
+  if (!isPersonGeom(geom)) {
+    return false;
+  }
+  const std::string body = geomLabel(geom);
+  return body == "person_hand" || body == "person_fingers" || body == "person_thumb";
+}
+
 std::string SimPerson::geomLabel(int geom) const {
   const char* name = mj_id2name(model_, mjOBJ_BODY, model_->geom_bodyid[geom]);
   return name != nullptr ? name : "person";

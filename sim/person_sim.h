@@ -51,6 +51,8 @@ class SimPerson {
   /// The person's geoms, and whether a geom is one.
   const std::vector<int>& geoms() const { return geoms_; }
   bool isPersonGeom(int geom) const;
+  /// Whether a geom is the hand's: the palm, the fingers or the thumb.
+  bool isHandGeom(int geom) const;
   /// A label for contacts(): "person_hand", "person_fingers", "person_thumb", "person_forearm" ...
   std::string geomLabel(int geom) const;
 

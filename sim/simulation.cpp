@@ -351,6 +351,8 @@ struct Simulation::Impl {
     status.scale = scale;
     status.protective_distance = protective;
     status.state = monitor ? stateName(monitor->state()) : "off";
+    status.collaborative = monitor && monitor->collaborative();
+    status.stop_reason = monitor ? monitor->stopReason() : "";
     status.arm_geom = arm_geom >= 0 ? geomName(arm_geom) : "";
     status.person_geom = person_geom >= 0 ? person->geomLabel(person_geom) : "";
     if (!settled) {
@@ -370,6 +372,7 @@ struct Simulation::Impl {
       record.violation_steps += separation < protective ? 1 : 0;
     }
     if (monitor) {
+      record.collaborative_seconds += monitor->collaborative() ? dt : 0.0;
       record.stops = monitor->stops();
       record.stopped_seconds += scale <= 0.0 && setpoint_source ? dt : 0.0;
     }
@@ -379,6 +382,7 @@ struct Simulation::Impl {
   /// the arm when it was moving (its override above 0), against the person when it was held still.
   void recordPersonContact() {
     double force = 0.0;
+    bool hand_only = true;
     for (int i = 0; i < data->ncon; ++i) {
       const mjContact& contact = data->contact[i];
       const bool first = person->isPersonGeom(contact.geom1);
@@ -393,8 +397,16 @@ struct Simulation::Impl {
       mjtNum wrench[6];
       mj_contactForce(model, data, i, wrench);
       force += std::abs(wrench[0]);
+      hand_only = hand_only && person->isHandGeom(first ? contact.geom1 : contact.geom2);
     }
-    if (force > 0.0 && settled) {
+    if (monitor) {
+      monitor->setContact(force, hand_only);
+    }
+    const bool collaborative = monitor && monitor->collaborative();
+    if (force > 0.0 && settled && collaborative && hand_only && scale > 0.0) {
+      ++record.hand_contact_steps;
+      record.max_hand_contact_force = std::max(record.max_hand_contact_force, force);
+    } else if (force > 0.0 && settled) {
       if (scale > 0.0) {
         ++record.contact_steps;
         record.max_contact_force = std::max(record.max_contact_force, force);
@@ -1080,6 +1092,15 @@ void Simulation::setStopInput(bool stop) {
         "monitoring off)");
   }
   impl_->monitor->setStopInput(stop);
+}
+
+void Simulation::setCollaborative(bool on) {
+  if (!impl_->monitor) {
+    throw std::logic_error(
+        "Simulation::setCollaborative: no speed and separation monitor (no person in the scene, or "
+        "monitoring off)");
+  }
+  impl_->monitor->setCollaborative(on);
 }
 
 Duration Simulation::trajectoryLag() const {

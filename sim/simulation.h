@@ -117,6 +117,8 @@ struct SeparationStatus {
   double scale = 1.0;                // the speed override, 0 .. 1
   double protective_distance = 0.0;  // S_p at arm_speed
   std::string state;                 // "free", "limited", "stopped" ("off": not monitored)
+  bool collaborative = false;        // power and force limiting for a hand-over
+  std::string stop_reason;           // why the arm is held (SpeedSeparationMonitor::stopReason)
   std::string arm_geom;              // the closest pair's geoms
   std::string person_geom;
 };
@@ -137,6 +139,11 @@ struct SeparationRecord {
   /// which the person pushes the stopped arm do not count as the arm moving fast.
   std::uint64_t stopped_contact_steps = 0;
   double max_stopped_contact_force = 0.0;
+  /// In collaborative mode (a hand-over): its time, and contact with the person's hand while
+  /// the arm moved (steps and the largest force, N; contact elsewhere counts above).
+  double collaborative_seconds = 0.0;
+  std::uint64_t hand_contact_steps = 0;
+  double max_hand_contact_force = 0.0;
   int stops = 0;                              // protective stops
   double stopped_seconds = 0.0;               // with the speed override at 0 while a trajectory ran
   static constexpr double fast_speed = 0.25;  // m/s (the threshold)
@@ -282,6 +289,11 @@ class Simulation {
   /// its path to rest and stays until released. @throws std::logic_error without a monitor (no
   /// person in the scene, or monitoring off).
   void setStopInput(bool stop);
+  /// The monitor's collaborative mode (power and force limiting for a hand-over,
+  /// SpeedSeparationMonitor::setCollaborative): the arm at most 0.2 m/s at any separation,
+  /// stopped by contact outside the person's hand or a hand force above 140 N.
+  /// @throws std::logic_error without a monitor.
+  void setCollaborative(bool on);
 
   /// The default robot's "home" configuration: tool pointing down above the table.
   static ArmJoints homeConfiguration();

@@ -1,6 +1,7 @@
 #include "sim/speed_separation.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <limits>
 
 namespace costar::sim {
@@ -59,11 +60,34 @@ double protectiveDistance(const SpeedSeparationParams& params, double robot_spee
          params.robot_uncertainty;
 }
 
-SpeedSeparationMonitor::SpeedSeparationMonitor(SpeedSeparationParams params) : params_(params) {}
+SpeedSeparationMonitor::SpeedSeparationMonitor(SpeedSeparationParams params, CollaborativeParams collaborative)
+    : params_(params), collaborative_params_(collaborative) {}
+
+void SpeedSeparationMonitor::setCollaborative(bool on) {
+  collaborative_ = on;
+  contact_stop_.clear();
+}
+
+void SpeedSeparationMonitor::setContact(double force, bool hand_only) {
+  if (!collaborative_ || force <= 0.0 || !contact_stop_.empty()) {
+    return;
+  }
+  if (!hand_only) {
+    contact_stop_ = "contact outside the hand";
+  } else if (force > collaborative_params_.hand_force_limit) {
+    char text[64];
+    std::snprintf(text, sizeof text, "hand force above %.0f N", collaborative_params_.hand_force_limit);
+    contact_stop_ = text;
+  }
+}
 
 double SpeedSeparationMonitor::update(double dt, std::optional<double> sensed_separation, double arm_speed) {
   const double before = scale_;
-  if (!sensed_separation) {
+  std::string reason;
+  if (collaborative_) {
+    allowed_ = contact_stop_.empty() ? collaborative_params_.max_speed : 0.0;
+    reason = contact_stop_;
+  } else if (!sensed_separation) {
     allowed_ = std::numeric_limits<double>::infinity();
   } else {
     const double standing = protectiveDistance(params_, 0.0) + params_.margin;
@@ -72,9 +96,11 @@ double SpeedSeparationMonitor::update(double dt, std::optional<double> sensed_se
     if (state_ == State::kStopped && *sensed_separation < standing + params_.resume_gap) {
       allowed_ = 0.0;  // hysteresis: stay stopped until the person is clearly back
     }
+    reason = allowed_ <= 0.0 ? "separation" : "";
   }
   if (stop_input_) {
     allowed_ = 0.0;
+    reason = "stop input";
   }
   if (allowed_ <= 0.0 || arm_speed > allowed_) {
     scale_ = std::max(0.0, scale_ - dt / params_.ramp_down);
@@ -86,8 +112,10 @@ double SpeedSeparationMonitor::update(double dt, std::optional<double> sensed_se
       ++stops_;
     }
     state_ = State::kStopped;
+    stop_reason_ = reason;
   } else {
     state_ = scale_ < 1.0 ? State::kLimited : State::kFree;
+    stop_reason_.clear();
   }
   rate_ = dt > 0.0 ? (scale_ - before) / dt : 0.0;
   return scale_;

@@ -18,6 +18,14 @@
 // 80 % of it s rises at 1 / ramp_up. At v_allowed(S) <= 0 the arm stops (a protective stop) and
 // resumes only once S is `resume_gap` beyond that. Pure logic, no simulator: sim/simulation.cpp
 // feeds it the separation and the speed.
+//
+// Collaborative mode (power and force limiting, ISO/TS 15066 5.5.5), for a hand-over: asked for
+// by the plan (the safety component's Collaborate), it replaces the separation rule by a speed
+// cap (`CollaborativeParams::max_speed` for the arm's fastest point, at any separation) and
+// watches contact with the person: contact with any part of the person but the hand, or a hand
+// contact force above the hand's limit (ISO/TS 15066 Table A.2, hand and fingers: 140 N
+// quasi-static), stops the arm (a protective stop) until collaborative mode is left; the
+// separation rule then decides when it resumes. Every stop has a reason (stopReason()).
 
 #include <optional>
 #include <string>
@@ -43,6 +51,12 @@ struct SpeedSeparationParams {
   double reactionTime() const { return sensor_period + control_period; }
 };
 
+/// Power and force limiting near the hand (collaborative mode).
+struct CollaborativeParams {
+  double max_speed = 0.20;          // m/s, the arm's fastest point: below the 0.25 m/s of "moving fast"
+  double hand_force_limit = 140.0;  // N, ISO/TS 15066 Table A.2, hand and fingers, quasi-static
+};
+
 /// A capsule: the points within `radius` of the segment a-b (a sphere when a = b). The
 /// separation is measured between capsules that enclose every arm, gripper and person geom
 /// (sim/person_sim.h), so it never exceeds the true distance.
@@ -62,12 +76,25 @@ class SpeedSeparationMonitor {
  public:
   enum class State { kFree, kLimited, kStopped };
 
-  explicit SpeedSeparationMonitor(SpeedSeparationParams params = {});
+  explicit SpeedSeparationMonitor(SpeedSeparationParams params = {}, CollaborativeParams collaborative = {});
 
   /// One control period of `dt` seconds: the separation as last sensed (absent: nobody
   /// sensed, full speed allowed) and the arm's fastest point speed now. Returns the scale for
   /// the next period.
   double update(double dt, std::optional<double> sensed_separation, double arm_speed);
+
+  /// Collaborative mode on or off (power and force limiting; see the file's comment). Leaving it
+  /// clears a contact stop; the separation rule applies again from the next update.
+  void setCollaborative(bool on);
+  bool collaborative() const { return collaborative_; }
+  /// The contact with the person in the last physics step: the largest total normal force (N;
+  /// 0: none) and whether every contact was with the hand. Outside collaborative mode it changes
+  /// nothing (the separation rule keeps the arm away; contact is recorded, not acted on).
+  void setContact(double force, bool hand_only);
+
+  /// Why the arm is held ("" while it is not): "separation", "stop input", "contact outside
+  /// the hand", "hand force above 140 N".
+  const std::string& stopReason() const { return stop_reason_; }
 
   /// A stop input (a safety-rated stop: an emergency stop button, a light curtain, or the
   /// bench measuring the arm's stopping): while set, the arm brakes to rest and stays there.
@@ -82,9 +109,14 @@ class SpeedSeparationMonitor {
   /// How many protective stops (the arm brought to rest for the person) so far.
   int stops() const { return stops_; }
   const SpeedSeparationParams& params() const { return params_; }
+  const CollaborativeParams& collaborativeParams() const { return collaborative_params_; }
 
  private:
   SpeedSeparationParams params_;
+  CollaborativeParams collaborative_params_;
+  bool collaborative_ = false;
+  std::string contact_stop_;  // the contact that stopped the arm in collaborative mode
+  std::string stop_reason_;
   double scale_ = 1.0;
   double rate_ = 0.0;
   double allowed_ = 0.0;

@@ -68,11 +68,13 @@ class FixedFrames final : public component::TableComponent {
 /// The cell controller's speed and separation monitor (sim/speed_separation.h, docs/PERSON.md)
 /// as a safety controller reports it, for the editor and for plans that wait on it: the
 /// separation its sensor last read, the protective distance at the arm's speed, the speed
-/// override, and whether it is slowing or holding the arm for the person. In cells whose scene has
-/// a person.
+/// override, and whether it is slowing or holding the arm for the person; and its collaborative
+/// mode for a hand-over (Collaborate on=true: power and force limiting, the arm at most 0.2 m/s
+/// at any separation, stopped by contact outside the hand or a hand force above 140 N). In cells
+/// whose scene has a person.
 class SeparationMonitor final : public component::TableComponent {
  public:
-  explicit SeparationMonitor(const sim::Simulation& simulation) : simulation_(simulation) {
+  explicit SeparationMonitor(sim::Simulation& simulation) : simulation_(simulation) {
     component::ComponentDescription description;
     description.name = "safety";
     description.type = "SpeedSeparationMonitor";
@@ -81,8 +83,20 @@ class SeparationMonitor final : public component::TableComponent {
         {"protective_distance", world::SymbolKind::kNumber, "ISO/TS 15066's S_p at the arm's present speed (m)"},
         {"arm_speed_scale", world::SymbolKind::kNumber, "the speed override, 0 (held) to 1 (full speed)"}};
     description.predicates = {{"arm_slowed_for_person", 0, "the monitor slows the arm for the person"},
-                              {"arm_stopped_for_person", 0, "the monitor holds the arm still for the person"}};
-    declare(std::move(description), {});  // no operations
+                              {"arm_stopped_for_person", 0, "the monitor holds the arm still for the person"},
+                              {"arm_collaborative", 0, "power and force limiting for a hand-over is on"}};
+    component::OperationTable operations;
+    operations.add({"Collaborate",
+                    "Power and force limiting for a hand-over (on) or speed and separation monitoring (off): "
+                    "on, the arm moves at most 0.2 m/s however near the person, and contact outside the hand or "
+                    "above 140 N on it stops it.",
+                    {{"on", component::ValueType::kBool, "collaborative mode on or off", true}},
+                    component::OperationKind::kRobotAction},
+                   [this](const component::ParamMap& params) {
+                     simulation_.setCollaborative(params.at("on").asBool());
+                     return std::make_unique<component::FinishedOperation>(component::OperationResult::success());
+                   });
+    declare(std::move(description), std::move(operations));
   }
   world::Report report() const override {
     world::Report report;
@@ -95,11 +109,12 @@ class SeparationMonitor final : public component::TableComponent {
     report.symbols.push_back({"arm_speed_scale", "", {}, world::NumberValue{status->scale, ""}});
     report.predicates.push_back({"arm_slowed_for_person", {}, status->state == "limited"});
     report.predicates.push_back({"arm_stopped_for_person", {}, status->state == "stopped"});
+    report.predicates.push_back({"arm_collaborative", {}, status->collaborative});
     return report;
   }
 
  private:
-  const sim::Simulation& simulation_;
+  sim::Simulation& simulation_;
 };
 
 /// The perception pipeline (models and SVM loaded from the data files, about half a second),

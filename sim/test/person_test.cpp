@@ -189,6 +189,61 @@ TEST(SpeedSeparation, TheMonitorStopsForAPersonAndResumesWhenTheyWithdraw) {
   EXPECT_EQ(monitor.stops(), 1);
 }
 
+TEST(SpeedSeparation, CollaborativeModeCapsTheSpeedAndStopsOnContactOutsideTheHandOrAboveItsLimit) {
+  SpeedSeparationMonitor monitor;
+  const double dt = 0.002;
+  const double near_the_hand = 0.05;  // well within the protective distance
+  // Outside collaborative mode the arm stops for the separation.
+  for (int i = 0; i < 200; ++i) {
+    monitor.update(dt, near_the_hand, 0.5 * monitor.scale());
+  }
+  EXPECT_EQ(monitor.state(), SpeedSeparationMonitor::State::kStopped);
+  EXPECT_EQ(monitor.stopReason(), "separation");
+  // Collaborative: the arm moves near the hand, no faster than the cap (0.2 m/s): a motion
+  // asked for at 0.5 m/s settles where its speed is at or under the cap.
+  monitor.setCollaborative(true);
+  double fastest_after_settling = 0.0;
+  for (int i = 0; i < 2000; ++i) {
+    const double speed = 0.5 * monitor.scale();
+    monitor.update(dt, near_the_hand, speed);
+    fastest_after_settling = i > 1000 ? std::max(fastest_after_settling, speed) : 0.0;
+  }
+  EXPECT_GT(monitor.scale(), 0.0);
+  EXPECT_LE(fastest_after_settling, monitor.collaborativeParams().max_speed + 0.01);
+  EXPECT_GT(fastest_after_settling, 0.8 * monitor.collaborativeParams().max_speed);
+  EXPECT_EQ(monitor.stopReason(), "");
+  // Touching the hand below its limit (the part's hand-over): on.
+  monitor.setContact(50.0, true);
+  monitor.update(dt, 0.0, 0.1);
+  EXPECT_NE(monitor.state(), SpeedSeparationMonitor::State::kStopped);
+  // Above it: a protective stop, held while collaborative.
+  monitor.setContact(200.0, true);
+  for (int i = 0; i < 200; ++i) {
+    monitor.update(dt, 0.0, 0.1 * monitor.scale());
+  }
+  EXPECT_EQ(monitor.state(), SpeedSeparationMonitor::State::kStopped);
+  EXPECT_EQ(monitor.stopReason(), "hand force above 140 N");
+  monitor.setContact(0.0, true);
+  monitor.update(dt, 0.1, 0.0);
+  EXPECT_EQ(monitor.stopReason(), "hand force above 140 N");
+  // Leaving collaborative mode: the separation rule again.
+  monitor.setCollaborative(false);
+  monitor.update(dt, near_the_hand, 0.0);
+  EXPECT_EQ(monitor.stopReason(), "separation");
+  // Any contact outside the hand stops it, however light.
+  monitor.setCollaborative(true);
+  monitor.update(dt, near_the_hand, 0.0);
+  EXPECT_EQ(monitor.stopReason(), "");
+  monitor.setContact(5.0, false);
+  monitor.update(dt, near_the_hand, 0.0);
+  EXPECT_EQ(monitor.stopReason(), "contact outside the hand");
+  // The stop input overrides everything.
+  monitor.setCollaborative(true);
+  monitor.setStopInput(true);
+  monitor.update(dt, near_the_hand, 0.0);
+  EXPECT_EQ(monitor.stopReason(), "stop input");
+}
+
 TEST(SimPerson, TheHandHoldsAPartByClosingAroundIt) {
   // The hand reaches, turns palm up, a part is put on the palm, the hand closes and withdraws:
   // the part goes with it (fingers' contact and friction only).
@@ -314,6 +369,54 @@ TEST(SimPerson, TheMonitorKeepsTheArmAwayFromThePersonWhichItWouldOtherwiseHit) 
   EXPECT_GT(monitored.min_separation, 0.0);
   EXPECT_GE(monitored.stops, 1);
   EXPECT_GT(monitored.fast_seconds, 0.5);  // the arm did move fast while the person was away
+}
+
+TEST(SimPerson, InCollaborativeModeTheArmMovesSlowlyNearThePersonAndStopsWhenItTouchesThem) {
+  // The person walks up and holds a hand where the UR5's base sweep passes; the arm sweeps in
+  // collaborative mode: no protective stop for the separation, at most the cap's speed once
+  // braked, and touching the person stops it with the reason.
+  const Scene scene = parseScene(R"({"parts": [], "person": {"shoulder": [0.2, 0.72, 0.5], "script": [
+      {"do": "reach", "to": [0.1, 0.2, 0.34], "speed": 1.0}, {"do": "wait", "seconds": 60}]}})",
+                                 "test");
+  const auto sim = Simulation::create(scene);
+  const arm::RobotDescription ur5 = arm::loadRobotDescription(arm::robotDescriptionFile("ur5"));
+  ArmJoints right = ur5.home;
+  ArmJoints left = ur5.home;
+  right[0] -= 0.6;
+  left[0] += 1.2;
+  sim->setArmSetpointSource([right](TimePoint) {
+    return ArmSetpoint{right, ArmJoints::zero(right.size()), ArmJoints::zero(right.size())};
+  });
+  sim->stepTo(sim->time() + fromSeconds(2.0));
+  EXPECT_EQ(sim->separation()->state, "stopped");  // the hand is within the protective distance
+  EXPECT_EQ(sim->separation()->stop_reason, "separation");
+  sim->setCollaborative(true);
+  auto go = std::make_shared<arm::JointTrajectory>(arm::JointTrajectory::pointToPoint(right, left, ur5.limits, 0.8));
+  const TimePoint start = sim->time();
+  sim->setArmSetpointSource([go, start](TimePoint t) {
+    const arm::TrajectoryPoint point = go->sample(t - start);
+    return ArmSetpoint{point.position, point.velocity, point.acceleration};
+  });
+  double fastest_once_braked = 0.0;
+  std::string reason;
+  while (sim->time() < start + fromSeconds(20.0) && reason.empty()) {
+    sim->stepTo(sim->time() + fromSeconds(0.01));
+    const SeparationStatus status = *sim->separation();
+    EXPECT_TRUE(status.collaborative);
+    if (sim->time() > start + fromSeconds(0.5) && status.state != "stopped") {
+      fastest_once_braked = std::max(fastest_once_braked, status.arm_speed);
+    }
+    reason = status.stop_reason;
+  }
+  EXPECT_TRUE(reason == "hand force above 140 N" || reason == "contact outside the hand") << reason;
+  EXPECT_LE(fastest_once_braked, 0.21);
+  EXPECT_GT(fastest_once_braked, 0.1);
+  // Held after the contact while collaborative, however long.
+  sim->stepTo(sim->time() + fromSeconds(1.0));
+  EXPECT_EQ(sim->separation()->state, "stopped");
+  EXPECT_EQ(sim->separation()->stop_reason, reason);
+  const SeparationRecord record = *sim->separationRecord();
+  EXPECT_GT(record.collaborative_seconds, 1.0);
 }
 
 }  // namespace

@@ -18,7 +18,11 @@ double number(Workcell& cell, const std::string& name) {
   return symbol->number()->value;
 }
 
-TEST(PersonSimWorkcell, TheMonitorsReadingIsInTheWorldStateWhenTheSceneHasAPerson) {
+bool holds(const world::WorldState& world, const std::string& name, std::vector<std::string> args) {
+  return world.holds(name, args);
+}
+
+TEST(PersonSimWorkcell, TheMonitorsReadingAndCollaborativeModeAreInTheWorldStateWhenTheSceneHasAPerson) {
   // Away: nothing slows the arm.
   const auto away =
       makeWorkcell({.name = "iiwa-3f-sim", .scene = dataRoot() / "sim/scenes/person_away.json", .memory_only = true});
@@ -36,16 +40,27 @@ TEST(PersonSimWorkcell, TheMonitorsReadingIsInTheWorldStateWhenTheSceneHasAPerso
   EXPECT_GT(number(*near, "protective_distance"), 0.5);
   EXPECT_DOUBLE_EQ(number(*near, "arm_speed_scale"), 0.0);
   EXPECT_TRUE(near->components().world().holds("arm_stopped_for_person", {}));
+  // Collaborative mode for a hand-over, asked for by a plan through the safety component.
+  component::Component* safety = near->components().find("safety");
+  ASSERT_NE(safety, nullptr);
+  EXPECT_FALSE(holds(near->components().world(), "arm_collaborative", {}));
+  const component::OperationId on = safety->start("Collaborate", {{"on", true}});
+  EXPECT_EQ(safety->poll(on).state, component::OperationState::kSuccess);
+  static_cast<SimClock&>(near->clock()).advanceBy(std::chrono::milliseconds(100));
+  near->beforeTick();
+  EXPECT_TRUE(holds(near->components().world(), "arm_collaborative", {}));
+  EXPECT_EQ(near->simulation()->separation()->stop_reason, "");  // not stopped for the separation
+  const component::OperationId off = safety->start("Collaborate", {{"on", false}});
+  EXPECT_EQ(safety->poll(off).state, component::OperationState::kSuccess);
+  static_cast<SimClock&>(near->clock()).advanceBy(std::chrono::milliseconds(100));
+  near->beforeTick();
+  EXPECT_FALSE(holds(near->components().world(), "arm_collaborative", {}));
   // Without a person the cell has no such component.
   const auto none =
       makeWorkcell({.name = "iiwa-3f-sim", .scene = dataRoot() / "sim/scenes/one_node.json", .memory_only = true});
   none->beforeTick();
   EXPECT_EQ(none->components().world().symbol("person_separation"), nullptr);
   EXPECT_EQ(none->components().world().symbol("hand_1"), nullptr);
-}
-
-bool holds(const world::WorldState& world, const std::string& name, std::vector<std::string> args) {
-  return world.holds(name, args);
 }
 
 TEST(PersonSimWorkcell, TheHandAndItsGestureAreInTheWorldStateAsTheCameraSeesThem) {
