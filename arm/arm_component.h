@@ -131,10 +131,11 @@ class ArmComponent final : public component::TableComponent {
   void releaseFreeDrive();
   struct FreeDriveStatus {
     bool active = false;
-    std::string mode;     // the guiding mode (GuidingMode::str())
-    std::string blocked;  // why the last step was not (wholly) taken: a limit, a contact ahead
-    Wrench hand;          // the push it measures (world, at the tool centre point)
-    double speed = 0.0;   // m/s of its reference
+    std::string mode;       // the guiding mode (GuidingMode::str())
+    std::string blocked;    // why the last step was not (wholly) taken: a limit, a contact ahead
+    Wrench hand;            // the push it measures (world, at the tool centre point)
+    double speed = 0.0;     // m/s of its reference
+    JointVector checked{};  // the joints its reference was checked at (for collisions, limits, speed)
   };
   FreeDriveStatus freeDriveStatus() const;
 

@@ -52,6 +52,13 @@ struct CartesianMotion {
   /// Redundant arms: the joints' configuration the controller keeps in the null space of the
   /// tool's motion (the elbow's); empty: where the joints are when the motion starts.
   JointVector posture{};
+  /// Every joint held to `posture` too, not only in the null space, with this stiffness (N m/rad,
+  /// damped critically on the joint's own inertia about `posture_velocity`): free-drive's
+  /// configuration checked for collisions, which near a singularity the tool's impedance alone
+  /// lets the arm leave (a UR5's elbow folded 1.6 rad away with the tool within 1 cm). 0: none.
+  double joint_stiffness = 0.0;
+  /// rad/s the posture moves at with the drift (empty: it holds).
+  JointVector posture_velocity{};
   /// A streamed reference (free-drive's admittance, arm/free_drive.h): the path's pose moves on
   /// at this twist (world, m/s and rad/s) from the start for at most `horizon`, then holds, so
   /// that a stream of motions that stops leaves the tool held.

@@ -1,5 +1,7 @@
 #include "arm/free_drive.h"
 
+#include "arm/arm_motion.h"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -147,7 +149,7 @@ world::Pose advance(const world::Pose& pose, const Twist& twist, double dt) {
 }
 
 FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joints, const Twist& twist, double dt,
-                            const JointVector& max_joint_step, const AdmittanceGains& gains, const StepCheck& check) {
+                            const JointVector& max_joint_step, const AdmittanceGains& gains, const StepChecks& check) {
   FreeDriveStep held{reference, joints, Twist{}, {}};
   const bool moving = twist.velocity.norm() > 0.0;
   const bool turning = twist.angular_velocity.norm() > 0.0;
@@ -172,16 +174,20 @@ FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joi
     }
   }
   std::string first_reason;
+  const auto refuse = [&](const std::string& why) {
+    if (first_reason.empty()) {
+      first_reason = why;
+    }
+  };
   for (Twist attempt : tries) {
-    // Near a singularity the joints would turn fast: the twist slows until they do not.
+    // Near a singularity the joints would turn fast, and the links would swing fast: the twist
+    // slows until they do not.
     for (int slowing = 0; slowing < 4; ++slowing) {
       const world::Pose next = advance(reference, attempt, dt);
       std::string why;
-      const std::optional<JointVector> q = check(next, joints, why);
+      const std::optional<JointVector> q = check.reach(next, joints, why);
       if (!q) {
-        if (first_reason.empty()) {
-          first_reason = why;
-        }
+        refuse(why);
         break;
       }
       double worst = 0.0;
@@ -191,12 +197,18 @@ FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joi
       if (worst > 1.0) {
         attempt.velocity /= 2.0 * worst;
         attempt.angular_velocity /= 2.0 * worst;
-        if (first_reason.empty()) {
-          first_reason = "a joint would turn too fast (near a singularity)";
-        }
+        refuse("a joint would turn too fast (near a singularity)");
         continue;
       }
-      // The stopping distance ahead must be clear too.
+      const double moved = check.displacement(joints, *q);
+      if (moved > gains.max_point_speed * dt) {
+        const double scale = 0.9 * gains.max_point_speed * dt / moved;
+        attempt.velocity *= scale;
+        attempt.angular_velocity *= scale;
+        refuse("a link would move faster than " + formatNumber("%.2f m/s", gains.max_point_speed));
+        continue;
+      }
+      // The stopping distance ahead must be clear too, for the tool and for every link.
       Twist ahead;
       if (attempt.velocity.norm() > 0.0) {
         ahead.velocity = attempt.velocity.normalized() * gains.look_ahead;
@@ -204,11 +216,20 @@ FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joi
       if (attempt.angular_velocity.norm() > 0.0) {
         ahead.angular_velocity = attempt.angular_velocity.normalized() * (gains.look_ahead / kMetresPerRadian);
       }
-      if (!check(advance(next, ahead, 1.0), *q, why)) {
-        if (first_reason.empty()) {
-          first_reason = why;
-        }
+      const std::optional<JointVector> tool_ahead = check.reach(advance(next, ahead, 1.0), *q, why);
+      if (!tool_ahead || !check.sweep(*q, *tool_ahead, why)) {
+        refuse(why);
         break;
+      }
+      if (moved > 0.0) {
+        JointVector links_ahead = *q;
+        for (int j = 0; j < joints.size(); ++j) {
+          links_ahead[j] += ((*q)[j] - joints[j]) * gains.look_ahead / moved;
+        }
+        if (!check.sweep(*q, links_ahead, why)) {
+          refuse(why);
+          break;
+        }
       }
       return {next, *q, attempt,
               attempt.velocity == twist.velocity && attempt.angular_velocity == twist.angular_velocity ? std::string()

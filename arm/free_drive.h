@@ -54,6 +54,9 @@ struct AdmittanceGains {
   /// How far ahead along the motion (m) the configuration must be free too: the tool stops this
   /// far before a contact at most (the collision world pads the arm by another centimetre).
   double look_ahead = 0.04;
+  /// m/s any point of the arm (an elbow swinging, not only the tool) moves at most: the tool
+  /// stays within 0.25 m/s with the controller's lag, and so does every link.
+  double max_point_speed = 0.2;
   /// The joints stay this far (rad) inside their limits.
   double joint_margin = 0.05;
   /// The joints turn at most this fraction of their top speed.
@@ -80,10 +83,20 @@ Twist admittance(const Wrench& hand, const Twist& before, double dt, const Guidi
 /// The pose a twist moves `pose` to in `dt`.
 world::Pose advance(const world::Pose& pose, const Twist& twist, double dt);
 
-/// Checks a step of the reference: the joints that reach `pose` near `seed`, or nullopt with
-/// the reason (out of reach, a joint at its limit, a collision) in `why`.
-using StepCheck =
-    std::function<std::optional<JointVector>(const world::Pose& pose, const JointVector& seed, std::string& why)>;
+/// What a step of the reference is checked against: the Arm's planner (its kinematics and the
+/// collision world the planner uses), or a test's toy arm.
+struct StepChecks {
+  /// The joints that reach `pose` nearest `seed` within the joint limits less the margin, or
+  /// nullopt with why (out of the arm's reach, a joint at its limit).
+  std::function<std::optional<JointVector>(const world::Pose& pose, const JointVector& seed, std::string& why)> reach;
+  /// Whether every configuration of the straight joint motion from `from` to `to` is free of
+  /// collisions (each link, the gripper and the tool against the table, the known parts and the
+  /// arm itself), else false with the contact in `why`.
+  std::function<bool(const JointVector& from, const JointVector& to, std::string& why)> sweep;
+  /// How far (m) the point of the arm that moves most (a link's, not only the tool's) moves from
+  /// `from` to `to`.
+  std::function<double(const JointVector& from, const JointVector& to)> displacement;
+};
 
 struct FreeDriveStep {
   world::Pose reference = world::Pose::Identity();  // where the reference is after the step
@@ -94,11 +107,14 @@ struct FreeDriveStep {
 };
 
 /// The step the reference takes from (`reference`, `joints`) with `twist` over `dt`: the whole
-/// twist when it passes `check` (at the new pose and `look_ahead` beyond it along the motion)
-/// and the joints turn within `max_joint_step`; otherwise its translation alone, or its
-/// rotation alone, or the translation less its part along one world axis (sliding along a wall),
-/// or none (the reference holds and the twist is zero).
+/// twist when the joints there turn within `max_joint_step`, no point of the arm moves faster
+/// than `gains.max_point_speed`, and the arm's sweep from there to the look-ahead is free: to
+/// where the tool is `look_ahead` further along its motion (0.4 rad along a turn), and to where
+/// the joints' motion carries the arm's fastest point `look_ahead` further (an elbow moving
+/// faster than the tool looks as far ahead as it moves); otherwise its translation alone, or its
+/// rotation alone, or the translation less its part along one world axis (sliding along a
+/// wall), or none (the reference holds and the twist is zero). A step too fast is slowed.
 FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joints, const Twist& twist, double dt,
-                            const JointVector& max_joint_step, const AdmittanceGains& gains, const StepCheck& check);
+                            const JointVector& max_joint_step, const AdmittanceGains& gains, const StepChecks& check);
 
 }  // namespace costar::arm

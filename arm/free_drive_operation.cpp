@@ -23,6 +23,8 @@ namespace {
 /// 40 N moves it 1 cm from the reference at most (the collision world's padding), compliant.
 constexpr double kStiffness = 4000.0;           // N/m
 constexpr double kRotationalStiffness = 200.0;  // N m/rad
+/// How stiffly every joint is held to the configuration checked for collisions (N m/rad).
+constexpr double kJointStiffness = 100.0;
 /// Above this (N) on the wrist, whatever pushes, free-drive stops.
 constexpr double kForceLimit = ArmComponent::kMaxForceLimit;
 /// A recording shorter than this (m of the tool) is not kept.
@@ -95,7 +97,6 @@ namespace {
 
 class FreeDriveOperation final : public component::RunningOperation {
  public:
-  using Check = StepCheck;
   FreeDriveOperation(std::function<OperationResult(bool first)> tick, std::function<void()> end)
       : tick_(std::move(tick)), end_(std::move(end)) {}
   ~FreeDriveOperation() override {
@@ -194,9 +195,9 @@ std::unique_ptr<component::RunningOperation> ArmComponent::freeDrive(const compo
   const world::Pose sensor_in_tool = config_.tcp_in_flange.inverse() * force_.sensor->inFlange();
   const Eigen::Vector3d tcp_in_sensor = sensor_in_tool.inverse().translation();
   const JointLimits& limits = kinematics_->limits();
-  const StepCheck check = [this, &limits, margin = run->gains.joint_margin](
-                              const world::Pose& pose, const JointVector& seed,
-                              std::string& why) -> std::optional<JointVector> {
+  StepChecks check;
+  check.reach = [this, &limits, margin = run->gains.joint_margin](const world::Pose& pose, const JointVector& seed,
+                                                                  std::string& why) -> std::optional<JointVector> {
     const std::vector<JointVector> solutions = planner_->solutions(pose, seed);
     if (solutions.empty()) {
       why = "out of the arm's reach";
@@ -209,11 +210,17 @@ std::unique_ptr<component::RunningOperation> ArmComponent::freeDrive(const compo
         return std::nullopt;
       }
     }
-    if (const auto contact = planner_->collision(q, {})) {
-      why = contact->str();
-      return std::nullopt;
-    }
     return q;
+  };
+  check.sweep = [this](const JointVector& from, const JointVector& to, std::string& why) {
+    if (const auto contact = planner_->collisionAlong(from, to)) {
+      why = contact->str();
+      return false;
+    }
+    return true;
+  };
+  check.displacement = [this](const JointVector& from, const JointVector& to) {
+    return planner_->largestDisplacement(from, to);
   };
 
   auto tick = [this, run, check, tcp_in_sensor, sensor_in_tool, &driving, &limits](bool first) -> OperationResult {
@@ -283,7 +290,14 @@ std::unique_ptr<component::RunningOperation> ArmComponent::freeDrive(const compo
     motion.impedance.rotational_stiffness = Eigen::Vector3d::Constant(kRotationalStiffness);
     motion.impedance.damping_ratio = 1.0;
     motion.force_limit = kForceLimit;
-    motion.posture = step.joints;
+    // The checked joints held, not only the tool: near a singularity the tool's impedance alone
+    // lets the elbow fold away from the configuration the step was checked at.
+    motion.posture = run->joints;
+    motion.joint_stiffness = kJointStiffness;
+    motion.posture_velocity = JointVector::zero(run->joints.size());
+    for (int j = 0; dt > 0.0 && j < run->joints.size(); ++j) {
+      motion.posture_velocity[j] = (step.joints[j] - run->joints[j]) / dt;
+    }
     motion.drift = CartesianMotion::Drift{step.twist.velocity, step.twist.angular_velocity,
                                           std::chrono::duration_cast<Duration>(std::chrono::duration<double>(dt))};
     motion_->trajectory.reset();
@@ -300,6 +314,7 @@ std::unique_ptr<component::RunningOperation> ArmComponent::freeDrive(const compo
     run->twist = step.twist;
     driving.status.blocked = step.blocked;
     driving.status.speed = step.twist.velocity.norm();
+    driving.status.checked = step.joints;
     return OperationResult::running();
   };
   auto end = [this, run, &driving] {

@@ -103,6 +103,34 @@ std::optional<planning::Contact> MotionPlanner::collision(const JointVector& q, 
   return collisions_.check(q.eigen(), scene);
 }
 
+std::optional<planning::Contact> MotionPlanner::collisionAlong(const JointVector& from, const JointVector& to,
+                                                               const QueryScene& scene) const {
+  return collisions_.checkSegment(from.eigen(), to.eigen(), scene);
+}
+
+double MotionPlanner::largestDisplacement(const JointVector& from, const JointVector& to) const {
+  const planning::RobotModel& robot = collisions_.robot();
+  std::vector<world::Pose> before;
+  std::vector<world::Pose> after;
+  robot.linkPoses(from.eigen(), before);
+  robot.linkPoses(to.eigen(), after);
+  double largest = 0.0;
+  for (std::size_t i = 0; i < robot.links().size(); ++i) {
+    for (const planning::CollisionShape& shape : robot.links()[i].shapes) {
+      double reach = shape.size.x();  // a sphere's radius
+      if (shape.kind == planning::CollisionShape::Kind::kBox) {
+        reach = 0.5 * shape.size.norm();
+      } else if (shape.kind == planning::CollisionShape::Kind::kCylinder) {
+        reach = std::hypot(shape.size.x(), 0.5 * shape.size.y());
+      }
+      const world::Pose a = before[i] * shape.origin;
+      const world::Pose b = after[i] * shape.origin;
+      largest = std::max(largest, (b.translation() - a.translation()).norm() + world::rotationAngle(a, b) * reach);
+    }
+  }
+  return largest;
+}
+
 MotionPlan MotionPlanner::timed(std::vector<JointVector> path, double speed) const {
   if (path.size() < 2) {
     return MotionPlan::failed(path.empty() ? JointVector{} : path.back(),

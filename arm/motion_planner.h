@@ -44,6 +44,13 @@ class MotionPlanner final : public MotionService {
   world::Pose toolAt(const JointVector& q) const override;
   std::vector<JointVector> solutions(const world::Pose& tcp_in_world, const JointVector& seed) const override;
   std::optional<planning::Contact> collision(const JointVector& q, const QueryScene& scene) const override;
+  /// The first contact along the straight joint motion from `from` to `to` (every configuration
+  /// at the collision world's resolution), or nullopt.
+  std::optional<planning::Contact> collisionAlong(const JointVector& from, const JointVector& to,
+                                                  const QueryScene& scene = {}) const;
+  /// How far (m) the point of the arm's collision shapes (links, gripper, tool) that moves most
+  /// moves from `from` to `to`: each shape's centre's displacement plus its turn times its reach.
+  double largestDisplacement(const JointVector& from, const JointVector& to) const;
   MotionPlan planToJoints(const JointVector& from, const JointVector& goal, double speed,
                           const QueryScene& scene = {}) const override;
   MotionPlan planLine(const JointVector& from, const world::Pose& tcp_in_world, double speed,

@@ -183,6 +183,7 @@ void dragRandom(workcell::Workcell& cell, const std::vector<std::string>& w) {
     std::printf("dragged %.1f s (simulated) in %d holds, the tool travelled %.2f m\n", r.seconds, r.holds, r.travelled);
     std::printf("joint limit violations: %llu ticks (closest to a limit: %.3f rad)\n",
                 static_cast<unsigned long long>(r.joint_limit_violations), r.closest_to_limit);
+    std::printf("the joints at most %.3f rad from the configuration the steps were checked at\n", r.max_departure);
     std::printf("contacts: table %llu physics steps, parts %llu ticks%s%s; lowest tool %.3f m above the table\n",
                 static_cast<unsigned long long>(r.table_contact_steps),
                 static_cast<unsigned long long>(r.part_contact_ticks), r.first_part_contact.empty() ? "" : " (first: ",

@@ -551,7 +551,8 @@ constexpr double kMaxHandForce = 60.0;
 constexpr double kMaxHandTorque = 3.0;
 
 /// POST /api/drag: free-drive's hand and dead-man (Backend::Drag): {"force": [x, y, z], "torque":
-/// [x, y, z]} (N, N m, world, at the tool) held for 0.5 s, or {"release": true}.
+/// [x, y, z]} (N, N m, world, at the tool), a push for 0.25 s and the dead-man for 2 s, or
+/// {"release": true}.
 HttpResponse dragTool(const Call& call) {
   const json body = call.body();
   if (!body.is_object()) {

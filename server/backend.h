@@ -92,15 +92,24 @@ class Backend {
   }
 
   /// Free-drive's hand and dead-man (docs/TEACHING.md): while a FreeDrive operation runs, the
-  /// person's push on the tool (force N and torque N m, world axes, at the tool centre point),
-  /// held for `hold_seconds`: the page sends one every 50 ms while the pointer is held, and when
-  /// the stream stops the hand lets go and the dead-man lapses (the arm stops and holds).
-  /// `release`: lets go now. Status 0 when applied; 409 when no FreeDrive runs, 404 for a cell
-  /// without a simulator (a real arm is pushed by a real hand).
+  /// person's push on the tool (force N and torque N m, world axes, at the tool centre point).
+  /// The page sends one every kDragPeriod (50 ms) while the pointer is held; each is a lease of
+  /// two lengths: the push acts for `push_seconds` (kDragPushSeconds: the arm moves only on a
+  /// push at most 0.25 s old, so a page that stalls or dies leaves the arm standing within it),
+  /// and the dead-man stays held for `hold_seconds` (kDragLeaseSeconds, 2 s: a page whose timer
+  /// runs late on a loaded machine keeps free-drive and its recording instead of losing them;
+  /// when the pushes stop for longer it lapses: the arm stops and holds, the operation ends).
+  /// `release` (the pointer let go) lets go now. Status 0 when applied; 409 when no FreeDrive
+  /// runs, 404 for a cell without a simulator (a real arm is pushed by a real hand, with the arm's
+  /// own enabling button).
+  static constexpr double kDragPeriodSeconds = 0.05;
+  static constexpr double kDragPushSeconds = 0.25;
+  static constexpr double kDragLeaseSeconds = 2.0;
   struct Drag {
     std::array<double, 3> force{};
     std::array<double, 3> torque{};
-    double hold_seconds = 0.5;
+    double push_seconds = kDragPushSeconds;
+    double hold_seconds = kDragLeaseSeconds;
     bool release = false;
   };
   virtual StartResult drag(const Drag& drag) {

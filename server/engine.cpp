@@ -355,7 +355,8 @@ StartResult Engine::drag(const Drag& request) {
     arm::Wrench hand;
     hand.force = Eigen::Vector3d(request.force[0], request.force[1], request.force[2]);
     hand.torque = Eigen::Vector3d(request.torque[0], request.torque[1], request.torque[2]);
-    simulation->setHandWrench(hand, hold);
+    simulation->setHandWrench(
+        hand, std::chrono::duration_cast<Duration>(std::chrono::duration<double>(request.push_seconds)));
     return out;
   });
 }

@@ -252,6 +252,21 @@ void SimCartesianController::control() {
     const int dof = arm_dofs_[i];
     d->ctrl[i] = task[dof] + scratch_[static_cast<std::size_t>(dof)] - removed[dof] + d->qfrc_bias[dof];
   }
+  if (motion_.joint_stiffness > 0.0 && !stopped_) {
+    // The whole configuration held too (free-drive's checked joints), moving with the drift.
+    const bool moving = motion_.drift && motion_.posture_velocity.size() == static_cast<int>(arm_dofs_.size());
+    const double along = moving ? std::clamp(toSeconds(now_() - start_), 0.0, toSeconds(motion_.drift->horizon)) : 0.0;
+    const bool drifting = moving && now_() - start_ < motion_.drift->horizon;
+    for (std::size_t i = 0; i < arm_dofs_.size(); ++i) {
+      const int dof = arm_dofs_[i];
+      const int j = static_cast<int>(i);
+      const double target = motion_.posture[j] + (moving ? motion_.posture_velocity[j] * along : 0.0);
+      const double rate = drifting ? motion_.posture_velocity[j] : 0.0;
+      const double joint_inertia = std::max(d->qM[m->dof_Madr[dof]], 1e-3);  // kg m^2 about the joint now
+      d->ctrl[i] += motion_.joint_stiffness * (target - d->qpos[arm_qpos_[i]]) +
+                    2.0 * std::sqrt(motion_.joint_stiffness * joint_inertia) * (rate - d->qvel[dof]);
+    }
+  }
 }
 
 }  // namespace costar::sim

@@ -93,6 +93,12 @@ FreeDriveTrialResult runFreeDriveTrial(workcell::Workcell& cell, const FreeDrive
       violated = violated || margin < 0.0;
     }
     result.joint_limit_violations += violated ? 1 : 0;
+    const arm::ArmComponent::FreeDriveStatus checked = arm->freeDriveStatus();
+    if (checked.active && checked.checked.size() == q.size()) {
+      for (int j = 0; j < q.size(); ++j) {
+        result.max_departure = std::max(result.max_departure, std::abs(q[j] - checked.checked[j]));
+      }
+    }
     for (const auto& [a, b] : simulation->contacts()) {
       if ((isRobotBody(a) && parts.contains(b)) || (isRobotBody(b) && parts.contains(a))) {
         if (result.part_contact_ticks == 0) {

@@ -30,6 +30,7 @@ struct FreeDriveTrialResult {
   double travelled = 0.0;                    // m of the tool centre point
   std::uint64_t joint_limit_violations = 0;  // ticks with a joint beyond its limit
   double closest_to_limit = 0.0;             // rad: the least distance of a joint to its limit
+  double max_departure = 0.0;                // rad: the joints' largest departure from those checked
   std::uint64_t table_contact_steps = 0;     // physics steps with the arm or gripper on the table
   std::uint64_t part_contact_ticks = 0;      // ticks with the arm or gripper touching a part
   std::string first_part_contact;            // the first: which bodies, when

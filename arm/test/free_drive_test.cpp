@@ -89,17 +89,24 @@ TEST(FreeDrive, TheAdmittanceAnswersBeyondItsDeadBandWithinItsSpeedAndMasksLocke
 TEST(FreeDrive, AStepTowardAWallStopsTheLookAheadShortOfItAndAnAslantPushSlidesAlongIt) {
   // A one-joint-per-axis "arm": the joints are the tool's x, y, z; a wall at z = 0.1.
   AdmittanceGains gains;
-  const StepCheck check = [](const world::Pose& pose, const JointVector&,
-                             std::string& why) -> std::optional<JointVector> {
-    if (pose.translation().z() < 0.1) {
-      why = "tool would touch table";
-      return std::nullopt;
-    }
+  gains.max_point_speed = 1.0;  // the wall, not the speed, is what this checks
+  StepChecks check;
+  check.reach = [](const world::Pose& pose, const JointVector&, std::string&) -> std::optional<JointVector> {
     JointVector q = JointVector::zero(3);
     for (int i = 0; i < 3; ++i) {
       q[i] = pose.translation()[i];
     }
     return q;
+  };
+  check.sweep = [](const JointVector& from, const JointVector& to, std::string& why) {
+    if (std::min(from[2], to[2]) < 0.1) {
+      why = "tool would touch table";
+      return false;
+    }
+    return true;
+  };
+  check.displacement = [](const JointVector& from, const JointVector& to) {
+    return (to.eigen() - from.eigen()).norm();
   };
   world::Pose reference = world::Pose::Identity();
   reference.translation() = Eigen::Vector3d(0, 0, 0.2);
@@ -129,11 +136,14 @@ TEST(FreeDrive, AStepTowardAWallStopsTheLookAheadShortOfItAndAnAslantPushSlidesA
 
 TEST(FreeDrive, FastJointsNearASingularitySlowTheStep) {
   AdmittanceGains gains;
-  const StepCheck check = [](const world::Pose& pose, const JointVector&, std::string&) -> std::optional<JointVector> {
+  StepChecks check;
+  check.reach = [](const world::Pose& pose, const JointVector&, std::string&) -> std::optional<JointVector> {
     JointVector q = JointVector::zero(1);
     q[0] = 10.0 * pose.translation().x();  // the joint turns 10 rad per metre
     return q;
   };
+  check.sweep = [](const JointVector&, const JointVector&, std::string&) { return true; };
+  check.displacement = [](const JointVector& from, const JointVector& to) { return 0.1 * std::abs(to[0] - from[0]); };
   Twist twist;
   twist.velocity = Eigen::Vector3d(0.2, 0, 0);
   const FreeDriveStep step =
@@ -142,6 +152,60 @@ TEST(FreeDrive, FastJointsNearASingularitySlowTheStep) {
   EXPECT_GT(step.twist.velocity.x(), 0.0);
   EXPECT_LT(step.twist.velocity.x(), 0.1);
   EXPECT_EQ(step.blocked, "a joint would turn too fast (near a singularity)");
+}
+
+TEST(FreeDrive, ALinkSwingingFasterThanTheToolSlowsTheStepToTheLinksSpeedLimit) {
+  // A one-joint "arm" whose elbow moves five times as far as its tool.
+  AdmittanceGains gains;
+  StepChecks check;
+  check.reach = [](const world::Pose& pose, const JointVector&, std::string&) -> std::optional<JointVector> {
+    JointVector q = JointVector::zero(1);
+    q[0] = pose.translation().x();
+    return q;
+  };
+  check.sweep = [](const JointVector&, const JointVector&, std::string&) { return true; };
+  check.displacement = [](const JointVector& from, const JointVector& to) { return 5.0 * std::abs(to[0] - from[0]); };
+  Twist twist;
+  twist.velocity = Eigen::Vector3d(0.15, 0, 0);
+  const FreeDriveStep step =
+      stepReference(world::Pose::Identity(), JointVector::zero(1), twist, 0.01, JointVector(1, 1.0), gains, check);
+  EXPECT_GT(step.twist.velocity.x(), 0.0);
+  EXPECT_LE(5.0 * step.twist.velocity.x(), gains.max_point_speed + 1e-12);
+  EXPECT_EQ(step.blocked, "a link would move faster than 0.20 m/s");
+}
+
+TEST(FreeDrive, ALinkWhoseMotionAheadReachesAWallStopsTheStepThoughTheToolsLookAheadIsClear) {
+  // Two joints: the tool moves with the first; a link with the second, which turns one way as
+  // the tool sets off and back by the tool's look-ahead (q2 = 0.02 + 3 x - 75 x^2): where the
+  // tool will be 4 cm on is clear, but the link carried on as it moves now reaches a wall at
+  // q2 = 0.05.
+  AdmittanceGains gains;
+  StepChecks check;
+  check.reach = [](const world::Pose& pose, const JointVector&, std::string&) -> std::optional<JointVector> {
+    const double x = pose.translation().x();
+    JointVector q = JointVector::zero(2);
+    q[0] = x;
+    q[1] = 0.02 + 3.0 * x - 75.0 * x * x;
+    return q;
+  };
+  check.sweep = [](const JointVector& from, const JointVector& to, std::string& why) {
+    if (std::max(from[1], to[1]) > 0.05) {
+      why = "forearm_link would touch table";
+      return false;
+    }
+    return true;
+  };
+  check.displacement = [](const JointVector& from, const JointVector& to) {
+    return (to.eigen() - from.eigen()).cwiseAbs().maxCoeff();
+  };
+  JointVector joints = JointVector::zero(2);
+  joints[1] = 0.02;
+  Twist twist;
+  twist.velocity = Eigen::Vector3d(0.05, 0, 0);
+  const FreeDriveStep step =
+      stepReference(world::Pose::Identity(), joints, twist, 0.01, JointVector(2, 1.0), gains, check);
+  EXPECT_EQ(step.twist.velocity.norm(), 0.0);
+  EXPECT_EQ(step.blocked, "forearm_link would touch table");
 }
 
 }  // namespace

@@ -940,5 +940,39 @@ TEST(Ur5Cell, DraggingTheToolGuidesTheArmWhileHeldAndItStopsWhenTheDragsStop) {
   h.waitForRun(json::parse(moving.body)["run"]);
 }
 
+TEST(Ur5Cell, APageThatStallsKeepsFreeDriveHeldWhileTheArmStandsAndMovesAgainOnTheNextPush) {
+  Harness h(blindCell(), 1.0);
+  const json push = {{"force", {0.0, 25.0, 0.0}}, {"torque", {0.0, 0.0, 0.0}}};
+  const HttpResponse started =
+      h.call("POST", "/api/operations", {{"node", "FreeDrive"}, {"attributes", {{"mode", "translation"}}}});
+  ASSERT_EQ(started.status, 202) << started.body;
+  const std::int64_t id = json::parse(started.body)["run"];
+  // The operation begins on the engine's next tick: until then a push finds free-drive off.
+  for (int tries = 0; tries < 100 && h.call("POST", "/api/drag", push).status != 200; ++tries) {
+    h.waitTicks(1);
+  }
+  const auto pushFor = [&](int ticks) {
+    const std::uint64_t target = h.engine().stats().ticks + static_cast<std::uint64_t>(ticks);
+    while (h.engine().stats().ticks < target) {
+      ASSERT_EQ(h.call("POST", "/api/drag", push).status, 200);
+      h.waitTicks(5);  // the page's 50 ms
+    }
+  };
+  pushFor(60);
+  // The page stalls for 1 s of the cell's time (a loaded machine): the push ends after 0.25 s
+  // and the arm stands; the dead-man (2 s) stays held.
+  h.waitTicks(40);
+  const double stalled = h.get("/api/state")["arm"]["endpoint"]["p"][1];
+  h.waitTicks(60);
+  const double still = h.get("/api/state")["arm"]["endpoint"]["p"][1];
+  EXPECT_NEAR(still, stalled, 0.002) << "the arm moved on a push older than 0.25 s";
+  // The next push finds free-drive on, and the arm moves again.
+  pushFor(60);
+  const double moved = h.get("/api/state")["arm"]["endpoint"]["p"][1];
+  EXPECT_GT(moved - still, 0.02);
+  EXPECT_EQ(h.call("POST", "/api/drag", {{"release", true}}).status, 200);
+  EXPECT_EQ(h.waitForRun(id)["result"], "SUCCESS");
+}
+
 }  // namespace
 }  // namespace costar::server

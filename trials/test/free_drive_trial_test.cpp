@@ -155,6 +155,9 @@ TEST_P(FreeDrive, ARandomDragKeepsTheLimitsTheSpeedAndClearOfTheTableAndParts) {
   EXPECT_EQ(result.part_contact_ticks, 0U);
   EXPECT_LE(result.max_tool_speed, 0.25);
   EXPECT_LE(result.max_stop_time, 0.5);
+  // The arm is where its steps were checked, its elbow too (a UR5 near its elbow's singularity
+  // folded 1.6 rad away from it with the tool within 1 cm, and its forearm reached the table).
+  EXPECT_LE(result.max_departure, 0.1);
 }
 
 TEST_P(FreeDrive, ARecordedStrokeIsReplayedWithinTwoMillimetresAndOneDegree) {
@@ -166,6 +169,37 @@ TEST_P(FreeDrive, ARecordedStrokeIsReplayedWithinTwoMillimetresAndOneDegree) {
   EXPECT_LE(result.rms_position, 0.002);
   EXPECT_LE(result.max_angle, 1.0 * M_PI / 180.0);
   EXPECT_GE(result.replay_seconds, 0.95 * result.recorded_seconds);  // at the recorded pace or slower
+}
+
+TEST_P(FreeDrive, PulledOutToItsReachTheArmStaysInTheConfigurationItsStepsWereCheckedAt) {
+  // The tool pulled straight out from the base until the arm is stretched: near the elbow's
+  // singularity the tool's impedance alone barely holds the elbow (a UR5's folded 1.6 rad away
+  // from the checked configuration, the tool within 1 cm), and the collisions checked were
+  // those of an arm somewhere else.
+  const Eigen::Vector3d base = simulation_->tcpPose().translation();
+  Eigen::Vector3d out(base.x(), base.y(), 0.0);
+  out.normalize();
+  double departure = 0.0;
+  const bt::RunResult result = run("<FreeDrive mode=\"translation\" hold=\"0.2\"/>", [&](double t) {
+    const arm::ArmComponent::FreeDriveStatus status = arm_->freeDriveStatus();
+    const arm::JointVector q = simulation_->armPositions();
+    if (status.active && status.checked.size() == q.size()) {
+      for (int j = 0; j < q.size(); ++j) {
+        departure = std::max(departure, std::abs(q[j] - status.checked[j]));
+      }
+    }
+    if (t < 8.0) {
+      arm::Wrench hand;
+      hand.force = 40.0 * out + Eigen::Vector3d(0.0, 0.0, 10.0);
+      simulation_->setHandWrench(hand);
+      arm_->holdFreeDrive(std::chrono::milliseconds(100));
+    } else {
+      simulation_->setHandWrench({});
+    }
+  });
+  EXPECT_EQ(result.status, bt::Status::kSuccess) << result.failure_reason;
+  EXPECT_GT((simulation_->tcpPose().translation() - base).norm(), 0.1);
+  EXPECT_LE(departure, 0.1) << departure;
 }
 
 INSTANTIATE_TEST_SUITE_P(BothArms, FreeDrive, ::testing::Values("ur5-sim", "iiwa-sim"),

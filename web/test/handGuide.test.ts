@@ -10,10 +10,10 @@ describe('the hand on the tool', () => {
     expect(handForce([0.2, 0.1, 0.3], [0.2, 0.1, 0.3])).toEqual([0, 0, 0]);
   });
   it('asks FreeDrive for the guiding mode, the locked axes and the recording', () => {
-    expect(freeDriveAttributes({ mode: 'translation', locked: [], record: '', recordFrame: 'world' })).toEqual({ mode: 'translation', hold: '0.5' });
+    expect(freeDriveAttributes({ mode: 'translation', locked: [], record: '', recordFrame: 'world' })).toEqual({ mode: 'translation', hold: '2' });
     expect(freeDriveAttributes({ mode: 'free', locked: ['z', 'rx'], record: 'stroke', recordFrame: 'node_2' })).toEqual({
       mode: 'free',
-      hold: '0.5',
+      hold: '2',
       locked: 'z,rx',
       record: 'stroke',
       record_frame: 'node_2',
