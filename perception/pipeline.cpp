@@ -306,18 +306,32 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
       tasks.push_back(std::move(task));
     }
   }
-  std::vector<Detection> found;
-  for (std::size_t m = 0; m < models_.size(); ++m) {
-    std::vector<Detection> of_class;
-    for (const Task& task : tasks) {
-      if (task.model == m) {
-        of_class.insert(of_class.end(), task.found.begin(), task.found.end());
+  // Touching parts of a class: each refined on its own points; then levelled where it rests.
+  // The classes are independent: one per worker thread (each thread's own estimators).
+  std::vector<std::vector<Detection>> of_class(models_.size());
+  for (const Task& task : tasks) {
+    of_class[task.model].insert(of_class[task.model].end(), task.found.begin(), task.found.end());
+  }
+  {
+    const std::size_t threads = std::min(workers_->estimators.size(), models_.size());
+    const auto refine = [&](std::size_t thread) {
+      for (std::size_t m = thread; m < models_.size(); m += threads) {
+        workers_->estimators[thread][m]->refineTouching(class_points[m], of_class[m], reference);
+        workers_->estimators[thread][m]->levelResting(of_class[m], reference);
       }
+    };
+    std::vector<std::thread> helpers;
+    for (std::size_t t = 1; t < threads; ++t) {
+      helpers.emplace_back(refine, t);
     }
-    // Touching parts of a class: each refined on its own points; then levelled where it rests.
-    workers_->estimators[0][m]->refineTouching(class_points[m], of_class, reference);
-    workers_->estimators[0][m]->levelResting(of_class, reference);
-    found.insert(found.end(), of_class.begin(), of_class.end());
+    refine(0);
+    for (auto& helper : helpers) {
+      helper.join();
+    }
+  }
+  std::vector<Detection> found;
+  for (const auto& detections : of_class) {
+    found.insert(found.end(), detections.begin(), detections.end());
   }
   for (const Task& task : tasks) {
     result.times.recognition += task.timing.recognition;
