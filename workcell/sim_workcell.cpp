@@ -503,23 +503,54 @@ class SimWorkcell final : public Workcell {
       fixture("tool stand", setup.stand * Eigen::Translation3d(0, 0, setup.tool.stand_size.z() / 2),
               setup.tool.stand_size, {0.45, 0.47, 0.5});
     }
+    // The power tool's shape (its object class's boxes, in the tool frame) and where it sits in
+    // the hand: the tool frame in the tool centre point's, from the grasp SmartGrasp picks it up
+    // by. The page draws it at the tool centre point while the tool reads held.
+    nlohmann::json power_tool;
+    if (const sim::SimPowerTool* tool = simulation_->powerTool(); tool != nullptr && tool->setup()) {
+      const world::ObjectClass shape = tool->setup()->tool.objectClass();
+      if (const std::optional<smartmove::Grasp> grasp = grasps_.defaultFor(shape.name)) {
+        nlohmann::json boxes = nlohmann::json::array();
+        for (const world::Box& box : shape.boxes) {
+          boxes.push_back({{"centre", {box.center.x(), box.center.y(), box.center.z()}},
+                           {"size", {2 * box.half_size.x(), 2 * box.half_size.y(), 2 * box.half_size.z()}}});
+        }
+        const world::Pose held = grasp->tcp_in_object.inverse();
+        const Eigen::Quaterniond turn(held.linear());
+        const Eigen::Vector3d& at = held.translation();
+        const Eigen::Vector3d rgb =
+            shape.colors.empty() ? Eigen::Vector3d(0.9, 0.45, 0.1) : shape.colors.front().second;
+        power_tool = {
+            {"name", shape.name},
+            {"label", shape.description},
+            {"boxes", std::move(boxes)},
+            {"rgb", {rgb.x(), rgb.y(), rgb.z()}},
+            {"grasp", grasp->name},
+            {"held_in_tcp", {{"p", {at.x(), at.y(), at.z()}}, {"q", {turn.x(), turn.y(), turn.z(), turn.w()}}}}};
+      }
+    }
     const Eigen::Quaterniond q(cell_.robot_base.linear());
     const Eigen::Vector3d& p = cell_.robot_base.translation();
-    return {{"fixtures", std::move(fixtures)},
-            {"urdf",
-             planning::mountUrdf(text(robot_description_.urdf), text(gripper_urdf), robot_description_.urdf_tool_link,
-                                 robot_description_.urdf.string() + "' + '" + gripper_urdf.string())},
-            {"name", robot_description_.name},
-            {"label", robot_description_.label},
-            {"base_link", robot_description_.urdf_base_link},
-            {"flange_link", robot_description_.urdf_tool_link},
-            {"tcp_link", gripper_model_.tcp_link},
-            {"base_in_world", {{"p", {p.x(), p.y(), p.z()}}, {"q", {q.x(), q.y(), q.z(), q.w()}}}},
-            {"joints", std::move(joints)},
-            {"gripper", std::move(gripper)},
-            {"table",
-             {{"centre", {cell_.table_centre.x(), cell_.table_centre.y(), cell_.table_centre.z()}},
-              {"size", {cell_.table_size.x(), cell_.table_size.y(), cell_.table_size.z()}}}}};
+    nlohmann::json drawing = {
+        {"fixtures", std::move(fixtures)},
+        {"urdf",
+         planning::mountUrdf(text(robot_description_.urdf), text(gripper_urdf), robot_description_.urdf_tool_link,
+                             robot_description_.urdf.string() + "' + '" + gripper_urdf.string())},
+        {"name", robot_description_.name},
+        {"label", robot_description_.label},
+        {"base_link", robot_description_.urdf_base_link},
+        {"flange_link", robot_description_.urdf_tool_link},
+        {"tcp_link", gripper_model_.tcp_link},
+        {"base_in_world", {{"p", {p.x(), p.y(), p.z()}}, {"q", {q.x(), q.y(), q.z(), q.w()}}}},
+        {"joints", std::move(joints)},
+        {"gripper", std::move(gripper)},
+        {"table",
+         {{"centre", {cell_.table_centre.x(), cell_.table_centre.y(), cell_.table_centre.z()}},
+          {"size", {cell_.table_size.x(), cell_.table_size.y(), cell_.table_size.z()}}}}};
+    if (!power_tool.is_null()) {
+      drawing["power_tool"] = std::move(power_tool);
+    }
+    return drawing;
   }
 
   std::string name() const override { return cell_.name; }

@@ -789,6 +789,30 @@ TEST(PolishingCell, TheStateCarriesTheWrenchAndTheTool) {
   EXPECT_EQ(truth["power_tool"]["arm_workpiece_steps"].get<int>(), 0);
 }
 
+// GET /api/robot on a cell with a power tool: its shape in the tool frame and where it sits in
+// the hand (the tool frame in the tool centre point's, from the grasp SmartGrasp takes it by:
+// the knob's, the pad 10.7 cm beyond the tool centre point, the tool pointing along its z), so
+// the page draws the sander in the gripper while the state reads it held.
+TEST(PolishingCell, TheRobotDescriptionCarriesThePowerToolAndWhereItSitsInTheHand) {
+  Harness h(polishingCell());
+  const json robot = h.get("/api/robot");
+  ASSERT_TRUE(robot.contains("power_tool")) << robot.dump().substr(0, 400);
+  const json& tool = robot["power_tool"];
+  EXPECT_EQ(tool["name"], "orbital_sander");
+  EXPECT_EQ(tool["grasp"], "knob");
+  ASSERT_EQ(tool["boxes"].size(), 3u);                                // pad, housing, knob
+  EXPECT_NEAR(tool["boxes"][0]["size"][0].get<double>(), 0.1, 1e-9);  // the pad, 10 cm square
+  EXPECT_NEAR(tool["boxes"][0]["centre"][2].get<double>(), 0.006, 1e-9);
+  const json& held = tool["held_in_tcp"];
+  EXPECT_NEAR(held["p"][0].get<double>(), 0.0, 1e-9);
+  EXPECT_NEAR(held["p"][2].get<double>(), 0.107, 1e-9);
+  const Eigen::Quaterniond q(held["q"][3].get<double>(), held["q"][0].get<double>(), held["q"][1].get<double>(),
+                             held["q"][2].get<double>());
+  EXPECT_NEAR((q * Eigen::Vector3d::UnitZ() - Eigen::Vector3d(0, 0, -1)).norm(), 0.0, 1e-9);  // the knob up the arm
+  Harness ur5(blindCell());
+  EXPECT_FALSE(ur5.get("/api/robot").contains("power_tool"));
+}
+
 // GET /api/robot: the robot as the planner models it (the arm's URDF with the gripper's on its
 // flange), where it stands, its joints, its gripper; the state carries the fingers' reading.
 TEST(Ur5Cell, TheRobotIsDescribedByThePlannersUrdf) {

@@ -17,6 +17,8 @@ export interface PortInfo {
   excludes?: string[];
   min?: number;
   max?: number;
+  /** Another number of the same node this one must stay below (MoveUntilContact's force: 'max_force'). */
+  less_than?: string;
 }
 
 export interface NodeInfo {

@@ -2,7 +2,7 @@
 // urdf-loader reads the URDF with the browser's DOMParser: happy-dom stands in for the browser.
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
-import { Quaternion } from 'three';
+import { Quaternion, Vector3 } from 'three';
 import { describe, expect, it } from 'vitest';
 import { DrawnRobot } from '../src/model/drawnRobot';
 import type { FingerReading, RobotDescription } from '../src/model/robot';
@@ -48,5 +48,43 @@ describe("the robot drawn from the planner's URDF", () => {
     const parallel = new DrawnRobot(two.robot);
     parallel.update(two.samples[0].joints, two.samples[0].gripper.reading, two.samples[0].gripper.mode);
     expect(parallel.fingerBoxes()).toBe(4);
+  });
+
+  it('draws the power tool in the gripper, where its grasp puts it, while the tool reads held', () => {
+    const { robot, samples } = fixture('iiwa-3f-sim');
+    // GET /api/robot's power_tool on iiwa-3f-sim with sim/scenes/polishing.json (server test
+    // PolishingCell.TheRobotDescriptionCarriesThePowerToolAndWhereItSitsInTheHand): the sander's pad, housing and
+    // knob, held by the knob 10.7 cm above the pad, the tool's z (up through the knob) back up the arm.
+    const sander: RobotDescription['power_tool'] = {
+      name: 'orbital_sander',
+      label: 'orbital palm sander / polisher',
+      boxes: [
+        { centre: [0, 0, 0.006], size: [0.1, 0.1, 0.012] },
+        { centre: [0, 0, 0.042], size: [0.08, 0.08, 0.06] },
+        { centre: [0, 0, 0.107], size: [0.036, 0.036, 0.07] },
+      ],
+      rgb: [0.9, 0.45, 0.1],
+      grasp: 'knob',
+      held_in_tcp: { p: [0, 0, 0.107], q: [1, 0, 0, 0] },
+    };
+    const drawn = new DrawnRobot({ ...robot, power_tool: sander });
+    for (const sample of samples) {
+      drawn.update(sample.joints, sample.gripper.reading, sample.gripper.mode, true);
+      const held = drawn.heldToolPose();
+      expect(held).not.toBeNull();
+      const tcp = drawn.toolPose();
+      const along = new Vector3(0, 0, 1).applyQuaternion(tcp.quaternion);
+      // The pad's face 10.7 cm beyond the tool centre point along its axis, the tool turned to face back up the arm.
+      expect(held!.position.distanceTo(tcp.position.clone().addScaledVector(along, 0.107))).toBeLessThan(1e-9);
+      expect(new Vector3(0, 0, 1).applyQuaternion(held!.quaternion).dot(along)).toBeCloseTo(-1, 9);
+      drawn.update(sample.joints, sample.gripper.reading, sample.gripper.mode, false);
+      expect(drawn.heldToolPose()).toBeNull(); // on its stand, or taken away: not in the hand
+    }
+    drawn.dispose();
+    // A cell without a power tool draws none, whatever the state says.
+    const plain = new DrawnRobot(robot);
+    plain.update(samples[0].joints, samples[0].gripper.reading, samples[0].gripper.mode, true);
+    expect(plain.heldToolPose()).toBeNull();
+    plain.dispose();
   });
 });

@@ -1,6 +1,6 @@
 import { describe, expect, it } from 'vitest';
 import type { NodeInfo, PortInfo } from '../src/api';
-import { rangeProblem, rangeProblems, rangeText, toPlan, toShown, unitOf } from '../src/model/units';
+import { boundProblem, boundText, rangeProblem, rangeProblems, rangeText, toPlan, toShown, unitOf } from '../src/model/units';
 import { argumentKinds, waypointPaths } from '../src/model/paths';
 import { forceReadout } from '../src/model/forceReadout';
 import type { CellState } from '../src/api';
@@ -45,6 +45,36 @@ describe('numbers in the units a technician states them in', () => {
     const root = { key: 'r', id: 'Sequence', attributes: [], collapsed: false, children: [leaf('a', [['force', '10']]), leaf('b', [['force', '70'], ['speed', '1']])] };
     const found = rangeProblems(root as never, (id) => (id === 'PressAndFollow' ? press : undefined));
     expect(found).toEqual([{ key: 'b', id: 'PressAndFollow', message: 'force 70 N is out of range: from 1 to 60 N' }]);
+  });
+});
+
+describe('a number that must stay below another of its node (less_than)', () => {
+  // MoveUntilContact's force and max_force as GET /api/nodes lists them (server/palette.cpp: less_than).
+  const pressing: PortInfo = { ...force, default: '5', less_than: 'max_force' };
+  const maxForce: PortInfo = { name: 'max_force', type: 'double', description: 'the force (N) that stops the motion', default: '40', min: 5, max: 150 };
+  const ports = [pressing, maxForce];
+
+  it('names the bound next to the field, with the value the node has now or its default', () => {
+    expect(boundText(pressing, ports, [])).toBe('below max_force (40 N)');
+    expect(boundText(pressing, ports, [['max_force', '25']])).toBe('below max_force (25 N)');
+    expect(boundText(maxForce, ports, [])).toBe('');
+    expect(boundText(force, ports, [])).toBe('');
+  });
+
+  it('refuses a force at or above max_force, whether max_force is written or its default', () => {
+    expect(boundProblem(pressing, ports, [['force', '40']])).toBe('force 40 N must be below max_force (40 N)');
+    expect(boundProblem(pressing, ports, [['force', '30'], ['max_force', '20']])).toBe('force 30 N must be below max_force (20 N)');
+    expect(boundProblem(pressing, ports, [['force', '39.9']])).toBeNull();
+    expect(boundProblem(pressing, ports, [])).toBeNull(); // 5 N below 40 N by default
+    expect(boundProblem(pressing, ports, [['force', 'abc']])).toBeNull(); // the range check names that
+  });
+
+  it('refuses the plan before Run: rangeProblems lists the node', () => {
+    const contact: NodeInfo = { id: 'MoveUntilContact', kind: 'Action', category: 'robot_action', description: '', asynchronous: true, ports };
+    const leaf = (key: string, attributes: [string, string][]) => ({ key, id: 'MoveUntilContact', attributes, children: [], collapsed: false });
+    const root = { key: 'r', id: 'Sequence', attributes: [], collapsed: false, children: [leaf('a', [['force', '10']]), leaf('b', [['force', '50'], ['max_force', '45']])] };
+    const found = rangeProblems(root as never, (id) => (id === 'MoveUntilContact' ? contact : undefined));
+    expect(found).toEqual([{ key: 'b', id: 'MoveUntilContact', message: 'force 50 N must be below max_force (45 N)' }]);
   });
 });
 

@@ -6,7 +6,7 @@ import type { EditorNode } from '../model/tree';
 import { formatPredicates, parsePredicates, PredicateTerm, referenceChoices } from '../model/predicates';
 import { formatPoseText, parsePoseText, POSE_FIELDS, PoseFields } from '../model/poseText';
 import { argumentKinds, waypointPaths } from '../model/paths';
-import { rangeProblem, rangeText, toPlan, toShown, unitOf } from '../model/units';
+import { boundProblem, boundText, rangeProblem, rangeText, toPlan, toShown, unitOf } from '../model/units';
 
 interface Props {
   node: EditorNode | null;
@@ -152,12 +152,21 @@ function PathInput(props: { id: string; text: string | undefined; waypoints: str
   );
 }
 
-/** A number in the unit a technician states it in (mm, mm/s, N), with its range and why a value is refused. */
-function NumberInput(props: { id: string; port: PortInfo; current: string | undefined; disabled: boolean; onChange: (value: string | undefined) => void }) {
+/** A number in the unit a technician states it in (mm, mm/s, N), with its range, the number of the node it must
+ * stay below (a force below max_force) and why a value is refused. */
+function NumberInput(props: {
+  id: string;
+  port: PortInfo;
+  ports: PortInfo[];
+  attributes: [string, string][];
+  current: string | undefined;
+  disabled: boolean;
+  onChange: (value: string | undefined) => void;
+}) {
   const { port } = props;
   const unit = unitOf(port);
-  const range = rangeText(port);
-  const problem = rangeProblem(port, props.current);
+  const range = [rangeText(port), boundText(port, props.ports, props.attributes)].filter((t) => t !== '').join(', ');
+  const problem = rangeProblem(port, props.current) ?? boundProblem(port, props.ports, props.attributes);
   const placeholder = port.default !== undefined ? `default: ${toShown(unit, port.default) || '(none)'}` : 'type a number';
   return (
     <div className="number-port">
@@ -428,7 +437,17 @@ export function NodeEditor({ node, info, choices, objects, trees, readOnly, onCh
       );
     }
     if (port.type === 'int' || port.type === 'double') {
-      return <NumberInput id={id} port={port} current={current} disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;
+      return (
+        <NumberInput
+          id={id}
+          port={port}
+          ports={info?.ports ?? []}
+          attributes={node.attributes}
+          current={current}
+          disabled={readOnly}
+          onChange={(v) => onChange(port.name, v)}
+        />
+      );
     }
     if (port.type === 'costar::Pose') {
       return <PoseInput id={id} text={current} disabled={readOnly} onChange={(v) => onChange(port.name, v)} />;

@@ -294,7 +294,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     const s = sceneRef.current;
     if (!s || !state) return;
     if (drawn) {
-      drawn.update(state.arm.joints, state.gripper.reading, state.gripper.mode);
+      drawn.update(state.arm.joints, state.gripper.reading, state.gripper.mode, state.tool?.held ?? false);
       const tool = drawn.toolPose();
       s.handle.visible = !!onGrab;
       s.handle.position.copy(tool.position);

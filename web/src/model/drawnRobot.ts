@@ -2,7 +2,8 @@
 // with the gripper's mounted on the flange), built by urdf-loader from its collision primitives
 // (no meshes needed), placed where the cell stands it, its joints set by name from the stream,
 // and the fingers drawn from the gripper's reading in place of the URDF's finger links (which
-// cover the fingers' whole travel for the planner).
+// cover the fingers' whole travel for the planner). A power tool the gripper holds is drawn at the
+// tool centre point, where its grasp puts it.
 
 import * as THREE from 'three';
 import URDFLoader from 'urdf-loader';
@@ -21,6 +22,8 @@ export class DrawnRobot {
   private readonly fingerMaterial = new THREE.MeshLambertMaterial({ color: FINGER_COLOUR });
   private readonly materials: THREE.Material[] = [];
   private fingerKey = '';
+  /** The power tool as held, under the tool centre point's link; shown while the tool reads held. */
+  private readonly heldTool = new THREE.Group();
 
   constructor(readonly description: RobotDescription) {
     const loader = new URDFLoader();
@@ -57,10 +60,27 @@ export class DrawnRobot {
       }
     }
     flange?.add(this.fingers);
+    const tool = description.power_tool;
+    if (tool) {
+      const toolMaterial = new THREE.MeshLambertMaterial({ color: new THREE.Color(...tool.rgb) });
+      this.materials.push(toolMaterial);
+      for (const box of tool.boxes) {
+        const mesh = new THREE.Mesh(new THREE.BoxGeometry(...box.size), toolMaterial);
+        mesh.position.set(...box.centre);
+        this.heldTool.add(mesh);
+      }
+      this.heldTool.name = tool.name;
+      this.heldTool.position.set(...tool.held_in_tcp.p);
+      this.heldTool.quaternion.set(...tool.held_in_tcp.q).normalize();
+      this.heldTool.visible = false;
+      (this.robot.links[description.tcp_link] ?? flange)?.add(this.heldTool);
+    }
   }
 
-  /** Joint angles (the description's order, rad), the fingers' reading and the gripper's mode. */
-  update(joints: number[] | undefined, reading: FingerReading | undefined, mode: string | undefined) {
+  /** Joint angles (the description's order, rad), the fingers' reading, the gripper's mode and whether the power
+   * tool is in the gripper (drawn there while it is). */
+  update(joints: number[] | undefined, reading: FingerReading | undefined, mode: string | undefined, toolHeld = false) {
+    this.heldTool.visible = toolHeld && this.heldTool.children.length > 0;
     this.robot.setJointValues(jointValues(this.description, joints));
     const key = JSON.stringify([reading?.positions, mode]);
     if (key !== this.fingerKey) {
@@ -100,6 +120,16 @@ export class DrawnRobot {
     const position = new THREE.Vector3();
     const quaternion = new THREE.Quaternion();
     tcp.matrixWorld.decompose(position, quaternion, new THREE.Vector3());
+    return { position, quaternion };
+  }
+
+  /** The held power tool's frame as drawn, in the world (null: none drawn in the hand now). */
+  heldToolPose(): { position: THREE.Vector3; quaternion: THREE.Quaternion } | null {
+    if (!this.heldTool.visible) return null;
+    this.object.updateMatrixWorld(true);
+    const position = new THREE.Vector3();
+    const quaternion = new THREE.Quaternion();
+    this.heldTool.matrixWorld.decompose(position, quaternion, new THREE.Vector3());
     return { position, quaternion };
   }
 

@@ -43,6 +43,16 @@ export interface RobotDescription {
   table?: { centre: [number, number, number]; size: [number, number, number] };
   /** What the scene fixes on the table (a workpiece and its marked area, a tool stand): boxes in the world. */
   fixtures?: { name: string; p: [number, number, number]; q: [number, number, number, number]; size: [number, number, number]; rgb: [number, number, number] }[];
+  /** The cell's power tool, when it has one: its boxes in the tool frame, and the tool frame in the tool centre
+   * point's while it is held (from the grasp SmartGrasp takes it by). */
+  power_tool?: {
+    name: string;
+    label: string;
+    boxes: { centre: [number, number, number]; size: [number, number, number] }[];
+    rgb: [number, number, number];
+    grasp: string;
+    held_in_tcp: { p: [number, number, number]; q: [number, number, number, number] };
+  };
 }
 
 /** The gripper's reading as the stream carries it (the `gripper_fingers` symbol). */

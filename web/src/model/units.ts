@@ -1,8 +1,9 @@
 // Numbers as a technician states them: a parameter's unit is the one its description names in
 // parentheses ("the force (N) ...", "how fast the tool approaches (m/s)"), the plan keeps the
 // cell's units (metres, m/s, N) and the editor shows lengths and speeds in millimetres and mm/s,
-// as it shows poses. A value out of the parameter's range (GET /api/nodes: min, max) is refused
-// with the reason before anything is saved or run.
+// as it shows poses. A value out of the parameter's range (GET /api/nodes: min, max), or not below
+// the number of the node it must stay below (less_than: a force below max_force), is refused with
+// the reason before anything is saved or run, as costar validate refuses it.
 
 import type { NodeInfo, PortInfo } from '../api';
 import type { EditorNode } from './tree';
@@ -81,13 +82,44 @@ export function rangeProblem(port: PortInfo, text: string | undefined): string |
   return `${port.name} ${toShown(unit, text)}${unit ? ` ${unit.shown}` : ''} is out of range: ${rangeText(port)}`;
 }
 
-/** Every parameter of the tree refused by its range, with its node's key: the first per node. */
+/** A node's number as it stands: written in the plan, else its port's default (undefined: neither). */
+function numberOf(ports: PortInfo[], attributes: [string, string][], name: string): { port: PortInfo; text: string } | undefined {
+  const port = ports.find((p) => p.name === name);
+  const text = attributes.find(([k]) => k === name)?.[1] ?? port?.default;
+  return port && text !== undefined && text.trim() !== '' ? { port, text } : undefined;
+}
+
+/** "below max_force (40 N)": the number a parameter must stay below, as the node has it now, or ''. */
+export function boundText(port: PortInfo, ports: PortInfo[], attributes: [string, string][]): string {
+  if (!port.less_than) return '';
+  const bound = numberOf(ports, attributes, port.less_than);
+  if (!bound || !Number.isFinite(Number(bound.text))) return `below ${port.less_than}`;
+  const unit = unitOf(bound.port);
+  return `below ${port.less_than} (${toShown(unit, bound.text)}${unit ? ` ${unit.shown}` : ''})`;
+}
+
+/** Why a number at or above the one it must stay below (less_than) is refused, in the shown unit, or null. */
+export function boundProblem(port: PortInfo, ports: PortInfo[], attributes: [string, string][]): string | null {
+  if (!port.less_than) return null;
+  const own = numberOf(ports, attributes, port.name);
+  const bound = numberOf(ports, attributes, port.less_than);
+  if (!own || !bound) return null;
+  const value = Number(own.text);
+  const limit = Number(bound.text);
+  if (!Number.isFinite(value) || !Number.isFinite(limit) || value < limit) return null;
+  const unit = unitOf(port);
+  const shown = (text: string) => `${toShown(unit, text)}${unit ? ` ${unit.shown}` : ''}`;
+  return `${port.name} ${shown(own.text)} must be below ${port.less_than} (${shown(bound.text)})`;
+}
+
+/** Every parameter of the tree refused by its range or its bound, with its node's key: the first per node. */
 export function rangeProblems(root: EditorNode | null, nodeInfo: (id: string) => NodeInfo | undefined): { key: string; id: string; message: string }[] {
   const found: { key: string; id: string; message: string }[] = [];
   const walk = (node: EditorNode) => {
     const info = nodeInfo(node.id);
-    for (const port of info?.ports ?? []) {
-      const problem = rangeProblem(port, node.attributes.find(([k]) => k === port.name)?.[1]);
+    const ports = info?.ports ?? [];
+    for (const port of ports) {
+      const problem = rangeProblem(port, node.attributes.find(([k]) => k === port.name)?.[1]) ?? boundProblem(port, ports, node.attributes);
       if (problem) {
         found.push({ key: node.key, id: node.id, message: problem });
         break;
