@@ -70,21 +70,38 @@ DisturbanceSpec parseDisturbance(std::string_view text) {
   if (at != std::string_view::npos && spec.kind == DisturbanceKind::kTakeTool) {
     const std::string_view when = text.substr(at + 1);
     constexpr std::string_view kAt = "at=";
-    if (when.substr(0, kAt.size()) != kAt) {
-      throw std::invalid_argument(where + "expected @at=SECONDS after take-tool, not '@" + std::string(when) + "'");
+    constexpr std::string_view kWithin = "within=";
+    const auto seconds = [&where](const std::string& number, const char* what) {
+      std::size_t used = 0;
+      double value = -1.0;
+      try {
+        value = std::stod(number, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (number.empty() || used != number.size() || !(value >= 0.0 && value <= 1e4)) {
+        throw std::invalid_argument(where + what + " needs a number of seconds from 0 to 10000, not '" + number + "'");
+      }
+      return value;
+    };
+    if (when.substr(0, kAt.size()) == kAt) {
+      spec.at_seconds = seconds(std::string(when.substr(kAt.size())), "at=SECONDS");
+    } else if (when.substr(0, kWithin.size()) == kWithin) {
+      const std::string_view window = when.substr(kWithin.size());
+      const std::size_t dash = window.find('-');
+      if (dash == std::string_view::npos) {
+        throw std::invalid_argument(where + "within=A-B needs two numbers of seconds joined by '-', not '" +
+                                    std::string(window) + "'");
+      }
+      spec.within = {seconds(std::string(window.substr(0, dash)), "within=A-B"),
+                     seconds(std::string(window.substr(dash + 1)), "within=A-B")};
+      if (!(spec.within.first < spec.within.second)) {
+        throw std::invalid_argument(where + "within=A-B needs A before B, not '" + std::string(window) + "'");
+      }
+    } else {
+      throw std::invalid_argument(where + "expected @at=SECONDS or @within=A-B after take-tool, not '@" +
+                                  std::string(when) + "'");
     }
-    const std::string number(when.substr(kAt.size()));
-    std::size_t used = 0;
-    double value = -1.0;
-    try {
-      value = std::stod(number, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (number.empty() || used != number.size() || !(value >= 0.0 && value <= 1e4)) {
-      throw std::invalid_argument(where + "at=SECONDS needs a number of seconds from 0 to 10000, not '" + number + "'");
-    }
-    spec.at_seconds = value;
     return spec;
   }
   if (at != std::string_view::npos) {
@@ -120,8 +137,8 @@ std::string disturbanceGrammar() {
          "  drop-frame  one camera frame of a DetectObjects comes empty\n"
          "  add         a part (node or link, drawn) is put on the table at a free place as the gripper goes down to "
          "another\n"
-         "  take-tool   the power tool is taken (from the gripper or its stand) 4-40 s into the trial (@at=S: at S s) "
-         "and given back onto its stand 2-8 s later\n"
+         "  take-tool   the power tool is taken (from the gripper or its stand) 1-19 s into the trial, within the "
+         "polishing plan's span (@within=A-B: A-B s; @at=S: at S s), and given back onto its stand 2-8 s later\n"
          "  @grasp=N    the N-th approach to a part (default: the 1st to 3rd, drawn)";
 }
 
@@ -135,7 +152,8 @@ Disturber::Disturber(std::vector<DisturbanceSpec> specs, std::uint64_t seed)
     }
     Pending pending;
     if (spec.kind == DisturbanceKind::kTakeTool) {
-      pending.take_at = spec.at_seconds.value_or(std::uniform_real_distribution<double>(4.0, 40.0)(random_));
+      pending.take_at = spec.at_seconds.value_or(
+          std::uniform_real_distribution<double>(spec.within.first, spec.within.second)(random_));
       pending.away_for = std::uniform_real_distribution<double>(2.0, 8.0)(random_);
     } else {
       pending.approach = spec.grasp > 0 ? spec.grasp : std::uniform_int_distribution<int>(1, 3)(random_);

@@ -13,8 +13,11 @@
 //               another (its class drawn from the seed among the cell's spare parts, parked
 //               off the table from the start: the simulator's bodies are fixed once loaded)
 //   take-tool   the power tool is taken (out of the gripper, or off its stand: wherever it is)
-//               at a moment drawn from the seed (4 to 40 s into the trial; "@at=S": S seconds)
-//               and given back onto its stand 2 to 8 s later (sim/power_tool.h)
+//               at a moment drawn from the seed within the polishing plan's span (1 to 19 s
+//               into the trial: undisturbed, examples/iiwa/polishing.xml picks the tool up from
+//               its stand until 5 s, runs it from 6 to 19.5 s and ends at 22 s, so every trial
+//               is disturbed while the plan works; "@within=A-B": A to B seconds; "@at=S": S
+//               seconds) and given back onto its stand 2 to 8 s later (sim/power_tool.h)
 // "@grasp=N" picks the N-th approach to a part (default: 1 to 3, drawn from the seed).
 // An approach is the tool going down over a part resting on the table with the fingers open
 // and empty, within 3 cm of its centre, 4 to 9 cm above it (just past the pre-grasp pose).
@@ -25,6 +28,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace costar::sim {
@@ -35,17 +39,22 @@ namespace costar::trials {
 
 enum class DisturbanceKind { kNudge, kTakeAway, kDropFrame, kAdd, kTakeTool };
 
+/// take-tool's default window (s into the trial): within the polishing plan's span (above).
+inline constexpr std::pair<double, double> kTakeToolWindow{1.0, 19.0};
+
 struct DisturbanceSpec {
   DisturbanceKind kind = DisturbanceKind::kNudge;
   /// The approach disturbed (1-based); 0: drawn from the seed in 1..3.
   int grasp = 0;
-  /// take-tool: when (simulated seconds); absent: drawn from the seed.
+  /// take-tool: when (simulated seconds); absent: drawn from the seed within `within`.
   std::optional<double> at_seconds;
+  /// take-tool: the window its moment is drawn in (simulated seconds).
+  std::pair<double, double> within = kTakeToolWindow;
   std::string text;  // as written
 };
 
-/// Parses "nudge", "take-away@grasp=2", "drop-frame", "take-tool@at=20". @throws std::invalid_argument naming the
-/// spec and the problem.
+/// Parses "nudge", "take-away@grasp=2", "drop-frame", "take-tool@at=20", "take-tool@within=2-10". @throws
+/// std::invalid_argument naming the spec and the problem.
 DisturbanceSpec parseDisturbance(std::string_view text);
 /// The grammar in a few lines, for --help.
 std::string disturbanceGrammar();

@@ -201,7 +201,7 @@ fi
 # Free-drive (docs/TEACHING.md): a push moves the tool, recorded and replayed; the table stops it.
 printf 'drag 0 20 0 1 translation record swipe\ntrajectories\nreplay swipe\nreplay nothing\ndrag 0 0 -40 3 lock x\nquit\n' |
   "$costar" teach --scene sim/scenes/one_node.json --waypoints "$tmp/waypoints.json" >"$tmp/drag.out" 2>&1
-if grep -q "^the tool moved [-0-9.]* 0\.1[0-9]* " "$tmp/drag.out" && grep -q "^  swipe  *in world: " "$tmp/drag.out" &&
+if grep -Eq "^the tool moved [-0-9.]* 0\.(09[5-9]|1[0-9])[0-9]* " "$tmp/drag.out" && grep -q "^  swipe  *in world: " "$tmp/drag.out" &&
   grep -q "failed: FollowTrajectory: unknown trajectory 'nothing'" "$tmp/drag.out" &&
   grep -q "held back: fingers would touch table" "$tmp/drag.out" && grep -q '"trajectories"' "$tmp/waypoints.json"; then
   echo "ok   teach: drag, record, replay"

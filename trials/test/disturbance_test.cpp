@@ -43,6 +43,45 @@ TEST(Disturbance, SpecsAreParsedAndBadOnesNamed) {
   EXPECT_NE(errorOf("drop-frame@grasp=1").find("takes no @"), std::string::npos);
 }
 
+// take-tool's moment is drawn within the polishing plan's span (1-19 s; the plan ends at 22 s
+// undisturbed), so every disturbed trial is disturbed while the plan works: the draw was 4-40 s,
+// and 47 of 100 trials on seeds 7101-7200 ended before it.
+TEST(Disturbance, TheToolIsTakenAtAMomentDrawnWithinThePlansSpan) {
+  EXPECT_EQ(parseDisturbance("take-tool").kind, DisturbanceKind::kTakeTool);
+  EXPECT_EQ(parseDisturbance("take-tool@at=20").at_seconds, 20.0);
+  EXPECT_EQ(parseDisturbance("take-tool@within=2-10").within, std::make_pair(2.0, 10.0));
+  EXPECT_NE(errorOf("take-tool@within=10-2").find("within=A-B needs A before B, not '10-2'"), std::string::npos)
+      << errorOf("take-tool@within=10-2");
+  EXPECT_NE(errorOf("take-tool@within=5").find("two numbers of seconds joined by '-'"), std::string::npos);
+  EXPECT_NE(errorOf("take-tool@within=x-5").find("within=A-B needs a number of seconds from 0 to 10000, not 'x'"),
+            std::string::npos)
+      << errorOf("take-tool@within=x-5");
+  EXPECT_NE(errorOf("take-tool@grasp=2").find("expected @at=SECONDS or @within=A-B"), std::string::npos);
+  // The moment drawn, as a trial that ended at once reports it ("not applied: the trial ended before X s").
+  const auto moment = [](const std::string& spec, std::uint64_t seed) {
+    const std::vector<std::string> events = Disturber({parseDisturbance(spec)}, seed).events();
+    const std::regex before(R"(take-tool: not applied: the trial ended before ([0-9.]+) s)");
+    std::smatch match;
+    EXPECT_EQ(events.size(), 1u);
+    EXPECT_TRUE(std::regex_match(events.at(0), match, before)) << events.at(0);
+    return std::stod(match[1]);
+  };
+  double earliest = 1e9;
+  double latest = 0.0;
+  for (std::uint64_t seed = 7101; seed <= 7200; ++seed) {
+    const double at = moment("take-tool", seed);
+    earliest = std::min(earliest, at);
+    latest = std::max(latest, at);
+    const double within = moment("take-tool@within=2-3", seed);
+    EXPECT_GE(within, 1.95);
+    EXPECT_LE(within, 3.05);
+  }
+  EXPECT_GE(earliest, kTakeToolWindow.first - 0.05);  // events round to 0.1 s
+  EXPECT_LE(latest, kTakeToolWindow.second + 0.05);
+  EXPECT_GT(latest - earliest, 12.0);  // spread over the window, not one moment
+  EXPECT_EQ(moment("take-tool@at=12.5", 7101), 12.5);
+}
+
 TEST(Disturbance, ADroppedFrameIsDrawnFromTheSeedAmongThePlansFrames) {
   const auto frames = [](std::uint64_t seed) { return Disturber({parseDisturbance("drop-frame")}, seed).faultSpecs(); };
   ASSERT_EQ(frames(7).size(), 1u);

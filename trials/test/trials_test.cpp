@@ -566,7 +566,9 @@ INSTANTIATE_TEST_SUITE_P(Assembly, FixedAssemblyTrial,
 // 32.84 s and 33.03 s (the SVM's AVX2 path and the leftover hand-over, alone, change nothing here);
 // then with the UR5 cell's own SVM (issue 33: trained with its arm, stacked parts; the voxels
 // labelled a little differently move the parts' poses by a fraction of a millimetre): 32.83 s and
-// 33.03 s.
+// 33.03 s; then with the joint controller's integral action while its setpoint rests (issue 30:
+// the arm now settles onto each goal under the held part's weight, which its model does not
+// carry): 32.84 s and 33.21 s.
 TEST(Trials, TheSameSeedsGiveTheSameAssemblyTrials) {
   TrialOptions options;
   options.plan = dataRoot() / "examples/ur5/assemble_structure.xml";
@@ -577,7 +579,7 @@ TEST(Trials, TheSameSeedsGiveTheSameAssemblyTrials) {
   options.jobs = 2;
   const Summary summary = runTrials(options);
   ASSERT_EQ(summary.trials.size(), 2u);
-  const double recorded[] = {32.83, 33.03};
+  const double recorded[] = {32.84, 33.21};
   for (std::size_t i = 0; i < 2; ++i) {
     const TrialResult& trial = summary.trials[i];
     EXPECT_TRUE(trial.success) << "seed " << trial.seed << ": " << trial.failure_path << ": " << trial.reason;
