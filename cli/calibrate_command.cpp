@@ -225,7 +225,7 @@ int evaluate(EvalOptions options) {
 void addCellOptions(CLI::App* command, CalibrateOptions& options) {
   command
       ->add_option("-w,--workcell", options.workcell,
-                   "simulated workcell (workcells/NAME.json: ur5-sim, iiwa-sim, iiwa-3f-sim)")
+                   "simulated workcell (workcells/NAME.json: " + workcell::knownWorkcellNames(true) + ")")
       ->capture_default_str();
   command->add_option("--scene", options.scene, "scene file (default sim/scenes/assembly.json)")
       ->check(CLI::ExistingFile);
@@ -273,7 +273,7 @@ void addCalibrateCommand(CLI::App& app, int& exit_code) {
   CLI::App* eval = command->add_subcommand(
       "eval", "Simulation: calibrate N seeded set-ups with the camera moved, and compare with its true pose");
   eval->add_option("-w,--workcell", eval_options->eval.workcell,
-                   "simulated workcell (workcells/NAME.json: ur5-sim, iiwa-sim, iiwa-3f-sim)")
+                   "simulated workcell (workcells/NAME.json: " + workcell::knownWorkcellNames(true) + ")")
       ->capture_default_str();
   eval->add_option("--scene", eval_options->eval.scene, "scene file (default sim/scenes/assembly.json)")
       ->check(CLI::ExistingFile);

@@ -83,11 +83,8 @@ void printDiagnostics(const bt::PlanError& error) {
 
 /// Options that choose and set up the workcell, shared by the plan commands.
 void addWorkcellOptions(CLI::App* command, workcell::WorkcellOptions& options) {
-  std::string known;
-  for (const auto& info : workcell::knownWorkcells()) {
-    known += (known.empty() ? "" : ", ") + info.name;
-  }
-  command->add_option("-w,--workcell", options.name, "workcell to run on: " + known)->capture_default_str();
+  command->add_option("-w,--workcell", options.name, "workcell to run on: " + workcell::knownWorkcellNames())
+      ->capture_default_str();
   command->add_option("--scene", options.scene, "simulated workcells: scene file (default sim/scenes/assembly.json)")
       ->check(CLI::ExistingFile);
   command->add_option("--seed", options.seed, "simulated workcells: seed of part placement and sensor noise")

@@ -11,11 +11,8 @@ void addServeCommand(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<server::ServeOptions>();
   CLI::App* serve = app.add_subcommand(
       "serve", "Serve the task editor (a web page) and its API: build, run and watch plans on a workcell");
-  std::string known;
-  for (const auto& info : workcell::knownWorkcells()) {
-    known += (known.empty() ? "" : ", ") + info.name;
-  }
-  serve->add_option("-w,--workcell", options->workcell.name, "workcell to run on: " + known)->capture_default_str();
+  serve->add_option("-w,--workcell", options->workcell.name, "workcell to run on: " + workcell::knownWorkcellNames())
+      ->capture_default_str();
   serve->add_option("--scene", options->workcell.scene, "simulated workcells: scene file")->check(CLI::ExistingFile);
   serve->add_option("--seed", options->workcell.seed, "simulated workcells: seed of part placement and sensor noise")
       ->check(wholeNumber());

@@ -10,6 +10,7 @@
 #include "core/files.h"
 #include "core/json_file.h"
 #include "core/paths.h"
+#include "gripper/description_fields.h"
 
 namespace costar::gripper {
 
@@ -36,87 +37,11 @@ std::optional<GripperMode> modeFromString(std::string_view name) {
   return std::nullopt;
 }
 
-std::filesystem::path gripperDescriptionFile(const std::string& name, const std::filesystem::path& data_root) {
-  const std::filesystem::path root = data_root.empty() ? dataRoot() : data_root;
-  return root / "robots" / "grippers" / (name + ".json");
-}
-
-namespace {
-
-/// Typed access that names the field in its errors.
-class Fields {
- public:
-  explicit Fields(std::string label) : label_(std::move(label)) {}
-  [[noreturn]] void fail(const std::string& field, const std::string& problem) const {
-    throw std::runtime_error(label_ + ": " + field + ": " + problem);
-  }
-  const nlohmann::json& at(const nlohmann::json& object, const std::string& key, const std::string& field) const {
-    if (!object.is_object() || !object.contains(key)) {
-      fail(field.empty() ? key : field + "." + key, "missing");
-    }
-    return object.at(key);
-  }
-  /// A finite number of magnitude at most `at_most` (1e308 is a typing error).
-  double number(const nlohmann::json& object, const std::string& key, const std::string& field,
-                double at_most = 1e6) const {
-    const auto& value = at(object, key, field);
-    if (!value.is_number() || !std::isfinite(value.get<double>())) {
-      fail(field.empty() ? key : field + "." + key, "must be a finite number");
-    }
-    if (std::abs(value.get<double>()) > at_most) {
-      char problem[96];
-      std::snprintf(problem, sizeof problem, "must be at most %g in magnitude, not %g", at_most, value.get<double>());
-      fail(field.empty() ? key : field + "." + key, problem);
-    }
-    return value.get<double>();
-  }
-  /// A length (m) above 0 and at most `at_most`.
-  double length(const nlohmann::json& object, const std::string& key, const std::string& field, double at_most) const {
-    const double value = number(object, key, field, at_most);
-    if (!(value > 0.0)) {
-      char problem[96];
-      std::snprintf(problem, sizeof problem, "must be a length above 0 and at most %g m, not %g", at_most, value);
-      fail(field + "." + key, problem);
-    }
-    return value;
-  }
-  /// 3 finite numbers, each of magnitude at most 1 (m: a hand is well under a metre across).
-  Eigen::Vector3d vec3(const nlohmann::json& object, const std::string& key, const std::string& field) const {
-    const auto& value = at(object, key, field);
-    if (!value.is_array() || value.size() != 3 || !std::all_of(value.begin(), value.end(), [](const auto& x) {
-          return x.is_number() && std::isfinite(x.template get<double>()) && std::abs(x.template get<double>()) <= 1.0;
-        })) {
-      fail(field.empty() ? key : field + "." + key, "must be 3 numbers from -1 to 1 (m)");
-    }
-    return {value[0].get<double>(), value[1].get<double>(), value[2].get<double>()};
-  }
-
- private:
-  std::string label_;
-};
-
-}  // namespace
-
 AdaptiveGripperDescription loadAdaptiveGripperDescription(const std::filesystem::path& file) {
-  const Fields fields("gripper description '" + file.string() + "'");
-  const std::string text = readFile(file, "gripper description");
-  nlohmann::json root;
-  try {
-    root = core::parseJson(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    fields.fail("(syntax)", e.what());
-  } catch (const std::runtime_error& e) {  // a key given twice: "FIELD: key 'K' appears twice ..."
-    throw std::runtime_error("gripper description '" + file.string() + "': " + e.what());
-  }
-  if (!root.is_object() || root.value("format", "") != "costar-gripper-description/1") {
-    fields.fail("format", "must be \"costar-gripper-description/1\"");
-  }
+  const detail::Fields fields("gripper description '" + file.string() + "'");
+  const nlohmann::json root = detail::readGripperDescription(file, fields, "adaptive-3f");
   AdaptiveGripperDescription description;
-  const auto& name = fields.at(root, "name", "");
-  if (!name.is_string()) {
-    fields.fail("name", "must be a string");
-  }
-  description.name = name.get<std::string>();
+  description.name = root.at("name").get<std::string>();
   description.tcp = fields.vec3(root, "tcp", "");
   const auto& fingers = fields.at(root, "fingers", "");
   if (!fingers.is_array() || fingers.size() != kFingerCount) {

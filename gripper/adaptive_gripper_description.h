@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "gripper/adaptive_gripper_driver.h"
+#include "gripper/gripper_description.h"
 
 namespace costar::gripper {
 
@@ -59,9 +60,6 @@ struct AdaptiveGripperDescription {
 
   const AdaptiveModeDescription& mode(GripperMode mode) const { return modes.at(mode); }
 };
-
-/// robots/grippers/NAME.json under `data_root` (default: dataRoot()).
-std::filesystem::path gripperDescriptionFile(const std::string& name, const std::filesystem::path& data_root = {});
 
 /// @throws std::runtime_error naming the file, the field and the problem.
 AdaptiveGripperDescription loadAdaptiveGripperDescription(const std::filesystem::path& file);

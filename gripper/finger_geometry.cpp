@@ -17,12 +17,4 @@ std::vector<FingerBox> FingerGeometry::at(double opening) const {
   return boxes;
 }
 
-FingerGeometry twoFingerGripper() {
-  FingerGeometry fingers;
-  fingers.closed = {{Eigen::Vector3d(0, 0.012, 0.12), Eigen::Vector3d(0.022, 0.016, 0.02)},
-                    {Eigen::Vector3d(0, 0.004, 0.14), Eigen::Vector3d(0.026, 0.008, 0.04)}};
-  fingers.max_opening = 0.085;
-  return fingers;
-}
-
 }  // namespace costar::gripper

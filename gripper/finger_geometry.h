@@ -26,8 +26,4 @@ struct FingerGeometry {
   std::vector<FingerBox> at(double opening) const;
 };
 
-/// The 2-finger gripper of the simulated cell (sim/models/gripper_parallel-2f.xml: each finger a
-/// 22 x 16 x 20 mm link and a 26 x 8 x 40 mm pad; 85 mm stroke).
-FingerGeometry twoFingerGripper();
-
 }  // namespace costar::gripper

@@ -121,7 +121,7 @@ ParallelGripper::ParallelGripper(GripperDriver& driver, const Clock& clock, Para
   speed.max = 0.15;
   ParamSpec force{"force", ValueType::kDouble, "grip force (N)", options_.force};
   force.min = 5.0;
-  force.max = 120.0;
+  force.max = options_.max_force;
   ParamSpec opening{"opening", ValueType::kDouble, "how far apart the fingers go (m); fully open by default",
                     driver_.maxOpening()};
   opening.min = 0.005;

@@ -17,8 +17,9 @@ namespace costar::gripper {
 
 struct ParallelGripperOptions {
   std::string name = "gripper";
-  double speed = 0.1;   // m/s, default for Open and Close
-  double force = 40.0;  // N, default grip force
+  double speed = 0.1;        // m/s, default for Open and Close
+  double force = 40.0;       // N, default grip force
+  double max_force = 120.0;  // N, the most Close accepts (the gripper's description)
   /// Close and Open fail when the fingers have not settled after this long.
   Duration timeout = std::chrono::seconds(3);
   /// A finger reading older than this (by the driver's stamp) means the driver stopped updating.

@@ -3,8 +3,9 @@
 
     generate_gripper.py DESCRIPTION.json OUTPUT_DIR
 
-reads a gripper description (format costar-gripper-description/1, see robots/README.md) and
-writes, into OUTPUT_DIR:
+reads a gripper description (format costar-gripper-description/1, see robots/README.md). A
+"parallel" gripper's are NAME_mount.xml, NAME.urdf and NAME.fingerprint (robots/parallel_gripper.py);
+an "adaptive-3f" gripper's, into OUTPUT_DIR:
 - NAME_body.xml: the gripper's bodies, to go inside any flange body (an arm's tool0, the test
   bench's carrier): <mujoco> around one <body name="NAME_base">;
 - NAME_sections.xml: its tendons, equalities and actuators, to go at the model's top level;
@@ -18,7 +19,7 @@ writes, into OUTPUT_DIR:
 sim/adaptive_gripper_sim.h mounts the first two into any model (mountAdaptiveGripper); a
 simulated workcell composes NAME_mount.xml like any gripper piece (workcell/grippers.cpp).
 
-Conventions (those of sim/models/gripper_parallel-2f.xml): gripper geoms contype 2, conaffinity 0
+Conventions (those of the parallel grippers, robots/parallel_gripper.py): gripper geoms contype 2, conaffinity 0
 (they touch parts and the table box, not each other); pads condim 4 with friction 1.2. Each
 finger is an underactuated chain of three hinges (proximal, medial, distal) about the finger's
 -x axis (closing moves the tip along the finger's +y); one tendon sums the three angles, and a
@@ -33,6 +34,7 @@ import pathlib
 import sys
 
 from description_reader import DescriptionError, Reader, fmt, write_fingerprint
+from parallel_gripper import parallel_mount_xml, parallel_urdf, read_parallel
 
 FORMAT = "costar-gripper-description/1"
 PHALANGES = ("proximal", "medial", "distal")
@@ -46,12 +48,24 @@ MAX_PHALANX_M = 0.5
 MAX_KG = 100.0
 
 
+KINDS = ("adaptive-3f", "parallel")
+
+
 def read_description(path):
+    """The description of either kind: "adaptive-3f" (below) or "parallel" (parallel_gripper.py)."""
     reader = Reader(path)
     root = reader.root
     if root.get("format") != FORMAT:
         reader.fail("format", f'must be "{FORMAT}"')
-    g = {"name": reader.get(root, "name", "", "string")}
+    kind = reader.get(root, "kind", "", "string")
+    if kind not in KINDS:
+        reader.fail("kind", f'"{kind}" is not one of {", ".join(KINDS)}')
+    name = reader.get(root, "name", "", "string")
+    if name != pathlib.Path(path).stem:
+        reader.fail("name", f'"{name}" must be the file\'s name ({pathlib.Path(path).stem}): the build finds grippers by their files')
+    if kind == "parallel":
+        return read_parallel(reader, root, name)
+    g = {"name": name, "kind": kind}
     if not g["name"].replace("_", "").isalnum():
         reader.fail("name", "must be letters, digits and underscores")
     palm = reader.get(root, "palm", "", "object")
@@ -335,6 +349,13 @@ def main(argv):
     out.mkdir(parents=True, exist_ok=True)
     shown = "/".join(source.resolve().parts[-3:])
     n = gripper["name"]
+    if gripper["kind"] == "parallel":
+        (out / f"{n}_mount.xml").write_text(
+            wrap(parallel_mount_xml(gripper), f"{n}_mount", shown,
+                 "The gripper as a workcell's gripper piece (sim/cell_model.h): body \"mount\" is the flange."))
+        (out / f"{n}.urdf").write_text(parallel_urdf(gripper, shown))
+        write_fingerprint(source, out / f"{n}.fingerprint")  # last: the models are complete
+        return 0
     body, sections = body_xml(gripper), sections_xml(gripper)
     (out / f"{n}_body.xml").write_text(
         wrap(body, f"{n}_body", shown, "The gripper's bodies: they go inside a flange body."))

@@ -2,7 +2,7 @@
 // The MuJoCo model of a simulated workcell, composed from pieces so that no cell is a copy of
 // another: the cell (table, camera, lights: sim/models/table_cell.xml), the robot arm (its
 // robot description's MJCF: hand-written for the UR5, generated for the LBR iiwa 14) and the
-// gripper (e.g. sim/models/gripper_parallel-2f.xml), mounted on the arm's flange.
+// gripper (e.g. parallel-2f_mount.xml, generated from robots/grippers/parallel-2f.json), mounted on the arm's flange.
 //
 // Each piece is an MJCF document (<mujoco>). Composition:
 // - the robot's and the gripper's <default>, <asset>, <equality>, <contact>, <tendon>,

@@ -50,7 +50,7 @@ class SimGripperDriver final : public gripper::GripperDriver {
   void command(double opening, double speed, double force) override {
     simulation_.commandFingers(opening, speed, force);
   }
-  double maxOpening() const override { return Simulation::kMaxOpening; }
+  double maxOpening() const override { return simulation_.maxOpening(); }
 
  private:
   Simulation& simulation_;

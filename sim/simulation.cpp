@@ -131,8 +131,9 @@ struct Simulation::Impl {
   std::vector<mjtNum> acceleration;                // nv, scratch
   std::vector<mjtNum> torque;                      // nv, scratch
 
-  double finger_target = kMaxOpening / 2;  // per side, m
-  double finger_command = kMaxOpening / 2;
+  double max_opening = 0.0;    // m: the stroke, from the finger servo's control range
+  double finger_target = 0.0;  // per side, m
+  double finger_command = 0.0;
   double finger_speed = 0.05;
   std::uint64_t arm_table_contact_steps = 0;
   arm::Wrench hand;  // a person's hand on the tool (world, at the tool centre point)
@@ -530,7 +531,7 @@ struct Simulation::Impl {
 
   /// How far the gripper was last told to close, 0 (open) to 1 (closed).
   double commandedClosure() const {
-    return adaptive ? adaptive->commandedClosure() : 1.0 - finger_target / (kMaxOpening / 2);
+    return adaptive ? adaptive->commandedClosure() : 1.0 - finger_target / (max_opening / 2);
   }
 
   /// A geom's label in contacts(): the adaptive gripper's by finger, else its body's.
@@ -622,9 +623,11 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   if (!options.adaptive_gripper.empty()) {
     adaptive = gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile(options.adaptive_gripper, root));
   }
-  std::string xml =
-      composeCellModel({under_root(options.cell_model), robot.mjcf, under_root(options.gripper_model),
-                        robot.urdf_tool_link, options.robot_base, kForceTorqueSite, kForceSensor, kTorqueSensor});
+  std::string xml = composeCellModel(
+      {under_root(options.cell_model), robot.mjcf,
+       options.gripper_model.empty() ? std::filesystem::path(COSTAR_GRIPPER_MODEL_DIR) / "parallel-2f_mount.xml"
+                                     : under_root(options.gripper_model),
+       robot.urdf_tool_link, options.robot_base, kForceTorqueSite, kForceSensor, kTorqueSensor});
   std::string assets;
   for (const auto& object : impl->classes) {
     for (const auto& [color_name, rgb] : object.colors) {
@@ -729,6 +732,13 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
     impl->finger_qpos = m->jnt_qposadr[finger_joint];
     impl->finger_dof = m->jnt_dofadr[finger_joint];
     impl->finger_actuator = impl->id(mjOBJ_ACTUATOR, "fingers");
+    impl->max_opening = 2.0 * m->actuator_ctrlrange[2 * impl->finger_actuator + 1];
+    if (!(impl->max_opening > 0.0)) {
+      throw std::runtime_error(
+          "the gripper model's finger servo 'fingers' has no control range above 0: its "
+          "ctrlrange's upper end is half the stroke");
+    }
+    impl->finger_target = impl->finger_command = impl->max_opening / 2;
     impl->left_pad = impl->id(mjOBJ_GEOM, "left_pad");
     impl->right_pad = impl->id(mjOBJ_GEOM, "right_pad");
   }
@@ -819,8 +829,8 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   if (impl->adaptive) {
     impl->adaptive->reset(gripper::GripperMode::kBasic);
   } else {
-    impl->data->qpos[impl->finger_qpos] = kMaxOpening / 2;
-    impl->data->qpos[m->jnt_qposadr[impl->id(mjOBJ_JOINT, "right_finger_joint")]] = kMaxOpening / 2;
+    impl->data->qpos[impl->finger_qpos] = impl->max_opening / 2;
+    impl->data->qpos[m->jnt_qposadr[impl->id(mjOBJ_JOINT, "right_finger_joint")]] = impl->max_opening / 2;
   }
   mj_forward(m, impl->data);
   const auto settle = static_cast<std::int64_t>(std::ceil(options.settle_seconds / m->opt.timestep));
@@ -927,6 +937,11 @@ world::Pose Simulation::tcpPose() const {
 
 std::uint64_t Simulation::armTableContactSteps() const { return impl_->arm_table_contact_steps; }
 
+double Simulation::maxOpening() const {
+  impl_->requireParallel("maxOpening");
+  return impl_->max_opening;
+}
+
 FingerState Simulation::fingers() const {
   impl_->requireParallel("fingers");
   const mjData* d = impl_->data;
@@ -952,7 +967,7 @@ void Simulation::commandFingers(double opening, double speed, double force) {
   impl_->requireParallel("commandFingers");
   // A new command starts from where the fingers are (not from the previous setpoint).
   impl_->finger_command = impl_->data->qpos[impl_->finger_qpos];
-  impl_->finger_target = std::clamp(opening, 0.0, kMaxOpening) / 2.0;
+  impl_->finger_target = std::clamp(opening, 0.0, impl_->max_opening) / 2.0;
   impl_->finger_speed = std::max(speed, 1e-3) / 2.0;
   const double limit = std::clamp(force, 1.0, 200.0);
   // The grip force limit: MuJoCo 2.2.2 clamps an actuator's force by mjModel's range only (no

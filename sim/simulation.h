@@ -68,7 +68,9 @@ struct SimulationOptions {
   /// The cell around the robot (table, camera) and the gripper on its flange: MJCF pieces
   /// composed with the robot's model (sim/cell_model.h). Relative paths are under `data_root`.
   std::filesystem::path cell_model = "sim/models/table_cell.xml";
-  std::filesystem::path gripper_model = "sim/models/gripper_parallel-2f.xml";
+  /// Empty: the 2-finger gripper's piece generated from robots/grippers/parallel-2f.json
+  /// (build/robots/grippers/parallel-2f_mount.xml).
+  std::filesystem::path gripper_model;
   /// The gripper is the 3-finger adaptive gripper of robots/grippers/NAME.json (under
   /// `data_root`), `gripper_model` its generated workcell piece (NAME_mount.xml,
   /// robots/generate_gripper.py): the simulation drives it, adaptiveGripper() is its driver.
@@ -232,7 +234,9 @@ class Simulation {
   /// nullptr when the cell has no power tool and the scene no workpiece. It lives as long as the
   /// simulation.
   SimPowerTool* powerTool();
-  static constexpr double kMaxOpening = 0.085;
+  /// The 2-finger gripper's stroke (m): twice its finger servo's control range, as the model
+  /// gives it (robots/grippers/NAME.json's stroke_m). @throws std::logic_error with the adaptive gripper.
+  double maxOpening() const;
 
   // --- camera ----------------------------------------------------------------------------
   const camera::Intrinsics& rgbdIntrinsics() const;

@@ -19,7 +19,7 @@
 namespace costar::smartmove {
 
 /// The grasp files' key of the 2-finger parallel gripper (entries without a "gripper" field).
-inline constexpr const char* kParallelGripper = "parallel2f";
+inline constexpr const char* kParallelGripper = "parallel-2f";
 /// The 3-finger adaptive gripper (robots/grippers/robotiq3f.json).
 inline constexpr const char* kAdaptiveGripper = "robotiq3f";
 

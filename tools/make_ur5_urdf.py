@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes sim/models/ur5_arm.urdf: the UR5 arm of sim/models/ur5_arm.xml as URDF (the gripper is
-sim/models/gripper_parallel-2f.urdf, mounted on tool0 when a workcell is made).
+the parallel-2f gripper URDF generated from robots/grippers/parallel-2f.json, mounted on tool0 when a workcell is made).
 
 Link frames are the standard DH frames i-1 rotated by q_i, exactly as the MJCF bodies; the
 collision shapes are the MJCF geoms (capsules as cylinders that cover them)."""

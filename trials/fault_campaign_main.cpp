@@ -14,6 +14,7 @@
 #include "core/clock.h"
 #include "core/files.h"
 #include "trials/fault_campaign.h"
+#include "workcell/workcell.h"
 
 namespace {
 
@@ -51,7 +52,8 @@ int main(int argc, char** argv) {
       ->check(costar::cli::numberIn(0.0, costar::kMaxDurationSeconds, true, " s"))
       ->capture_default_str();
   app.add_option("-w,--workcell", options.workcell,
-                 "a simulated workcell (ur5-sim, iiwa-sim, iiwa-3f-sim: `costar workcells`), or test (components only)")
+                 "a simulated workcell (" + costar::workcell::knownWorkcellNames(true) +
+                     ": `costar workcells`), or test (components only)")
       ->capture_default_str();
   std::vector<std::string> plans;
   app.add_option("--plan", plans, "plan(s) to run in place of the paper's three tasks");

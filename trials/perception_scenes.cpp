@@ -51,7 +51,7 @@ std::unique_ptr<sim::Simulation> armOverTableSimulation(const workcell::CellSimu
     if (gripper::AdaptiveGripperDriver* hand = candidate->adaptiveGripper()) {
       hand->commandFingers({unit(random), unit(random), unit(random)}, 1.0, 20.0);
     } else {
-      candidate->commandFingers(sim::Simulation::kMaxOpening * unit(random), 0.1, 20.0);
+      candidate->commandFingers(candidate->maxOpening() * unit(random), 0.1, 20.0);
     }
     return candidate;
   }

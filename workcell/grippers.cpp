@@ -1,4 +1,4 @@
-// The gripper table: one row per gripper (workcell/grippers.h).
+// The gripper table: one row per gripper described in robots/grippers/ (workcell/grippers.h).
 
 #include "workcell/grippers.h"
 
@@ -11,42 +11,33 @@
 #include "gripper/adaptive_gripper.h"
 #include "gripper/adaptive_gripper_description.h"
 #include "gripper/parallel_gripper.h"
-#include "smartmove/grasps.h"
+#include "gripper/parallel_gripper_description.h"
 
 namespace costar::workcell {
 
 namespace {
 
-std::shared_ptr<component::Component> makeParallelGripper(const GripperDrivers& drivers, const Clock& clock) {
-  if (drivers.parallel == nullptr) {
-    throw std::logic_error("the parallel 2-finger gripper needs a 2-finger driver");
-  }
-  return std::make_shared<gripper::ParallelGripper>(*drivers.parallel, clock);
-}
+/// The calibration marker's pose in the flange frame as the generators put it (robots/
+/// generate_gripper.py, robots/parallel_gripper.py): on the body's +x face, image right along
+/// -y of the flange, image up towards the flange.
+world::Pose markerOnFace(double x, double z) { return world::poseFromXyzRpy(x, 0, z, -M_PI / 2, 0, -M_PI / 2); }
 
-std::shared_ptr<component::Component> makeRobotiq3f(const GripperDrivers& drivers, const Clock& clock) {
-  if (drivers.adaptive == nullptr) {
-    throw std::logic_error("the 3-finger adaptive gripper needs an adaptive gripper driver");
-  }
-  return std::make_shared<gripper::AdaptiveGripper>(
-      *drivers.adaptive, clock, gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile("robotiq3f")));
-}
-
-/// "parallel-2f": the parallel 2-finger gripper (sim/models/gripper_parallel-2f.xml): tool
-/// centre point 0.14 m along the flange's z axis, between the pads; the calibration marker on
-/// the body's +x face, 7.5 cm from the flange.
-GripperModel parallelTwoFinger() {
+/// A parallel 2-finger gripper ("kind": "parallel"): its pieces generated at build time from
+/// its description (robots/parallel_gripper.py), the fingers' boxes, stroke and forces read from it.
+GripperModel parallelGripper(const std::string& name) {
+  const std::filesystem::path generated = COSTAR_GRIPPER_MODEL_DIR;
+  const gripper::ParallelGripperDescription description =
+      gripper::loadParallelGripperDescription(gripper::gripperDescriptionFile(name));
   GripperModel model;
-  model.key = "parallel-2f";
-  model.mjcf = "sim/models/gripper_parallel-2f.xml";
-  model.urdf = "sim/models/gripper_parallel-2f.urdf";
+  model.key = name;
+  model.mjcf = generated / (name + "_mount.xml");
+  model.urdf = generated / (name + ".urdf");
   model.tcp_link = "tcp";
-  model.tcp_in_flange.translation() = Eigen::Vector3d(0.0, 0.0, 0.14);
+  model.tcp_in_flange.translation() = description.tcp;
   model.links = {"fingers"};
   model.finger_link = "fingers";
-  const gripper::FingerGeometry fingers = gripper::twoFingerGripper();
-  model.geometry = gripper::parallelGripperGeometry(fingers);
-  model.read_stance = [stroke = fingers.max_opening](const GripperDrivers& drivers) {
+  model.geometry = gripper::parallelGripperGeometry(description.fingers);
+  model.read_stance = [stroke = description.fingers.max_opening](const GripperDrivers& drivers) {
     double opening = std::numeric_limits<double>::quiet_NaN();
     try {
       opening = drivers.parallel->read().opening;
@@ -56,29 +47,39 @@ GripperModel parallelTwoFinger() {
     // An opening not known (a reading that fails, or is not a number) counts as the whole stroke.
     return std::optional<gripper::FingerStance>({.opening = std::isfinite(opening) ? opening : stroke});
   };
-  model.marker_in_flange_guess = world::poseFromXyzRpy(0.035, 0, 0.075, -M_PI / 2, 0, -M_PI / 2);
-  model.grasps = smartmove::kParallelGripper;
-  model.make_component = &makeParallelGripper;
+  model.marker_in_flange_guess =
+      markerOnFace(description.body_centre.x() + description.body_size.x() / 2, description.body_centre.z());
+  model.grasps = description.grasps;
+  model.make_component = [description](const GripperDrivers& drivers,
+                                       const Clock& clock) -> std::shared_ptr<component::Component> {
+    if (drivers.parallel == nullptr) {
+      throw std::logic_error("the parallel 2-finger gripper '" + description.name + "' needs a 2-finger driver");
+    }
+    gripper::ParallelGripperOptions options;
+    options.force = description.default_force;
+    options.max_force = description.max_force;
+    return std::make_shared<gripper::ParallelGripper>(*drivers.parallel, clock, options);
+  };
   return model;
 }
 
-/// "robotiq3f": the 3-finger adaptive gripper (robots/grippers/robotiq3f.json, docs/GRIPPERS.md),
-/// its pieces generated at build time (robots/generate_gripper.py): the tool centre point from
-/// the description (0.19 m along the flange's z axis); the calibration marker where the
-/// generator puts it, on the palm's +x face. Its fingers are modelled in each mode, open or (in a
-/// fingertip mode) closed part way; it opens fully, or to a position in a fingertip mode.
-GripperModel robotiq3f() {
+/// A 3-finger adaptive gripper ("kind": "adaptive-3f", docs/GRIPPERS.md), its pieces generated
+/// at build time (robots/generate_gripper.py): the tool centre point from the description; the
+/// calibration marker where the generator puts it, on the palm's +x face. Its fingers are
+/// modelled in each mode, open or (in a fingertip mode) closed part way; it opens fully, or to a
+/// position in a fingertip mode.
+GripperModel adaptiveGripper(const std::string& name) {
   const std::filesystem::path generated = COSTAR_GRIPPER_MODEL_DIR;
   const gripper::AdaptiveGripperDescription description =
-      gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile("robotiq3f"));
+      gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile(name));
   GripperModel model;
-  model.key = "robotiq3f";
-  model.mjcf = generated / "robotiq3f_mount.xml";
-  model.urdf = generated / "robotiq3f.urdf";
+  model.key = name;
+  model.mjcf = generated / (name + "_mount.xml");
+  model.urdf = generated / (name + ".urdf");
   model.tcp_link = "tcp";
   model.tcp_in_flange.translation() = description.tcp;
-  model.links = {"robotiq3f_fingers"};
-  model.finger_link = "robotiq3f_fingers";
+  model.links = {name + "_fingers"};
+  model.finger_link = name + "_fingers";
   model.geometry = gripper::adaptiveGripperGeometry(description);
   // The fingers as the mode places them: open, or in a fingertip mode closed part way as far as
   // its most open closing finger reads (rounded down to 1 %, toward open).
@@ -102,15 +103,31 @@ GripperModel robotiq3f() {
     }
     return gripper::FingerStance{.mode = std::string(gripper::toString(reading.mode)), .position = position};
   };
-  model.marker_in_flange_guess = world::poseFromXyzRpy(0.0653, 0, 0.045, -M_PI / 2, 0, -M_PI / 2);
-  model.adaptive = "robotiq3f";
-  model.grasps = smartmove::kAdaptiveGripper;
-  model.make_component = &makeRobotiq3f;
+  // The palm's +x face and the 0.3 mm the generator sets the marker off it.
+  model.marker_in_flange_guess = markerOnFace(0.0653, 0.045);
+  model.adaptive = name;
+  model.grasps = name;
+  model.make_component = [description](const GripperDrivers& drivers,
+                                       const Clock& clock) -> std::shared_ptr<component::Component> {
+    if (drivers.adaptive == nullptr) {
+      throw std::logic_error("the 3-finger adaptive gripper '" + description.name +
+                             "' needs an adaptive gripper driver");
+    }
+    return std::make_shared<gripper::AdaptiveGripper>(*drivers.adaptive, clock, description);
+  };
   return model;
 }
 
+/// Every gripper described in robots/grippers/ (a new gripper is its file, nothing here).
 const std::vector<GripperModel>& table() {
-  static const std::vector<GripperModel> grippers = {parallelTwoFinger(), robotiq3f()};
+  static const std::vector<GripperModel> grippers = [] {
+    std::vector<GripperModel> models;
+    for (const std::string& name : gripper::gripperDescriptionNames()) {
+      const std::filesystem::path file = gripper::gripperDescriptionFile(name);
+      models.push_back(gripper::gripperKind(file) == "parallel" ? parallelGripper(name) : adaptiveGripper(name));
+    }
+    return models;
+  }();
   return grippers;
 }
 
@@ -128,12 +145,10 @@ std::vector<std::string> gripperKeys() {
 const GripperModel& gripperModel(const std::string& key) {
   for (const GripperModel& model : table()) {
     if (model.key == key) {
-      if (!model.adaptive.empty()) {
-        // The simulator mounts the models generated from the description at build time; the
-        // component reads the description: they must be of the same file.
-        checkGeneratedFrom(gripper::gripperDescriptionFile(model.adaptive),
-                           std::filesystem::path(COSTAR_GRIPPER_MODEL_DIR) / (model.adaptive + ".fingerprint"));
-      }
+      // The simulator mounts the models generated from the description at build time; the
+      // component reads the description: they must be of the same file.
+      checkGeneratedFrom(gripper::gripperDescriptionFile(model.key),
+                         std::filesystem::path(COSTAR_GRIPPER_MODEL_DIR) / (model.key + ".fingerprint"));
       return model;
     }
   }

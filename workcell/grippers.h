@@ -1,8 +1,9 @@
 #pragma once
 // The grippers a simulated workcell can carry (workcells/NAME.json, "gripper": KEY): one row
-// per gripper in a table (workcell/grippers.cpp) with its models and the numbers the cell's
-// components need. A new gripper adds its MJCF and URDF pieces (sim/models/, or generated from
-// robots/grippers/NAME.json for an adaptive gripper) and a row.
+// per gripper described in robots/grippers/KEY.json (a table, workcell/grippers.cpp, made by
+// listing that folder) with its models and the numbers the cell's components need. A new
+// gripper of a known kind ("parallel", "adaptive-3f") is its description file: the build
+// generates its MJCF and URDF pieces (robots/generate_gripper.py).
 
 #include <filesystem>
 #include <functional>
@@ -56,7 +57,8 @@ struct GripperModel {
   std::string grasps;
   /// The gripper component on its driver (the driver and clock outlive it).
   /// @throws std::logic_error when the driver it needs is null.
-  std::shared_ptr<component::Component> (*make_component)(const GripperDrivers& drivers, const Clock& clock) = nullptr;
+  std::function<std::shared_ptr<component::Component>(const GripperDrivers& drivers, const Clock& clock)>
+      make_component;
 };
 
 /// The gripper with key `key`. @throws std::invalid_argument naming the known ones.

@@ -128,6 +128,16 @@ std::vector<WorkcellInfo> knownWorkcells() {
   return cells;
 }
 
+std::string knownWorkcellNames(bool simulated_only) {
+  std::string names;
+  for (const WorkcellInfo& cell : knownWorkcells()) {
+    if (!simulated_only || (cell.name != "test" && cell.name != "none")) {
+      names += (names.empty() ? "" : ", ") + cell.name;
+    }
+  }
+  return names;
+}
+
 std::unique_ptr<Workcell> makeTestWorkcell(const ComponentWrapper& wrap,
                                            const std::function<void(const Clock&)>& attach) {
   return std::make_unique<TestWorkcell>(wrap, attach);

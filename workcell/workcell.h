@@ -123,6 +123,9 @@ struct WorkcellInfo {
 
 /// The workcells this build knows.
 std::vector<WorkcellInfo> knownWorkcells();
+/// Their names, comma-separated, for a command's help: all, or the simulated ones only
+/// (workcells/*.json, listed from the folder).
+std::string knownWorkcellNames(bool simulated_only = false);
 /// @throws std::invalid_argument naming the known workcells when `name` is not one of them.
 void requireKnownWorkcell(const std::string& name);
 

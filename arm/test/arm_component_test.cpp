@@ -64,8 +64,8 @@ class ArmTest : public ::testing::Test {
   explicit ArmTest(std::filesystem::path waypoint_file = {})
       : waypoints(std::move(waypoint_file), /*persist=*/true, 6),
         robot(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5_arm.urdf",
-                                             dataRoot() / "sim/models/gripper_parallel-2f.urdf", "tool0", "base_link",
-                                             "tcp")),
+                                             std::filesystem::path(COSTAR_GRIPPER_MODEL_DIR) / "parallel-2f.urdf",
+                                             "tool0", "base_link", "tcp")),
         collisions(robot, kBase, {.padding = 0.005}, {kHome.eigen()}),
         driver(clock, kHome),
         arm(

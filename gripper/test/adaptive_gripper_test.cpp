@@ -125,7 +125,7 @@ TEST(AdaptiveGripperDescriptionTest, BadFilesNameTheFieldAndTheProblem) {
   const auto dir = std::filesystem::temp_directory_path() / "costar_adaptive_gripper_test";
   std::filesystem::create_directories(dir);
   const auto write = [&](const std::string& text) {
-    const auto file = dir / "bad.json";
+    const auto file = dir / "robotiq3f.json";  // a description's name is its file's
     std::ofstream(file) << text;
     return file;
   };
@@ -140,7 +140,7 @@ TEST(AdaptiveGripperDescriptionTest, BadFilesNameTheFieldAndTheProblem) {
   std::ifstream in(gripperDescriptionFile("robotiq3f"));
   std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(error(dir / "missing.json").find("No such file or directory"), std::string::npos);
-  EXPECT_NE(error(write("{")).find("bad.json"), std::string::npos);
+  EXPECT_NE(error(write("{")).find("costar_adaptive_gripper_test/robotiq3f.json"), std::string::npos);
   std::string unknown_mode = good;
   unknown_mode.replace(unknown_mode.find("\"name\": \"wide\""), 14, "\"name\": \"wild\"");
   EXPECT_NE(error(write(unknown_mode)).find("modes[2].name: must be one of basic, pinch, wide, scissor"),

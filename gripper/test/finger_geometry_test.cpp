@@ -2,11 +2,16 @@
 
 #include <gtest/gtest.h>
 
+#include "gripper/parallel_gripper_description.h"
+
 namespace costar::gripper {
 namespace {
 
+/// The 2-finger gripper of the UR5 cell, as its description gives it.
+FingerGeometry twoFingers() { return loadParallelGripperDescription(gripperDescriptionFile("parallel-2f")).fingers; }
+
 TEST(FingerGeometry, PadsAreTheOpeningApartAndTheFingersMirrorEachOther) {
-  const FingerGeometry fingers = twoFingerGripper();
+  const FingerGeometry fingers = twoFingers();
   for (const double opening : {0.0, 0.03, 0.07, fingers.max_opening}) {
     const std::vector<FingerBox> boxes = fingers.at(opening);
     ASSERT_EQ(boxes.size(), 2 * fingers.closed.size());
@@ -27,7 +32,7 @@ TEST(FingerGeometry, PadsAreTheOpeningApartAndTheFingersMirrorEachOther) {
 }
 
 TEST(FingerGeometry, OpeningsBeyondTheStrokeAreClamped) {
-  const FingerGeometry fingers = twoFingerGripper();
+  const FingerGeometry fingers = twoFingers();
   const auto widest = fingers.at(fingers.max_opening);
   const auto beyond = fingers.at(1.0);
   for (std::size_t i = 0; i < widest.size(); ++i) {

@@ -4,12 +4,17 @@
 
 #include <gtest/gtest.h>
 
+#include "gripper/parallel_gripper_description.h"
+
 namespace costar::gripper {
 namespace {
 
+/// The 2-finger gripper of the UR5 cell, as its description gives it.
+FingerGeometry twoFingers() { return loadParallelGripperDescription(gripperDescriptionFile("parallel-2f")).fingers; }
+
 TEST(GripperGeometry, AParallelGripperOpensAsFarAsAGraspNeedsAndIsModelledAtEveryOpening) {
-  const auto geometry = parallelGripperGeometry(twoFingerGripper());
-  const double stroke = twoFingerGripper().max_opening;
+  const auto geometry = parallelGripperGeometry(twoFingers());
+  const double stroke = twoFingers().max_opening;
   ASSERT_EQ(geometry->stroke(), stroke);
   // A part 4 cm wide with a 16 mm margin; one wider than the stroke is refused.
   EXPECT_DOUBLE_EQ(*geometry->graspOpening(0.02, 0.016), 0.056);
@@ -18,7 +23,7 @@ TEST(GripperGeometry, AParallelGripperOpensAsFarAsAGraspNeedsAndIsModelledAtEver
   // Boxes at an opening (both fingers, link and pad each); none asked: as the cell has them.
   const auto open = geometry->fingerBoxes({.opening = 0.05});
   ASSERT_TRUE(open.has_value());
-  EXPECT_EQ(open->size(), twoFingerGripper().at(0.05).size());
+  EXPECT_EQ(open->size(), twoFingers().at(0.05).size());
   EXPECT_FALSE(geometry->fingerBoxes({}).has_value());
   // Open to the opening asked for; no modes.
   component::ParamMap params;

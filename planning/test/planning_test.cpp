@@ -14,7 +14,8 @@ namespace {
 
 RobotModel ur5() {
   return RobotModel::fromUrdf(dataRoot() / "sim/models/ur5_arm.urdf",
-                              dataRoot() / "sim/models/gripper_parallel-2f.urdf", "tool0", "base_link", "tcp");
+                              std::filesystem::path(COSTAR_GRIPPER_MODEL_DIR) / "parallel-2f.urdf", "tool0",
+                              "base_link", "tcp");
 }
 
 /// Independent standard-DH model of the UR5 with the 0.14 m tool centre point.

@@ -13,7 +13,7 @@ ROBOTIQ = ROOT / "robots" / "grippers" / "robotiq3f.json"
 class GenerateGripper(GeneratorCase):
     GENERATOR = ROOT / "robots" / "generate_gripper.py"
     DESCRIPTION = ROBOTIQ
-    VARIANT_NAME = "gripper.json"
+    VARIANT_NAME = "robotiq3f.json"  # a description's name is its file's
 
     def test_writes_three_underactuated_fingers_and_a_scissor_axis(self):
         result = self.run_generator(ROBOTIQ, self.tmp)
@@ -65,6 +65,8 @@ class GenerateGripper(GeneratorCase):
             return change
 
         self.expect_error(drop("modes"), "modes: missing")
+        self.expect_error(setter(["kind"], "vacuum"), 'kind: "vacuum" is not one of adaptive-3f, parallel')
+        self.expect_error(setter(["name"], "other"), 'name: "other" must be the file\'s name (robotiq3f)')
         self.expect_error(setter(["format"], "x"), "format: must be")
         self.expect_error(setter(["fingers", 1, "scissor_sign"], 2), "fingers[1].scissor_sign: must be -1, 0")
         self.expect_error(setter(["fingers", 2, "name"], "finger_1"), 'fingers[2].name: "finger_1" appears twice')
@@ -108,6 +110,67 @@ class GenerateGripper(GeneratorCase):
         result = self.run_generator(path, self.tmp / "out")
         self.assertEqual(result.returncode, 1)
         self.assertIn("gripper.json: line 3", result.stderr)
+
+
+PARALLEL = ROOT / "robots" / "grippers" / "parallel-2f.json"
+FRANKA = ROOT / "robots" / "grippers" / "franka-hand.json"
+
+
+class GenerateParallelGripper(GeneratorCase):
+    GENERATOR = ROOT / "robots" / "generate_gripper.py"
+    DESCRIPTION = PARALLEL
+    VARIANT_NAME = "parallel-2f.json"
+
+    def generated(self, description):
+        result = self.run_generator(description, self.tmp)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        name = description.stem
+        return ET.parse(self.tmp / f"{name}_mount.xml").getroot(), ET.parse(self.tmp / f"{name}.urdf").getroot()
+
+    def test_the_fingers_slide_coupled_with_the_stroke_and_force_described(self):
+        for description, half, force in ((PARALLEL, 0.0425, 60), (FRANKA, 0.04, 70)):
+            mount, urdf = self.generated(description)
+            joints = {j.get("name"): j for j in mount.iter("joint") if j.get("type") == "slide"}
+            self.assertEqual(set(joints), {"left_finger_joint", "right_finger_joint"})
+            self.assertEqual(joints["left_finger_joint"].get("axis"), "0 1 0")
+            self.assertEqual(joints["right_finger_joint"].get("axis"), "0 -1 0")
+            self.assertAlmostEqual(float(joints["left_finger_joint"].get("range").split()[1]), half)
+            servo = mount.find("actuator/position")
+            self.assertEqual(servo.get("name"), "fingers")
+            self.assertAlmostEqual(float(servo.get("ctrlrange").split()[1]), half)  # the simulator's stroke / 2
+            self.assertAlmostEqual(float(servo.get("forcerange").split()[1]), force)
+            self.assertEqual(mount.find("equality/joint").get("name"), "finger_coupling")
+            pads = {g.get("name"): g for g in mount.iter("geom") if g.get("class") == "finger_pad"}
+            self.assertEqual(set(pads), {"left_pad", "right_pad"})
+            # The pads' inner faces touch when closed: centre y = half its thickness, mirrored.
+            left = [float(x) for x in pads["left_pad"].get("pos").split()]
+            right = [float(x) for x in pads["right_pad"].get("pos").split()]
+            self.assertAlmostEqual(left[1], float(pads["left_pad"].get("size").split()[1]))
+            self.assertAlmostEqual(right[1], -left[1])
+            self.assertIsNotNone(mount.find("worldbody/body[@name='mount']/site[@name='tcp']"))
+            self.assertIsNotNone(mount.find("worldbody/body[@name='mount']/geom[@name='gripper_marker']"))
+            # The planner's fingers: one box over the whole travel, fully open outer faces included.
+            travel = [float(x) for x in urdf.find("link[@name='fingers']/collision/geometry/box").get("size").split()]
+            self.assertGreater(travel[1], 2 * half + 0.01)
+            self.assertEqual(urdf.find("joint[@name='tool_centre_point']/parent").get("link"), "fingers")
+
+    def test_bad_descriptions_name_the_field(self):
+        def setter(path, value):
+            def change(d):
+                target = d
+                for key in path[:-1]:
+                    target = target[key]
+                target[path[-1]] = value
+            return change
+
+        self.expect_error(setter(["stroke_m"], -0.08), "stroke_m: must be positive")
+        self.expect_error(setter(["finger", "pad", "centre"], [0, 0.01, 0.14]), "finger.pad: the closed pad's inner face must be on y = 0")
+        self.expect_error(setter(["finger", "link", "centre"], [0, -0.02, 0.12]), "finger.link: the +y finger's box must lie at y >= 0")
+        self.expect_error(setter(["body", "size"], [0.07, 0.05, 0.07]), "body.size: the body's +x face must hold the 6.67 cm calibration marker")
+        self.expect_error(setter(["grip_force_n", "default"], 500), "grip_force_n.default: must be at most grip_force_n.max")
+        self.expect_error(setter(["servo", "kp"], 0), "servo.kp: must be positive")
+        self.expect_error(lambda d: d.pop("finger"), "finger: missing")
+        self.expect_error(setter(["name"], "parallel 2f"), 'name: "parallel 2f" must be the file\'s name')
 
 
 if __name__ == "__main__":

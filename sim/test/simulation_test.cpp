@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <random>
 
 #include "core/paths.h"
@@ -200,7 +201,7 @@ TEST(Simulation, AGraspIsPhysicalTheFingersHoldThePartByFrictionOnly) {
       contacts.end());
 
   // Open: it falls back onto the table.
-  sim->commandFingers(Simulation::kMaxOpening, 0.1, 40.0);
+  sim->commandFingers(sim->maxOpening(), 0.1, 40.0);
   waitSeconds(*sim, 1.5);
   EXPECT_NEAR(sim->parts()[0].pose.translation().z(), 0.025, 0.01);
   EXPECT_FALSE(sim->fingers().pads_in_contact);
@@ -212,6 +213,28 @@ TEST(Simulation, ClosingOnNothingClosesFully) {
   waitSeconds(*sim, 1.2);
   EXPECT_LT(sim->fingers().opening, 0.001);
   EXPECT_FALSE(sim->fingers().pads_in_contact);
+}
+
+// A parallel gripper is its description (robots/grippers/NAME.json): the Franka Hand's stroke
+// is read back from its generated model, and it opens, closes and squeezes as described.
+TEST(Simulation, AParallelGripperHasTheStrokeItsDescriptionGives) {
+  const auto two = Simulation::create(sceneOf(R"({"parts": []})"));
+  EXPECT_DOUBLE_EQ(two->maxOpening(), 0.085);
+  SimulationOptions options;
+  options.gripper_model = std::filesystem::path(COSTAR_GRIPPER_MODEL_DIR) / "franka-hand_mount.xml";
+  const auto hand = Simulation::create(sceneOf(R"({"parts": []})"), options);
+  EXPECT_DOUBLE_EQ(hand->maxOpening(), 0.08);
+  EXPECT_NEAR(hand->fingers().opening, 0.08, 0.001);  // fully open at the start
+  hand->commandFingers(0.03, 0.1, 40.0);
+  waitSeconds(*hand, 1.0);
+  EXPECT_NEAR(hand->fingers().opening, 0.03, 0.001);
+  hand->commandFingers(0.5, 0.1, 40.0);  // beyond the stroke: fully open
+  waitSeconds(*hand, 1.0);
+  EXPECT_NEAR(hand->fingers().opening, 0.08, 0.001);
+  hand->commandFingers(0.0, 0.1, 40.0);
+  waitSeconds(*hand, 1.2);
+  EXPECT_LT(hand->fingers().opening, 0.001);
+  EXPECT_FALSE(hand->fingers().pads_in_contact);
 }
 
 TEST(Simulation, TheRgbdCameraSeesTheTableAndTheParts) {

@@ -19,6 +19,7 @@
 #include "core/paths.h"
 #include "planning/robot_model.h"
 #include "sim/simulation.h"
+#include "workcell/grippers.h"
 #include "workcell/workcell.h"
 
 namespace costar::workcell {
@@ -27,9 +28,8 @@ namespace {
 const world::Pose kBaseInWorld(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
 
 TEST(Ur5SimWorkcell, TheMujocoModelAndTheUrdfAgreeToATenthOfAMillimetre) {
-  const auto robot =
-      planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5_arm.urdf",
-                                     dataRoot() / "sim/models/gripper_parallel-2f.urdf", "tool0", "base_link", "tcp");
+  const auto robot = planning::RobotModel::fromUrdf(
+      dataRoot() / "sim/models/ur5_arm.urdf", workcell::gripperModel("parallel-2f").urdf, "tool0", "base_link", "tcp");
   std::mt19937 random(11);
   std::uniform_real_distribution<double> angle(-M_PI, M_PI);
   const sim::Scene empty = sim::parseScene(R"({"parts": []})", "empty");
