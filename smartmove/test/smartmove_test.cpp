@@ -161,14 +161,14 @@ TEST(Grasps, AGraspGivenTwiceIsRefusedNamingBothEntries) {
   std::ofstream(file)
       << R"({"grasps": [{"class": "node", "name": "top", "position": [0, 0, 0], "rpy_degrees": [0, 0, 0]},)"
          R"( {"class": "link", "name": "top", "position": [0, 0, 0], "rpy_degrees": [0, 0, 0]},)"
-         R"( {"gripper": "parallel2f", "class": "node", "name": "top", "position": [0, 0, 0.01],)"
+         R"( {"gripper": "parallel-2f", "class": "node", "name": "top", "position": [0, 0, 0.01],)"
          R"( "rpy_degrees": [0, 0, 0]}]})";
   try {
     GraspLibrary library(file, {});
     ADD_FAILURE() << "accepted a grasp given twice";
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()), "grasp file '" + file.string() +
-                                         "': grasps[2]: gripper 'parallel2f', class 'node', name 'top' is given "
+                                         "': grasps[2]: gripper 'parallel-2f', class 'node', name 'top' is given "
                                          "twice, in grasps[0] and here (one grasp per gripper, class and name)");
   }
   std::filesystem::remove(file);
