@@ -30,6 +30,26 @@ def fmt(values):
     return " ".join(f"{float(x):.12g}" for x in values)
 
 
+# The hand-eye calibration marker every generated gripper carries on its body's +x face
+# (DICT_4X4_50 id 1, docs/CALIBRATION.md): 6.67 cm square with its white quiet zone, image right
+# along -y of the flange, image up towards the flange, 0.3 mm off the face.
+MARKER_HALF = 0.033333
+MARKER_ASSET = ['<asset>',
+                '  <texture name="gripper_marker" type="2d" file="aruco_4x4_50_id1.png"/>',
+                '  <material name="gripper_marker" texture="gripper_marker" texrepeat="1 1" texuniform="false" '
+                'specular="0" shininess="0" reflectance="0"/>',
+                '</asset>']
+
+
+def marker_geom(face_centre, cls=None):
+    """The marker's geom on a +x face whose centre is `face_centre` (a visual-only sticker)."""
+    pos = [face_centre[0] + 0.0003, face_centre[1], face_centre[2]]
+    klass = f' class="{cls}"' if cls else ""
+    return (f'<geom name="gripper_marker"{klass} type="box" pos="{fmt(pos)}" '
+            f'xyaxes="0 -1 0 0 0 -1" size="{MARKER_HALF} {MARKER_HALF} 0.0003" material="gripper_marker" '
+            'contype="0" conaffinity="0" group="2" mass="0"/>')
+
+
 def _no_duplicates(pairs):
     """An object's keys, each once: a key given twice is refused (json keeps the last silently)."""
     seen = {}

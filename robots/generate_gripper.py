@@ -33,7 +33,7 @@ import math
 import pathlib
 import sys
 
-from description_reader import DescriptionError, Reader, fmt, write_fingerprint
+from description_reader import MARKER_ASSET, MARKER_HALF, DescriptionError, Reader, fmt, marker_geom, write_fingerprint
 from parallel_gripper import parallel_mount_xml, parallel_urdf, read_parallel
 
 FORMAT = "costar-gripper-description/1"
@@ -259,11 +259,6 @@ def sections_xml(g):
     return lines
 
 
-# The hand-eye calibration marker (sim/models/aruco_4x4_50_id1.png, DICT_4X4_50 id 1, 5 cm black
-# square, 6.67 cm with its white quiet zone), as on the 2-finger gripper: a sticker on the
-# body's +x face, image right along -y of the flange, image up towards the flange.
-MARKER_HALF = 0.033333
-
 
 def mount_xml(g):
     """The gripper piece of a workcell model: body "mount" is the flange."""
@@ -271,18 +266,11 @@ def mount_xml(g):
     half = [s / 2 for s in palm["size"]]
     if min(half[1], half[2]) < MARKER_HALF:
         raise DescriptionError("palm.size: the palm's +x face must hold the 6.67 cm calibration marker")
-    marker = [palm["centre"][0] + half[0] + 0.0003, palm["centre"][1], palm["centre"][2]]
-    lines = ['<asset>',
-             '  <texture name="gripper_marker" type="2d" file="aruco_4x4_50_id1.png"/>',
-             '  <material name="gripper_marker" texture="gripper_marker" texrepeat="1 1" texuniform="false" '
-             'specular="0" shininess="0" reflectance="0"/>',
-             '</asset>',
-             '<worldbody>',
-             '  <body name="mount">',
-             f'    <site name="tcp" pos="{fmt(g["tcp"])}" size="0.004" rgba="1 0.5 0 0.6"/>',
-             f'    <geom name="gripper_marker" type="box" pos="{fmt(marker)}" xyaxes="0 -1 0 0 0 -1" '
-             f'size="{MARKER_HALF} {MARKER_HALF} 0.0003" material="gripper_marker" contype="0" conaffinity="0" '
-             'group="2" mass="0"/>']
+    face = [palm["centre"][0] + half[0], palm["centre"][1], palm["centre"][2]]
+    lines = MARKER_ASSET + ['<worldbody>',
+                            '  <body name="mount">',
+                            f'    <site name="tcp" pos="{fmt(g["tcp"])}" size="0.004" rgba="1 0.5 0 0.6"/>',
+                            '    ' + marker_geom(face)]
     lines += ["    " + line for line in body_xml(g)]
     lines += ['  </body>', '</worldbody>']
     return lines + sections_xml(g)

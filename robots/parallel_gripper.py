@@ -6,13 +6,10 @@ The simulator finds the fingers by these names: joints left_finger_joint and rig
 (slides along +y and -y, coupled by an equality), pads left_pad and right_pad, the position
 servo "fingers" on the left joint (its control range is half the stroke: the opening is twice
 it). Geoms are in explicit classes, as the robot's bodies may carry a childclass."""
-from description_reader import fmt
+from description_reader import MARKER_ASSET, MARKER_HALF, fmt, marker_geom
 
 MAX_M = 1.0
 MAX_KG = 100.0
-# The ArUco marker (DICT_4X4_50 id 1) with its white quiet zone: 6.67 cm square, on the
-# body's +x face, image right along -y of the flange, image up towards the flange.
-MARKER_HALF = 0.033333
 
 
 def _box(reader, obj, key, field, mass=True):
@@ -85,7 +82,7 @@ def _finger(side, g):
 def parallel_mount_xml(g):
     """The gripper piece of a workcell model: body "mount" is the flange."""
     body = g["body"]
-    marker = [body["centre"][0] + body["size"][0] / 2 + 0.0003, body["centre"][1], body["centre"][2]]
+    face = [body["centre"][0] + body["size"][0] / 2, body["centre"][1], body["centre"][2]]
     s = g["servo"]
     lines = ['<compiler angle="radian" autolimits="true"/>',
              '<default>',
@@ -97,12 +94,7 @@ def parallel_mount_xml(g):
              f'    <geom contype="2" conaffinity="0" condim="4" friction="{fmt(g["pad"]["friction"])}" solref="0.004 1" '
              'rgba="0.15 0.15 0.15 1"/>',
              '  </default>',
-             '</default>',
-             '<asset>',
-             '  <texture name="gripper_marker" type="2d" file="aruco_4x4_50_id1.png"/>',
-             '  <material name="gripper_marker" texture="gripper_marker" texrepeat="1 1" texuniform="false" '
-             'specular="0" shininess="0" reflectance="0"/>',
-             '</asset>',
+             '</default>'] + MARKER_ASSET + [
              '<worldbody>',
              '  <body name="mount">',
              f'    <site name="tcp" class="gripper_visual" pos="{fmt(g["tcp"])}" size="0.004" rgba="1 0.5 0 0.6"/>']
@@ -112,9 +104,7 @@ def parallel_mount_xml(g):
                      f'0 0 {c["to_z"]:.12g}" size="{c["radius"]:.12g}"/>')
     lines += [f'    <geom name="gripper_body" class="gripper" type="box" pos="{fmt(body["centre"])}" '
               f'size="{fmt(x / 2 for x in body["size"])}" mass="{body["mass"]:.12g}"/>',
-              f'    <geom name="gripper_marker" class="gripper_visual" type="box" pos="{fmt(marker)}" xyaxes="0 -1 0 0 0 -1" '
-              f'size="{MARKER_HALF} {MARKER_HALF} 0.0003" material="gripper_marker" contype="0" conaffinity="0" '
-              'group="2" mass="0"/>']
+              '    ' + marker_geom(face, "gripper_visual")]
     lines += ["    " + line for line in _finger("left", g) + _finger("right", g)]
     lines += ['  </body>',
               '</worldbody>',

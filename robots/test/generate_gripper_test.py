@@ -10,6 +10,16 @@ from generator_case import ROOT, GeneratorCase
 ROBOTIQ = ROOT / "robots" / "grippers" / "robotiq3f.json"
 
 
+def setter(path, value):
+    """A change to a description: the field at `path` (keys and indices) set to `value`."""
+    def change(d):
+        target = d
+        for key in path[:-1]:
+            target = target[key]
+        target[path[-1]] = value
+    return change
+
+
 class GenerateGripper(GeneratorCase):
     GENERATOR = ROOT / "robots" / "generate_gripper.py"
     DESCRIPTION = ROBOTIQ
@@ -55,14 +65,6 @@ class GenerateGripper(GeneratorCase):
     def test_bad_descriptions_name_the_field(self):
         def drop(key):
             return lambda d: d.pop(key)
-
-        def setter(path, value):
-            def change(d):
-                target = d
-                for key in path[:-1]:
-                    target = target[key]
-                target[path[-1]] = value
-            return change
 
         self.expect_error(drop("modes"), "modes: missing")
         self.expect_error(setter(["kind"], "vacuum"), 'kind: "vacuum" is not one of adaptive-3f, parallel')
@@ -155,14 +157,6 @@ class GenerateParallelGripper(GeneratorCase):
             self.assertEqual(urdf.find("joint[@name='tool_centre_point']/parent").get("link"), "fingers")
 
     def test_bad_descriptions_name_the_field(self):
-        def setter(path, value):
-            def change(d):
-                target = d
-                for key in path[:-1]:
-                    target = target[key]
-                target[path[-1]] = value
-            return change
-
         self.expect_error(setter(["stroke_m"], -0.08), "stroke_m: must be positive")
         self.expect_error(setter(["finger", "pad", "centre"], [0, 0.01, 0.14]), "finger.pad: the closed pad's inner face must be on y = 0")
         self.expect_error(setter(["finger", "link", "centre"], [0, -0.02, 0.12]), "finger.link: the +y finger's box must lie at y >= 0")
