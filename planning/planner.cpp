@@ -8,6 +8,7 @@
 #include <ompl/util/RandomNumbers.h>
 
 #include <chrono>
+#include <cstdio>
 #include <mutex>
 
 namespace costar::planning {
@@ -53,6 +54,19 @@ PlanResult planPath(const CollisionWorld& world, const Eigen::VectorXd& start, c
     result.failure = "the goal is in collision: " + contact->str();
     return result;
   }
+  // A goal beyond a joint's limits is refused with the joint named (OMPL would only log
+  // "invalid bounds" to the console and find nothing).
+  const RobotModel& robot = world.robot();
+  for (Eigen::Index j = 0; j < goal.size() && j < robot.lowerLimits().size(); ++j) {
+    if (!(goal[j] >= robot.lowerLimits()[j] && goal[j] <= robot.upperLimits()[j])) {
+      char bounds[160];
+      std::snprintf(bounds, sizeof bounds, " (%.4f rad; its limits %.4f .. %.4f)", goal[j], robot.lowerLimits()[j],
+                    robot.upperLimits()[j]);
+      result.failure =
+          "the goal is outside joint " + robot.jointNames()[static_cast<std::size_t>(j)] + "'s limits" + bounds;
+      return result;
+    }
+  }
   if (!query.checkSegment(start, goal)) {
     result.path = {start, goal};
     result.planning_seconds = elapsed();
@@ -67,10 +81,12 @@ PlanResult planPath(const CollisionWorld& world, const Eigen::VectorXd& start, c
   space->setStateSamplerAllocator(
       [seed](const ob::StateSpace* state_space) { return std::make_shared<SeededSampler>(state_space, seed); });
   ob::RealVectorBounds bounds(dof);
-  const RobotModel& robot = world.robot();
   for (unsigned j = 0; j < dof; ++j) {
-    bounds.setLow(j, std::max(robot.lowerLimits()[j], std::min(start[j], goal[j]) - options.joint_range));
-    bounds.setHigh(j, std::min(robot.upperLimits()[j], std::max(start[j], goal[j]) + options.joint_range));
+    // The arm is where it is: a start a hair beyond a limit (a reading at the stop) stays inside.
+    bounds.setLow(
+        j, std::min(start[j], std::max(robot.lowerLimits()[j], std::min(start[j], goal[j]) - options.joint_range)));
+    bounds.setHigh(
+        j, std::max(start[j], std::min(robot.upperLimits()[j], std::max(start[j], goal[j]) + options.joint_range)));
   }
   space->setBounds(bounds);
   og::SimpleSetup setup(space);

@@ -328,5 +328,17 @@ TEST_F(Collisions, ThePlannerSaysWhyWhenTheGoalIsInCollision) {
   EXPECT_EQ(planPath(world, kHome, kHome).path.size(), 2u);  // nothing to plan
 }
 
+TEST_F(Collisions, AGoalBeyondAJointsLimitIsRefusedNamingTheJoint) {
+  Eigen::VectorXd beyond = kHome;
+  beyond[5] = world.robot().upperLimits()[5] + 0.01;
+  const PlanResult plan = planPath(world, kHome, beyond);
+  EXPECT_FALSE(plan.ok());
+  EXPECT_NE(plan.failure.find("the goal is outside joint " + world.robot().jointNames()[5] + "'s limits"),
+            std::string::npos)
+      << plan.failure;
+  beyond[5] = std::nan("");
+  EXPECT_NE(planPath(world, kHome, beyond).failure.find("outside joint"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace costar::planning
