@@ -43,6 +43,9 @@ AdaptiveGripperDescription loadAdaptiveGripperDescription(const std::filesystem:
   AdaptiveGripperDescription description;
   description.name = root.at("name").get<std::string>();
   description.tcp = fields.vec3(root, "tcp", "");
+  const auto& palm = fields.at(root, "palm", "");
+  description.palm_centre = fields.vec3(palm, "centre", "palm");
+  description.palm_size = fields.vec3(palm, "size", "palm");
   const auto& fingers = fields.at(root, "fingers", "");
   if (!fingers.is_array() || fingers.size() != kFingerCount) {
     fields.fail("fingers", "must be a list of " + std::to_string(kFingerCount) + " fingers");

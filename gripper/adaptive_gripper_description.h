@@ -50,10 +50,12 @@ struct AdaptiveGripperDescription {
   double open_lean_deg = 0.0;       // how far an open finger leans out (the proximal joint's lower limit, negated)
   double proximal_upper_deg = 0.0;  // the proximal joint's upper limit: a fingertip mode's finger fully closed
   std::map<GripperMode, AdaptiveModeDescription> modes;
-  double min_force = 0.0;                         // N per finger: the least grip the servos hold steadily
-  double max_force = 0.0;                         // N per finger
-  double lever = 0.0;                             // m: the grip force is the flexion torque over this lever
-  Eigen::Vector3d tcp = Eigen::Vector3d::Zero();  // the tool centre point in the flange frame
+  double min_force = 0.0;                                 // N per finger: the least grip the servos hold steadily
+  double max_force = 0.0;                                 // N per finger
+  double lever = 0.0;                                     // m: the grip force is the flexion torque over this lever
+  Eigen::Vector3d tcp = Eigen::Vector3d::Zero();          // the tool centre point in the flange frame
+  Eigen::Vector3d palm_centre = Eigen::Vector3d::Zero();  // the palm's box in the flange frame
+  Eigen::Vector3d palm_size = Eigen::Vector3d::Zero();    // full side lengths
   double scissor_lower_deg = 0.0;
   double scissor_upper_deg = 0.0;
   double scissor_speed_deg_s = 0.0;

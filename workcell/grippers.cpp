@@ -104,7 +104,8 @@ GripperModel adaptiveGripper(const std::string& name) {
     return gripper::FingerStance{.mode = std::string(gripper::toString(reading.mode)), .position = position};
   };
   // The palm's +x face and the 0.3 mm the generator sets the marker off it.
-  model.marker_in_flange_guess = markerOnFace(0.0653, 0.045);
+  model.marker_in_flange_guess =
+      markerOnFace(description.palm_centre.x() + description.palm_size.x() / 2 + 0.0003, description.palm_centre.z());
   model.adaptive = name;
   model.grasps = name;
   model.make_component = [description](const GripperDrivers& drivers,

@@ -9,13 +9,18 @@
 namespace costar::perception {
 namespace {
 
-TEST(TrainingData, EachObjectOnTheTableIsOneExample) {
+/// Three 5 cm blocks on the table, at y -0.2, 0.2 and 0: a synthetic frame.
+camera::RgbdFrame threeBlocks() {
   world::ObjectClass block;
   block.boxes = {{Eigen::Vector3d::Zero(), Eigen::Vector3d(0.025, 0.025, 0.025)}};
-  const camera::RgbdFrame frame = test::renderSynthetic({{&block, world::Pose(Eigen::Translation3d(0.4, -0.2, 0.025))},
-                                                         {&block, world::Pose(Eigen::Translation3d(0.6, 0.2, 0.025))},
-                                                         {&block, world::Pose(Eigen::Translation3d(0.5, 0.0, 0.025))}},
-                                                        0.0005);
+  return test::renderSynthetic({{&block, world::Pose(Eigen::Translation3d(0.4, -0.2, 0.025))},
+                                {&block, world::Pose(Eigen::Translation3d(0.6, 0.2, 0.025))},
+                                {&block, world::Pose(Eigen::Translation3d(0.5, 0.0, 0.025))}},
+                               0.0005);
+}
+
+TEST(TrainingData, EachObjectOnTheTableIsOneExample) {
+  const camera::RgbdFrame frame = threeBlocks();
   TrainingSet set;
   set.names = {{0, "background"}, {1, "block"}};
   const ExamplesAdded added = addTrainingExamples(frame, PipelineOptions{}, 1, /*add_table=*/true, set);
@@ -38,12 +43,7 @@ TEST(TrainingData, EachObjectOnTheTableIsOneExample) {
 // Point-by-point labels (the simulator's truth in collection): each voxel takes its points'
 // majority label; points labelled -1 (near a boundary) give no example.
 TEST(TrainingData, LabelledExamplesTakeTheirPointsLabelsAndSkipTheUnlearned) {
-  world::ObjectClass block;
-  block.boxes = {{Eigen::Vector3d::Zero(), Eigen::Vector3d(0.025, 0.025, 0.025)}};
-  const camera::RgbdFrame frame = test::renderSynthetic({{&block, world::Pose(Eigen::Translation3d(0.4, -0.2, 0.025))},
-                                                         {&block, world::Pose(Eigen::Translation3d(0.6, 0.2, 0.025))},
-                                                         {&block, world::Pose(Eigen::Translation3d(0.5, 0.0, 0.025))}},
-                                                        0.0005);
+  const camera::RgbdFrame frame = threeBlocks();
   TrainingSet set;
   set.names = {{0, "background"}, {1, "left"}, {2, "right"}};
   const auto label_of = [](const Eigen::Vector3d& point) {
