@@ -48,7 +48,8 @@ std::vector<Detection> mergeDetections(std::vector<Detection> detections, const 
 }
 
 std::vector<Detection> keepSupported(const std::vector<Detection>& detections, const std::vector<ObjectModel>& models,
-                                     const TablePlane& table, double tolerance) {
+                                     const TablePlane& table, double tolerance,
+                                     const std::vector<std::vector<Eigen::Vector3f>>& unfound) {
   struct Extent {
     double low = 0.0, high = 0.0;
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // the origin projected onto the table
@@ -85,10 +86,40 @@ std::vector<Detection> keepSupported(const std::vector<Detection>& detections, c
   for (std::size_t d = 0; d < detections.size(); ++d) {
     kept[d] = extents[d].low <= tolerance;
   }
+  // A cluster where nothing was found, standing on the table, holds up what lies on its top as
+  // a kept detection does: a part hidden but for its sides (a node under a link across it).
+  for (const std::vector<Eigen::Vector3f>& points : unfound) {
+    if (points.empty()) {
+      continue;
+    }
+    std::vector<double> heights;
+    heights.reserve(points.size());
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3f& point : points) {
+      heights.push_back(table.height(point));
+      mean += point.cast<double>();
+    }
+    mean /= static_cast<double>(points.size());
+    std::sort(heights.begin(), heights.end());
+    Extent extent;
+    extent.low = heights[heights.size() / 20];
+    extent.high = heights[heights.size() - 1 - heights.size() / 20];
+    if (extent.low > kRaisedSupport) {
+      continue;
+    }
+    extent.centre = mean - table.normal * (table.normal.dot(mean) + table.offset);
+    for (const Eigen::Vector3f& point : points) {
+      const Eigen::Vector3d p = point.cast<double>();
+      extent.radius =
+          std::max(extent.radius, (p - table.normal * (table.normal.dot(p) + table.offset) - extent.centre).norm());
+    }
+    extents.push_back(extent);
+    kept.push_back(true);
+  }
   for (bool changed = true; changed;) {
     changed = false;
     for (std::size_t d = 0; d < detections.size(); ++d) {
-      for (std::size_t e = 0; e < detections.size() && !kept[d]; ++e) {
+      for (std::size_t e = 0; e < extents.size() && !kept[d]; ++e) {
         if (kept[e] && e != d && std::abs(extents[d].low - extents[e].high) <= tolerance &&
             (extents[d].centre - extents[e].centre).norm() < extents[d].radius + extents[e].radius) {
           kept[d] = true;

@@ -342,7 +342,19 @@ PipelineResult Pipeline::detectFiltered(const camera::RgbdFrame& frame, const ca
   }
   result.pose_clusters = static_cast<int>(tasks.size());
   found = mergeDetections(std::move(found), models_);
-  found = keepSupported(found, models_, workspace.plane, options_.support_tolerance);
+  // Clusters where nothing was found: a part hidden under another but for its sides (a node
+  // under the link put across it) still holds that one up.
+  std::vector<std::vector<Eigen::Vector3f>> unfound;
+  for (const Task& task : tasks) {
+    if (task.found.empty()) {
+      std::vector<Eigen::Vector3f>& points = unfound.emplace_back();
+      points.reserve(task.cluster.size());
+      for (const int i : task.cluster) {
+        points.push_back(class_points[task.model].points[static_cast<std::size_t>(i)]);
+      }
+    }
+  }
+  found = keepSupported(found, models_, workspace.plane, options_.support_tolerance, unfound);
   // Class order, then best first.
   std::stable_sort(found.begin(), found.end(), [this](const Detection& a, const Detection& b) {
     const auto index = [this](const std::string& name) {

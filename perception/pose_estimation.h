@@ -199,9 +199,14 @@ std::vector<Detection> mergeDetections(std::vector<Detection> detections, const 
 /// box the robot's arm or gripper shows can be matched anywhere above it. A detection is kept
 /// when its lowest box corner lies within `tolerance` (m) of `table` (heights in the detections'
 /// optical frame), or of the highest corner of a kept detection whose footprint on the table
-/// meets its own (a link across a node), repeated until nothing more is kept. `models` must hold
-/// every detection's class; the order of the kept ones is kept.
+/// meets its own (a link across a node), repeated until nothing more is kept. `unfound` are
+/// clusters of a part class's points where no part was found (optical frame): one standing on
+/// the table (its 5th percentile height at most kRaisedSupport) holds up a detection as a kept
+/// one does, its top its 95th percentile height: a part hidden but for its sides, a node under
+/// a link put across it, is seen only as such slivers. `models` must hold every detection's
+/// class; the order of the kept ones is kept.
 std::vector<Detection> keepSupported(const std::vector<Detection>& detections, const std::vector<ObjectModel>& models,
-                                     const TablePlane& table, double tolerance);
+                                     const TablePlane& table, double tolerance,
+                                     const std::vector<std::vector<Eigen::Vector3f>>& unfound = {});
 
 }  // namespace costar::perception

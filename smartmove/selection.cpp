@@ -17,11 +17,30 @@ double jointDistance(const arm::JointVector& a, const arm::JointVector& b) {
   return sum;
 }
 
+/// Reasons whose detail names what was false: the summary says which (the part and the
+/// predicate), at most kNamedDetails of them.
+constexpr const char* kPredicateFalse = "predicate false";
+constexpr std::size_t kNamedDetails = 3;
+
 std::string summarize(const std::vector<Candidate>& candidates) {
-  std::map<std::string, int> reasons;
+  struct Reason {
+    int count = 0;
+    std::vector<std::string> details;  // distinct, in the candidates' order
+  };
+  std::map<std::string, Reason> reasons;
   for (const Candidate& candidate : candidates) {
-    if (!candidate.rejected.empty()) {
-      ++reasons[candidate.rejected.substr(0, candidate.rejected.find(':'))];
+    if (candidate.rejected.empty()) {
+      continue;
+    }
+    const std::size_t colon = candidate.rejected.find(':');
+    Reason& reason = reasons[candidate.rejected.substr(0, colon)];
+    ++reason.count;
+    if (colon != std::string::npos && candidate.rejected.compare(0, colon, kPredicateFalse) == 0) {
+      const std::size_t from = candidate.rejected.find_first_not_of(' ', colon + 1);
+      const std::string detail = from == std::string::npos ? std::string() : candidate.rejected.substr(from);
+      if (!detail.empty() && std::find(reason.details.begin(), reason.details.end(), detail) == reason.details.end()) {
+        reason.details.push_back(detail);
+      }
     }
   }
   std::string text = std::to_string(candidates.size()) + " candidate" + (candidates.size() == 1 ? "" : "s");
@@ -29,8 +48,14 @@ std::string summarize(const std::vector<Candidate>& candidates) {
     return "no candidates";
   }
   std::string details;
-  for (const auto& [reason, count] : reasons) {
-    details += (details.empty() ? "" : ", ") + std::to_string(count) + " " + reason;
+  for (const auto& [name, reason] : reasons) {
+    details += (details.empty() ? "" : ", ") + std::to_string(reason.count) + " " + name;
+    for (std::size_t d = 0; d < reason.details.size() && d < kNamedDetails; ++d) {
+      details += (d == 0 ? ": " : "; ") + reason.details[d];
+    }
+    if (reason.details.size() > kNamedDetails) {
+      details += "; " + std::to_string(reason.details.size() - kNamedDetails) + " more";
+    }
   }
   return text + ", none feasible (" + details + ")";
 }

@@ -233,5 +233,33 @@ TEST(Selection, WithNothingFeasibleTheFailureCountsTheReasons) {
   EXPECT_EQ(selection.failure, "16 candidates, none feasible (8 collision at the goal, 8 no IK solution)");
 }
 
+// "1 candidate, none feasible (1 predicate false)" did not say which predicate of which part was
+// false (the UR5 assembly's top node: its one link not left of table_center, as the link across
+// the base node had not been seen).
+TEST(Selection, AFailureOnAPredicateNamesWhichWasFalse) {
+  const auto rejected = [](const std::string& object, const std::string& reason) {
+    Candidate candidate;
+    candidate.object = object;
+    candidate.symmetry = -1;
+    candidate.rejected = reason;
+    return candidate;
+  };
+  Selection one;
+  one.candidates = {rejected("link_1", "predicate false: left_of(link_1,table_center) is false")};
+  one.summarizeFailure();
+  EXPECT_EQ(one.failure, "1 candidate, none feasible (1 predicate false: left_of(link_1,table_center) is false)");
+  // Each distinct one, at most three, beside the other reasons' counts.
+  Selection many;
+  for (int n = 1; n <= 5; ++n) {
+    const std::string part = "node_" + std::to_string(n);
+    many.candidates.push_back(rejected(part, "predicate false: right_of(" + part + ",table_center) is false"));
+  }
+  many.candidates.push_back(rejected("node_6", "no IK solution: out of reach or beyond the joint limits"));
+  many.summarizeFailure();
+  EXPECT_EQ(many.failure,
+            "6 candidates, none feasible (1 no IK solution, 5 predicate false: right_of(node_1,table_center) is false; "
+            "right_of(node_2,table_center) is false; right_of(node_3,table_center) is false; 2 more)");
+}
+
 }  // namespace
 }  // namespace costar::smartmove
