@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 namespace costar::arm {
 
@@ -56,7 +57,46 @@ Eigen::Vector3d ramp(const Eigen::Vector3d& before, const Eigen::Vector3d& targe
   return change.norm() <= step ? target : Eigen::Vector3d(before + change.normalized() * step);
 }
 
+/// "joints 4, 6" (1-based, as the status names them).
+std::string jointList(const std::vector<int>& joints) {
+  std::string text = joints.size() == 1 ? "joint " : "joints ";
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    text += (i == 0 ? "" : ", ") + std::to_string(joints[i]);
+  }
+  return text;
+}
+
 }  // namespace
+
+Dexterity dexterity(const std::function<world::Pose(const JointVector&)>& tool, const JointVector& q) {
+  constexpr double kStep = 1e-6;  // rad: central differences, exact to about 1e-10 here
+  const int n = q.size();
+  Eigen::MatrixXd jacobian(6, n);
+  for (int j = 0; j < n; ++j) {
+    JointVector plus = q;
+    JointVector minus = q;
+    plus[j] += kStep;
+    minus[j] -= kStep;
+    const world::Pose a = tool(plus);
+    const world::Pose b = tool(minus);
+    jacobian.block<3, 1>(0, j) = (a.translation() - b.translation()) / (2.0 * kStep);
+    // The small turn from b to a: the skew part of their relative rotation.
+    const Eigen::Matrix3d turn = a.linear() * b.linear().transpose();
+    const Eigen::Vector3d axis(turn(2, 1) - turn(1, 2), turn(0, 2) - turn(2, 0), turn(1, 0) - turn(0, 1));
+    jacobian.block<3, 1>(3, j) = axis / 2.0 * kMetresPerRadian / (2.0 * kStep);
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinV);
+  const Eigen::Index last = svd.singularValues().size() - 1;
+  Dexterity found;
+  found.value = svd.singularValues()[last];
+  const Eigen::VectorXd lost = svd.matrixV().col(last).cwiseAbs();
+  for (int j = 0; j < n; ++j) {
+    if (lost[j] >= 0.5 * lost.maxCoeff()) {
+      found.joints.push_back(j + 1);
+    }
+  }
+  return found;
+}
 
 GuidingMode GuidingMode::parse(const std::string& mode, const std::string& locked, const std::string& axes) {
   GuidingMode guiding;
@@ -179,6 +219,11 @@ FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joi
       first_reason = why;
     }
   };
+  const bool guarded = static_cast<bool>(check.dexterity);
+  const Dexterity here = guarded ? check.dexterity(joints) : Dexterity{};
+  // Toward a singularity the step may take this fraction of the top speeds, none below the floor.
+  const double near_singular =
+      std::clamp((here.value - gains.singular_floor) / (gains.singular_slow - gains.singular_floor), 0.0, 1.0);
   for (Twist attempt : tries) {
     // Near a singularity the joints would turn fast, and the links would swing fast: the twist
     // slows until they do not.
@@ -199,6 +244,23 @@ FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joi
         attempt.angular_velocity /= 2.0 * worst;
         refuse("a joint would turn too fast (near a singularity)");
         continue;
+      }
+      if (guarded) {
+        const Dexterity there = check.dexterity(*q);
+        if (there.value < here.value && there.value < gains.singular_slow) {
+          if (there.value <= gains.singular_floor) {
+            refuse("at a singularity (" + jointList(there.joints) + "): guide the tool another way");
+            break;
+          }
+          const double fraction = std::max(attempt.velocity.norm() / gains.max_speed,
+                                           attempt.angular_velocity.norm() / gains.max_rotation_speed);
+          if (fraction > near_singular * (1.0 + 1e-9)) {
+            attempt.velocity *= near_singular / fraction;
+            attempt.angular_velocity *= near_singular / fraction;
+            refuse("slowed near a singularity (" + jointList(there.joints) + ")");
+            continue;
+          }
+        }
       }
       const double moved = check.displacement(joints, *q);
       if (moved > gains.max_point_speed * dt) {

@@ -18,6 +18,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -61,7 +62,24 @@ struct AdmittanceGains {
   double joint_margin = 0.05;
   /// The joints turn at most this fraction of their top speed.
   double joint_speed_fraction = 0.5;
+  /// Near a singularity (the arm's dexterity, below, under `singular_slow`) a step that brings it
+  /// nearer slows in proportion to what is left above `singular_floor`, and none goes below the
+  /// floor; a step away from the singularity is free. As a UR's free-drive grows heavy near a
+  /// limit: the hand feels it, and the status says why.
+  double singular_slow = 0.02;    // m/rad
+  double singular_floor = 0.008;  // m/rad
 };
+
+/// How far the arm is from a singularity: the smallest singular value of the tool's Jacobian
+/// (its rotation rows counted at 0.1 m per rad, so that both are m/rad), and the joints that move
+/// most along the direction the tool loses there (1-based), for the status's reason.
+struct Dexterity {
+  double value = 0.0;
+  std::vector<int> joints;
+};
+/// The dexterity of the arm at `q`, whose tool centre point is at `tool(q)`: the Jacobian by
+/// central differences of `tool` (any arm, any number of joints).
+Dexterity dexterity(const std::function<world::Pose(const JointVector&)>& tool, const JointVector& q);
 
 /// The hand's push at the tool centre point, in the world: the wrist sensor's reading less what
 /// it read when free-drive began, less the change of the payload's weight as the tool turned.
@@ -96,6 +114,8 @@ struct StepChecks {
   /// How far (m) the point of the arm that moves most (a link's, not only the tool's) moves from
   /// `from` to `to`.
   std::function<double(const JointVector& from, const JointVector& to)> displacement;
+  /// The arm's dexterity at a configuration (dexterity() above); empty: not checked.
+  std::function<Dexterity(const JointVector& q)> dexterity;
 };
 
 struct FreeDriveStep {
@@ -113,7 +133,8 @@ struct FreeDriveStep {
 /// the joints' motion carries the arm's fastest point `look_ahead` further (an elbow moving
 /// faster than the tool looks as far ahead as it moves); otherwise its translation alone, or its
 /// rotation alone, or the translation less its part along one world axis (sliding along a
-/// wall), or none (the reference holds and the twist is zero). A step too fast is slowed.
+/// wall), or none (the reference holds and the twist is zero). A step too fast is slowed, and so is
+/// one toward a singularity (`gains.singular_slow`, `singular_floor`).
 FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joints, const Twist& twist, double dt,
                             const JointVector& max_joint_step, const AdmittanceGains& gains, const StepChecks& check);
 

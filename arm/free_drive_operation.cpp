@@ -222,6 +222,9 @@ std::unique_ptr<component::RunningOperation> ArmComponent::freeDrive(const compo
   check.displacement = [this](const JointVector& from, const JointVector& to) {
     return planner_->largestDisplacement(from, to);
   };
+  check.dexterity = [this](const JointVector& q) {
+    return dexterity([this](const JointVector& at) { return toolAt(at); }, q);
+  };
 
   auto tick = [this, run, check, tcp_in_sensor, sensor_in_tool, &driving, &limits](bool first) -> OperationResult {
     const TimePoint now = clock_.now();

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "arm/arm_component.h"
+#include "arm/free_drive.h"
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
@@ -184,6 +185,9 @@ void dragRandom(workcell::Workcell& cell, const std::vector<std::string>& w) {
     std::printf("joint limit violations: %llu ticks (closest to a limit: %.3f rad)\n",
                 static_cast<unsigned long long>(r.joint_limit_violations), r.closest_to_limit);
     std::printf("the joints at most %.3f rad from the configuration the steps were checked at\n", r.max_departure);
+    std::printf("nearest a singularity: dexterity %.4f m/rad (joints %s; the guard slows from %.3f, stops at %.3f)\n",
+                r.least_dexterity, r.least_dexterity_joints.c_str(), arm::AdmittanceGains{}.singular_slow,
+                arm::AdmittanceGains{}.singular_floor);
     std::printf("contacts: table %llu physics steps, parts %llu ticks%s%s; lowest tool %.3f m above the table\n",
                 static_cast<unsigned long long>(r.table_contact_steps),
                 static_cast<unsigned long long>(r.part_contact_ticks), r.first_part_contact.empty() ? "" : " (first: ",

@@ -551,8 +551,9 @@ constexpr double kMaxHandForce = 60.0;
 constexpr double kMaxHandTorque = 3.0;
 
 /// POST /api/drag: free-drive's hand and dead-man (Backend::Drag): {"force": [x, y, z], "torque":
-/// [x, y, z]} (N, N m, world, at the tool), a push for 0.25 s and the dead-man for 2 s, or
-/// {"release": true}.
+/// [x, y, z]} (N, N m, world, at the tool), a push for 0.25 s and the dead-man for 2 s, answered
+/// with why free-drive's last step was not wholly taken ("blocked", empty when it was) and its
+/// speed (m/s); or {"release": true}.
 HttpResponse dragTool(const Call& call) {
   const json body = call.body();
   if (!body.is_object()) {
@@ -588,11 +589,14 @@ HttpResponse dragTool(const Call& call) {
       throw RequestError(400, "unknown field '" + key.substr(0, 32) + "' (force, torque, release)");
     }
   }
-  const StartResult result = call.backend.drag(drag);
+  const Backend::DragResult result = call.backend.drag(drag);
   if (result.status != 0) {
     return errorResponse(result.status, result.error);
   }
-  return jsonResponse({{"ok", drag.release ? "released" : "held"}});
+  if (drag.release) {
+    return jsonResponse({{"ok", "released"}});
+  }
+  return jsonResponse({{"ok", "held"}, {"blocked", result.blocked}, {"speed", result.speed}});
 }
 
 HttpResponse getGroundTruth(const Call& call) {

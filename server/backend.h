@@ -99,9 +99,10 @@ class Backend {
   /// and the dead-man stays held for `hold_seconds` (kDragLeaseSeconds, 2 s: a page whose timer
   /// runs late on a loaded machine keeps free-drive and its recording instead of losing them;
   /// when the pushes stop for longer it lapses: the arm stops and holds, the operation ends).
-  /// `release` (the pointer let go) lets go now. Status 0 when applied; 409 when no FreeDrive
-  /// runs, 404 for a cell without a simulator (a real arm is pushed by a real hand, with the arm's
-  /// own enabling button).
+  /// `release` (the pointer let go) lets go now. Status 0 when applied, with why free-drive's last
+  /// step was not wholly taken (a contact ahead, a joint limit, near a singularity: what the page
+  /// shows the person guiding) and its speed; 409 when no FreeDrive runs, 404 for a cell without a
+  /// simulator (a real arm is pushed by a real hand, with the arm's own enabling button).
   static constexpr double kDragPeriodSeconds = 0.05;
   static constexpr double kDragPushSeconds = 0.25;
   static constexpr double kDragLeaseSeconds = 2.0;
@@ -112,8 +113,14 @@ class Backend {
     double hold_seconds = kDragLeaseSeconds;
     bool release = false;
   };
-  virtual StartResult drag(const Drag& drag) {
-    StartResult refused;
+  struct DragResult {
+    int status = 0;  // as StartResult's
+    std::string error;
+    std::string blocked;  // arm::ArmComponent::FreeDriveStatus::blocked (empty: the step was taken)
+    double speed = 0.0;   // m/s of free-drive's reference
+  };
+  virtual DragResult drag(const Drag& drag) {
+    DragResult refused;
     refused.status = 404;
     refused.error = "this backend has no arm to guide";
     (void)drag;

@@ -330,9 +330,9 @@ StartResult Engine::resetScene() {
   });
 }
 
-StartResult Engine::drag(const Drag& request) {
-  return call([this, request]() -> StartResult {
-    StartResult out;
+Backend::DragResult Engine::drag(const Drag& request) {
+  return call([this, request]() -> DragResult {
+    DragResult out;
     sim::Simulation* simulation = cell_->simulation();
     auto* arm = dynamic_cast<arm::ArmComponent*>(cell_->components().provider("FreeDrive"));
     if (simulation == nullptr || arm == nullptr) {
@@ -357,6 +357,9 @@ StartResult Engine::drag(const Drag& request) {
     hand.torque = Eigen::Vector3d(request.torque[0], request.torque[1], request.torque[2]);
     simulation->setHandWrench(
         hand, std::chrono::duration_cast<Duration>(std::chrono::duration<double>(request.push_seconds)));
+    const arm::ArmComponent::FreeDriveStatus status = arm->freeDriveStatus();
+    out.blocked = status.blocked;
+    out.speed = status.speed;
     return out;
   });
 }

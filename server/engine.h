@@ -112,7 +112,7 @@ class Engine final : public Backend {
   std::optional<nlohmann::json> pointCloud(std::size_t max_points) override;
   std::optional<nlohmann::json> robot() override;
   StartResult resetScene() override;
-  StartResult drag(const Drag& drag) override;
+  DragResult drag(const Drag& drag) override;
 
   // --- the live stream ----------------------------------------------------------------------
   /// The messages since the last call, in order: run_started, statuses (each changed node's

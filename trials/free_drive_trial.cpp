@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "arm/arm_component.h"
+#include "arm/free_drive.h"
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
@@ -79,6 +80,7 @@ FreeDriveTrialResult runFreeDriveTrial(workcell::Workcell& cell, const FreeDrive
   const TimePoint start = cell.clock().now();
   const auto elapsed = [&] { return toSeconds(cell.clock().now() - start); };
   result.closest_to_limit = 1e9;
+  result.least_dexterity = 1e9;
   result.lowest_tool = 1e9;
   const std::uint64_t table_steps_before = simulation->armTableContactSteps();
   world::Pose last_tcp = simulation->tcpPose();
@@ -97,6 +99,14 @@ FreeDriveTrialResult runFreeDriveTrial(workcell::Workcell& cell, const FreeDrive
     if (checked.active && checked.checked.size() == q.size()) {
       for (int j = 0; j < q.size(); ++j) {
         result.max_departure = std::max(result.max_departure, std::abs(q[j] - checked.checked[j]));
+      }
+      const arm::Dexterity here = arm::dexterity([arm](const arm::JointVector& at) { return arm->toolAt(at); }, q);
+      if (here.value < result.least_dexterity) {
+        result.least_dexterity = here.value;
+        result.least_dexterity_joints.clear();
+        for (int j : here.joints) {
+          result.least_dexterity_joints += (result.least_dexterity_joints.empty() ? "" : ", ") + std::to_string(j);
+        }
       }
     }
     for (const auto& [a, b] : simulation->contacts()) {

@@ -31,6 +31,8 @@ struct FreeDriveTrialResult {
   std::uint64_t joint_limit_violations = 0;  // ticks with a joint beyond its limit
   double closest_to_limit = 0.0;             // rad: the least distance of a joint to its limit
   double max_departure = 0.0;                // rad: the joints' largest departure from those checked
+  double least_dexterity = 0.0;              // m/rad: the arm's nearest a singularity (arm::dexterity), free-driving
+  std::string least_dexterity_joints;        // the joints that lose the tool's motion there ("4, 6")
   std::uint64_t table_contact_steps = 0;     // physics steps with the arm or gripper on the table
   std::uint64_t part_contact_ticks = 0;      // ticks with the arm or gripper touching a part
   std::string first_part_contact;            // the first: which bodies, when

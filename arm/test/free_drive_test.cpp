@@ -1,8 +1,11 @@
 #include "arm/free_drive.h"
 
+#include "arm/ur5_kinematics.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 
 #include <Eigen/Geometry>
 
@@ -206,6 +209,131 @@ TEST(FreeDrive, ALinkWhoseMotionAheadReachesAWallStopsTheStepThoughTheToolsLookA
       stepReference(world::Pose::Identity(), joints, twist, 0.01, JointVector(2, 1.0), gains, check);
   EXPECT_EQ(step.twist.velocity.norm(), 0.0);
   EXPECT_EQ(step.blocked, "forearm_link would touch table");
+}
+
+/// The UR5's own kinematics with a tool 15 cm beyond the flange, free of obstacles: what a step
+/// is checked against near its singularities.
+struct Ur5Steps {
+  Ur5Kinematics ur5;
+  world::Pose tcp = world::Pose(Eigen::Translation3d(0.0, 0.0, 0.15));
+  world::Pose tool(const JointVector& q) const { return ur5.forward(q) * tcp; }
+  StepChecks checks(bool guard) const {
+    StepChecks check;
+    check.reach = [this](const world::Pose& pose, const JointVector& seed, std::string& why) {
+      std::optional<JointVector> q = ur5.inverseNearest(pose * tcp.inverse(), seed);
+      if (!q) {
+        why = "out of the arm's reach";
+      }
+      return q;
+    };
+    check.sweep = [](const JointVector&, const JointVector&, std::string&) { return true; };
+    check.displacement = [this](const JointVector& from, const JointVector& to) {
+      return (tool(to).translation() - tool(from).translation()).norm();
+    };
+    if (guard) {
+      check.dexterity = [this](const JointVector& q) {
+        return dexterity([this](const JointVector& at) { return tool(at); }, q);
+      };
+    }
+    return check;
+  }
+};
+
+TEST(FreeDrive, TheDexterityFallsToZeroAtTheUr5sWristSingularityNamingTheWristJoints) {
+  const Ur5Steps arm;
+  const auto tool = [&arm](const JointVector& q) { return arm.tool(q); };
+  JointVector q{0.3, -1.3, 1.5, -1.8, 1.2, 0.4};
+  const Dexterity away = dexterity(tool, q);
+  EXPECT_GT(away.value, AdmittanceGains{}.singular_slow);
+  double before = away.value;
+  for (double q5 : {0.6, 0.3, 0.1, 0.01}) {
+    q[4] = q5;
+    const Dexterity d = dexterity(tool, q);
+    EXPECT_LT(d.value, before) << "q5 " << q5;
+    EXPECT_EQ(d.joints, (std::vector<int>{4, 6})) << "q5 " << q5;
+    before = d.value;
+  }
+  q[4] = 0.0;
+  EXPECT_LT(dexterity(tool, q).value, 1e-6);
+}
+
+/// The checked joints as the hand pulls the UR5's tool, 3 s at 100 Hz, from the wrist at q5 =
+/// 0.35 rad toward the pose it has at q5 = -0.35 (the other side of its wrist singularity).
+struct WristPull {
+  double least_q5 = 1e9;
+  double least_dexterity = 1e9;
+  double fastest = 0.0;  // m/s of the reference
+  std::set<std::string> blocked;
+  JointVector end;
+};
+WristPull pullThroughTheWrist(bool guard) {
+  const Ur5Steps arm;
+  const StepChecks check = arm.checks(guard);
+  const AdmittanceGains gains;
+  JointVector joints{0.3, -1.3, 1.5, -1.8, 0.35, 0.4};
+  JointVector other = joints;
+  other[4] = -0.35;
+  const world::Pose goal = arm.tool(other);
+  world::Pose reference = arm.tool(joints);
+  const JointVector max_step(6, 0.5 * 3.15 * 0.01);  // half the UR5's top speed, one tick
+  WristPull pull;
+  for (int tick = 0; tick < 300; ++tick) {
+    Twist twist;
+    const Eigen::Vector3d error = goal.translation() - reference.translation();
+    twist.velocity = error.norm() > 1e-6 ? Eigen::Vector3d(error.normalized() * std::min(0.1, error.norm() / 0.01))
+                                         : Eigen::Vector3d::Zero();
+    const Eigen::AngleAxisd turn(goal.linear() * reference.linear().transpose());
+    twist.angular_velocity = turn.axis() * std::min(0.4, turn.angle() / 0.01);
+    const FreeDriveStep step = stepReference(reference, joints, twist, 0.01, max_step, gains, check);
+    pull.fastest = std::max(pull.fastest, (step.reference.translation() - reference.translation()).norm() / 0.01);
+    reference = step.reference;
+    joints = step.joints;
+    pull.least_q5 = std::min(pull.least_q5, joints[4]);
+    pull.least_dexterity =
+        std::min(pull.least_dexterity, dexterity([&arm](const JointVector& q) { return arm.tool(q); }, joints).value);
+    if (!step.blocked.empty()) {
+      pull.blocked.insert(step.blocked);
+    }
+  }
+  pull.end = joints;
+  return pull;
+}
+
+TEST(FreeDrive, PulledThroughTheUr5sWristSingularityTheStepSlowsAndStopsShortOfIt) {
+  // Without the guard the checked wrist goes to within 0.03 rad of its singularity, where joints
+  // 4 and 6 turn fast for little of the tool's motion (the UR5's 0.553 m/s on the random drag's
+  // seed 1: the checked wrist crossed it, joints 4 and 6 chattered).
+  const AdmittanceGains gains;
+  const WristPull unguarded = pullThroughTheWrist(false);
+  EXPECT_LT(unguarded.least_q5, 0.03);
+  EXPECT_LT(unguarded.least_dexterity, 0.25 * gains.singular_floor);
+
+  const WristPull guarded = pullThroughTheWrist(true);
+  EXPECT_GE(guarded.least_dexterity, gains.singular_floor);
+  EXPECT_GT(guarded.least_q5, 0.1);
+  EXPECT_LE(guarded.fastest, gains.max_speed + 1e-9);
+  EXPECT_TRUE(guarded.blocked.contains("slowed near a singularity (joints 4, 6)"));
+  EXPECT_TRUE(guarded.blocked.contains("at a singularity (joints 4, 6): guide the tool another way"));
+}
+
+TEST(FreeDrive, AStepAwayFromASingularityIsNotSlowed) {
+  // The UR5's wrist at q5 = 0.1 rad, within the guard's floor: pulled back to q5 = 0.6 at full speed.
+  const Ur5Steps arm;
+  const StepChecks check = arm.checks(true);
+  const AdmittanceGains gains;
+  const JointVector joints{0.3, -1.3, 1.5, -1.8, 0.1, 0.4};
+  ASSERT_LT(check.dexterity(joints).value, gains.singular_floor);
+  JointVector away = joints;
+  away[4] = 0.11;
+  const world::Pose from = arm.tool(joints);
+  const world::Pose to = arm.tool(away);
+  Twist twist;
+  twist.velocity = (to.translation() - from.translation()).normalized() * 0.02;
+  const Eigen::AngleAxisd turn(to.linear() * from.linear().transpose());
+  twist.angular_velocity = turn.axis() * 0.02 * turn.angle() / (to.translation() - from.translation()).norm();
+  const FreeDriveStep step = stepReference(from, joints, twist, 0.01, JointVector(6, 0.0157), gains, check);
+  EXPECT_EQ(step.blocked, "");
+  EXPECT_GT(step.joints[4], joints[4]);
 }
 
 }  // namespace

@@ -998,5 +998,34 @@ TEST(Ur5Cell, APageThatStallsKeepsFreeDriveHeldWhileTheArmStandsAndMovesAgainOnT
   EXPECT_EQ(h.waitForRun(id)["result"], "SUCCESS");
 }
 
+TEST(Ur5Cell, EachPushIsAnsweredWithWhyFreeDriveHeldBackAndItsSpeed) {
+  // Pushed down onto the table: the page is told the reference's speed while it moves, and why
+  // the arm stopped short of the table when it does (what the page shows the person guiding).
+  Harness h(blindCell(), 1.0);
+  const json down = {{"force", {0.0, 0.0, -40.0}}, {"torque", {0.0, 0.0, 0.0}}};
+  const HttpResponse started =
+      h.call("POST", "/api/operations", {{"node", "FreeDrive"}, {"attributes", {{"mode", "translation"}}}});
+  ASSERT_EQ(started.status, 202) << started.body;
+  const std::int64_t id = json::parse(started.body)["run"];
+  double fastest = 0.0;
+  std::string blocked;
+  const std::uint64_t end = h.engine().stats().ticks + 600;
+  while (h.engine().stats().ticks < end && blocked.find("table") == std::string::npos) {
+    const HttpResponse pushed = h.call("POST", "/api/drag", down);
+    if (pushed.status == 200) {
+      const json answer = json::parse(pushed.body);
+      EXPECT_EQ(answer["ok"], "held");
+      fastest = std::max(fastest, answer["speed"].get<double>());
+      blocked = answer["blocked"].get<std::string>();
+    }
+    h.waitTicks(5);
+  }
+  EXPECT_GT(fastest, 0.05);
+  EXPECT_NE(blocked.find("would touch table"), std::string::npos) << blocked;
+  const HttpResponse released = h.call("POST", "/api/drag", {{"release", true}});
+  EXPECT_EQ(json::parse(released.body), json({{"ok", "released"}}));
+  EXPECT_EQ(h.waitForRun(id)["result"], "SUCCESS");
+}
+
 }  // namespace
 }  // namespace costar::server

@@ -1,5 +1,5 @@
 // What the editor's end-to-end tests share: starting `costar serve` on a simulated cell (its
-// token in a private file, a store and a waypoint file of its own), Debian's Chromium driven by
+// token in a private file, a store, a waypoint file and a state folder of its own), Debian's Chromium driven by
 // playwright-core, checks that log what they proved, counting UI actions, the simulator's true
 // state (a TEST ONLY endpoint), and the readability check at a screen size.
 
@@ -44,7 +44,8 @@ export async function startServer({ workcell = 'ur5-sim', scene, waypoints, pace
   const argv = ['serve', '--workcell', workcell, '--port', '0', '--waypoints', waypointFile, '--store', path.join(work, 'editor.sqlite'),
     '--token-file', tokenFile, '--web-root', path.join(root, 'web/dist'), '--pace', String(pace), '--test-endpoints', ...extra];
   if (scene) argv.push('--scene', path.join(root, scene));
-  const server = spawn(costar, argv, { stdio: ['ignore', 'pipe', 'pipe'] });
+  // Its own state folder too: the grasps TeachGrasp saves go there, not into the user's.
+  const server = spawn(costar, argv, { stdio: ['ignore', 'pipe', 'pipe'], env: { ...process.env, XDG_STATE_HOME: path.join(work, 'state') } });
   server.stderr.on('data', (d) => process.stderr.write(`serve: ${d}`));
   const started = await new Promise((resolve, reject) => {
     let text = '';

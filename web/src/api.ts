@@ -201,9 +201,13 @@ export class Api {
   control = (action: 'pause' | 'resume' | 'step' | 'stop') => this.request('POST', '/api/control', { action });
   operation = (node: string, attributes: Record<string, string> = {}) =>
     this.request<{ run: number }>('POST', '/api/operations', { node, attributes });
-  /** Free-drive's hand: a push on the tool (N, N m, world) for 0.25 s, holding the dead-man 2 s, or let go. */
+  /**
+   * Free-drive's hand: a push on the tool (N, N m, world) for 0.25 s, holding the dead-man 2 s,
+   * answered with why free-drive held back its last step ('' when it did not: a contact ahead, a
+   * joint limit, near a singularity) and its speed (m/s); or let go.
+   */
   drag = (body: { force: [number, number, number]; torque?: [number, number, number] } | { release: true }) =>
-    this.request<{ ok: string }>('POST', '/api/drag', body);
+    this.request<{ ok: string; blocked?: string; speed?: number }>('POST', '/api/drag', body);
   runStatus = (id: number) => this.request<RunInfo>('GET', `/api/runs/${id}`);
   runs = () => this.request<StoredRun[]>('GET', '/api/runs');
   /** A logged run with every transition: the server answers a long log in pages. */

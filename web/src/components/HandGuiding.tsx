@@ -1,6 +1,6 @@
 // Teaching by demonstration (docs/TEACHING.md), under the waypoint pane: the guiding mode the
 // tool's handle in the 3D view moves the arm in (Franka's: free, translation only, rotation only,
-// an axis locked), recording the guided path as a trajectory, replaying one, and teaching a grasp
+// world axes locked: x, y, z), recording the guided path as a trajectory, replaying one, and teaching a grasp
 // of the part the gripper is around now (SmartMove's relative transform for that class).
 
 import { useState } from 'react';
@@ -32,7 +32,6 @@ export function HandGuiding({ guiding, onGuiding, frames, classes, trajectories,
   const [replayFrame, setReplayFrame] = useState('');
   const objectClass = graspClass || classes[0] || '';
   const chosen = replay || trajectories[0] || '';
-  const lockZ = guiding.locked.includes('z');
   return (
     <div className="hand-guiding" aria-label="Hand guiding">
       <div className="guide-row" title="Grab the sphere at the tool in the 3D view and drag: the arm follows while the pointer is held">
@@ -49,15 +48,18 @@ export function HandGuiding({ guiding, onGuiding, frames, classes, trajectories,
             {m.label}
           </button>
         ))}
-        <label title="the tool keeps its height">
-          <input
-            type="checkbox"
-            checked={lockZ}
-            aria-label="lock z"
-            onChange={(e) => onGuiding({ ...guiding, locked: e.target.checked ? [...guiding.locked, 'z'] : guiding.locked.filter((a) => a !== 'z') })}
-          />
-          lock z
-        </label>
+        lock
+        {(['x', 'y', 'z'] as const).map((axis) => (
+          <label key={axis} title={`the tool keeps its world ${axis}${axis === 'z' ? ' (its height)' : ''}`}>
+            <input
+              type="checkbox"
+              checked={guiding.locked.includes(axis)}
+              aria-label={`lock ${axis}`}
+              onChange={(e) => onGuiding({ ...guiding, locked: e.target.checked ? [...guiding.locked, axis] : guiding.locked.filter((a) => a !== axis) })}
+            />
+            {axis}
+          </label>
+        ))}
       </div>
       <div className="guide-row">
         <input

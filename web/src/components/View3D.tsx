@@ -104,6 +104,8 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
   const [toolScreen, setToolScreen] = useState('');
   const [partScreens, setPartScreens] = useState('{}');
   const [guiding, setGuiding] = useState(false);
+  /** Why free-drive holds the tool back while it is guided (the server's answer to each push). */
+  const [heldBack, setHeldBack] = useState('');
   const grabRef = useRef(onGrab);
   grabRef.current = onGrab;
   const apiRef = useRef(api);
@@ -199,6 +201,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       grab = null;
       controls.enabled = true;
       setGuiding(false);
+      setHeldBack('');
       apiRef.current.drag({ release: true }).catch(() => undefined);
     };
     const onDown = async (event: PointerEvent) => {
@@ -221,7 +224,9 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
         if (!grab) return;
         const tool = handle.position;
         const force = handForce([tool.x, tool.y, tool.z] as Vec3, [grab.target.x, grab.target.y, grab.target.z] as Vec3);
-        apiRef.current.drag({ force }).catch((e) => {
+        apiRef.current.drag({ force }).then((answer) => {
+          if (grab) setHeldBack(answer.blocked ?? '');
+        }, (e) => {
           // The server's dead-man lapsed (a push came late) while the pointer is still held:
           // free-drive again, as a hand still on the button would.
           if ((e as ApiError).status === 409 && grab && !rearming && grabRef.current) {
@@ -451,6 +456,11 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
         )}
       </h2>
       {replayLabel && <div className="view3d-replay">{replayLabel}</div>}
+      {guiding && heldBack && (
+        <div className="view3d-held-back" role="status">
+          Held back: {heldBack}
+        </div>
+      )}
       <ForceStrip state={state} />
       {error ? (
         <p className="empty">{error}</p>
