@@ -142,9 +142,18 @@ SmartMoveComponent::SmartMoveComponent(const arm::MotionService& motion, compone
                   {object_class, predicates, push_distance, speed},
                   component::OperationKind::kRobotAction},
                  [this](const Params& params) { return beginPush(params); });
+  // A gripper with modes (the 3-finger gripper's basic, pinch, wide, scissor): the mode the taught
+  // grasp needs, chosen when it is taught; empty: the mode the gripper is in.
+  ParamSpec teach_mode{"mode", ValueType::kString,
+                       "the gripper mode the grasp needs, for a gripper with modes (empty: the mode it is in now)",
+                       std::string()};
+  if (!fingers_.modes().empty()) {
+    teach_mode.choices = fingers_.modes();
+    teach_mode.choices.insert(teach_mode.choices.begin(), "");
+  }
   operations.add({"TeachGrasp",
                   "Saves how the gripper holds the nearest part of a class as a named grasp.",
-                  {object_class, {"grasp", ValueType::kString, "name of the new grasp", {}}},
+                  {object_class, {"grasp", ValueType::kString, "name of the new grasp", {}}, teach_mode},
                   component::OperationKind::kKnowledge},
                  [this](const Params& params) { return beginTeachGrasp(params); });
   description.predicates = {{"holding", 1, "holding(o): the gripper holds part o"},

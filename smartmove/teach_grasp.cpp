@@ -1,5 +1,8 @@
 // TeachGrasp: how the gripper holds the nearest part of a class now, saved as a named grasp
-// (snapped to the class's canonical frame; with the gripper's mode, for a gripper with modes).
+// (snapped to the class's canonical frame; with the mode chosen, or the gripper's, for a gripper
+// with modes).
+
+#include <algorithm>
 
 #include "smartmove/script.h"
 #include "smartmove/smartmove.h"
@@ -27,11 +30,21 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginTeachGrasp(const comp
                   " within 10 cm of the gripper: detect the parts, then put the gripper "
                   "around one");
   }
+  const std::vector<std::string> modes = fingers_.modes();
+  const std::string chosen = text("mode");
+  if (!chosen.empty() && std::find(modes.begin(), modes.end(), chosen) == modes.end()) {
+    std::string listed;
+    for (const std::string& mode : modes) {
+      listed += (listed.empty() ? "" : ", ") + mode;
+    }
+    return failed("mode: '" + chosen + "' is not a mode of this gripper" +
+                  (modes.empty() ? std::string(" (it has none)") : " (" + listed + ")"));
+  }
   const world::Pose relative = snapToCanonical(nearest->second.inverse() * tool, *object);
-  Grasp taught{object_class, text("grasp"), relative, {}, {}};
-  // A gripper with modes: the grasp needs the one it was taught in.
-  for (const std::string& mode : fingers_.modes()) {
-    if (world_.holds("gripper_mode", std::vector<std::string>{mode})) {
+  Grasp taught{object_class, text("grasp"), relative, {}, chosen};
+  // A gripper with modes: the grasp needs the one chosen, else the one it was taught in.
+  for (const std::string& mode : modes) {
+    if (chosen.empty() && world_.holds("gripper_mode", std::vector<std::string>{mode})) {
       taught.mode = mode;
     }
   }

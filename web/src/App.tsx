@@ -1202,6 +1202,7 @@ export function App() {
             frames={liveChoices?.frame ?? ['world']}
             classes={choices?.object_class ?? []}
             trajectories={choices?.trajectory ?? []}
+            graspModes={(nodes.find((n) => n.id === 'TeachGrasp')?.ports.find((p) => p.name === 'mode')?.choices ?? []).filter((m) => m !== '')}
             refusal={refusedMotion}
             run={runOperation}
           />

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <random>
@@ -19,6 +20,7 @@
 #include "core/paths.h"
 #include "planning/robot_model.h"
 #include "sim/simulation.h"
+#include "smartmove/grasps.h"
 #include "workcell/grippers.h"
 #include "workcell/sim_cell_description.h"
 #include "workcell/workcell.h"
@@ -154,6 +156,49 @@ TEST_P(IiwaAdaptiveGripper, PicksAPartUpInEachMode) {
   EXPECT_TRUE(cell->components().world().holds("gripper_mode", std::vector<std::string>{mode}));
   EXPECT_TRUE(cell->components().world().holds("holding", std::vector<std::string>{part.name}));
   EXPECT_EQ(simulation.armTableContactSteps(), 0u);
+}
+
+// A grasp taught on the 3-finger gripper with the mode chosen (as the editor's Teach grasp row
+// offers it), not the mode the gripper is in: the grasp file keeps that mode, which SmartGrasp
+// sets. A mode the gripper lacks is refused naming its modes when the plan is built.
+TEST(IiwaAdaptiveGripperTeaching, AGraspTaughtWithAModeChosenKeepsThatMode) {
+  const auto folder = std::filesystem::temp_directory_path() / "costar_iiwa_teach_mode";
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  setenv("XDG_STATE_HOME", folder.c_str(), 1);  // where the taught grasps are written
+  const auto scene = folder / "scene.json";
+  std::ofstream(scene) << R"({"parts": [{"class": "node", "color": "red", "at": [0.5, -0.15, 30]}]})";
+  const auto cell = makeWorkcell(
+      {.name = "iiwa-3f-sim", .scene = scene, .waypoints = folder / "waypoints.json", .test_oracle_perception = true});
+  const auto run = [&cell](const std::string& body) {
+    const auto plan = bt::loadPlanText(
+        R"(<root BTCPP_format="4"><BehaviorTree ID="m"><Sequence>)" + body + "</Sequence></BehaviorTree></root>",
+        "teach.xml");
+    bt::Tree tree = bt::buildTree(plan, cell->nodes(), cell->clock());
+    bt::Executor executor(tree, cell->clock(), {.time_limit = std::chrono::seconds(90)});
+    executor.setBeforeTick([&cell] { cell->beforeTick(); });
+    return executor.run();
+  };
+  // The gripper around the node in Pinch mode.
+  ASSERT_EQ(run(R"(<SmartGrasp object_class="node" grasp="pinch"/>)").status, bt::Status::kSuccess);
+  try {
+    run(R"(<TeachGrasp object_class="node" grasp="demo" mode="sideways"/>)");
+    ADD_FAILURE() << "a mode the gripper lacks was taken";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("parameter 'mode' of TeachGrasp: 'sideways' is not one of: basic, pinch, "
+                                         "wide, scissor"),
+              std::string::npos)
+        << e.what();
+  }
+  ASSERT_EQ(run(R"(<TeachGrasp object_class="node" grasp="demo" mode="wide"/>)").status, bt::Status::kSuccess);
+  ASSERT_EQ(run(R"(<TeachGrasp object_class="node" grasp="as_it_is"/>)").status, bt::Status::kSuccess);
+  const smartmove::GraspLibrary taught(dataRoot() / "data/grasps.json", defaultGraspFile("iiwa-3f-sim"), "robotiq3f");
+  ASSERT_TRUE(taught.find("node", "demo"));
+  EXPECT_EQ(taught.find("node", "demo")->mode, "wide");
+  ASSERT_TRUE(taught.find("node", "as_it_is"));
+  EXPECT_EQ(taught.find("node", "as_it_is")->mode, "pinch");
+  unsetenv("XDG_STATE_HOME");
+  std::filesystem::remove_all(folder);
 }
 
 INSTANTIATE_TEST_SUITE_P(Modes, IiwaAdaptiveGripper,

@@ -13,6 +13,8 @@ interface Props {
   frames: string[];
   classes: string[];
   trajectories: string[];
+  /** The gripper's modes a grasp may need (TeachGrasp's mode: the 3-finger gripper's); none: no choice. */
+  graspModes: string[];
   refusal: string | null;
   run: (node: string, attributes?: Record<string, string>) => void;
 }
@@ -23,11 +25,12 @@ const MODES: { mode: Guiding['mode']; label: string; title: string }[] = [
   { mode: 'rotation', label: 'Rotate', title: 'the tool keeps its place and turns' },
 ];
 
-export function HandGuiding({ guiding, onGuiding, frames, classes, trajectories, refusal, run }: Props) {
+export function HandGuiding({ guiding, onGuiding, frames, classes, trajectories, graspModes, refusal, run }: Props) {
   const busy = refusal !== null;
   const why = refusal ?? undefined;
   const [graspClass, setGraspClass] = useState('');
   const [graspName, setGraspName] = useState('');
+  const [graspMode, setGraspMode] = useState('');
   const [replay, setReplay] = useState('');
   const [replayFrame, setReplayFrame] = useState('');
   const objectClass = graspClass || classes[0] || '';
@@ -111,13 +114,23 @@ export function HandGuiding({ guiding, onGuiding, frames, classes, trajectories,
             </option>
           ))}
         </select>
+        {graspModes.length > 0 && (
+          <select value={graspMode} aria-label="grasp mode" title="the gripper mode SmartGrasp sets for this grasp" onChange={(e) => setGraspMode(e.target.value)}>
+            <option value="">mode it is in</option>
+            {graspModes.map((m) => (
+              <option key={m} value={m}>
+                {m}
+              </option>
+            ))}
+          </select>
+        )}
         <input placeholder="grasp name" value={graspName} aria-label="grasp name" onChange={(e) => setGraspName(e.target.value)} />
         <button
           type="button"
           disabled={busy || !graspName || !objectClass}
           title={why ?? (!graspName ? 'name the grasp first' : 'the gripper is around a detected part of this class now: SmartGrasp will hold parts of it like this')}
           onClick={() => {
-            run('TeachGrasp', { object_class: objectClass, grasp: graspName });
+            run('TeachGrasp', graspMode ? { object_class: objectClass, grasp: graspName, mode: graspMode } : { object_class: objectClass, grasp: graspName });
             setGraspName('');
           }}
         >
