@@ -84,7 +84,7 @@ std::vector<Detection> keepSupported(const std::vector<Detection>& detections, c
   }
   std::vector<bool> kept(detections.size(), false);
   for (std::size_t d = 0; d < detections.size(); ++d) {
-    kept[d] = extents[d].low <= tolerance;
+    kept[d] = std::abs(extents[d].low) <= tolerance;
   }
   // A cluster where nothing was found, standing on the table, holds up what lies on its top as
   // a kept detection does: a part hidden but for its sides (a node under a link across it).

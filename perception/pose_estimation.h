@@ -44,7 +44,7 @@ struct PoseEstimationOptions {
   /// a detected instance's points, or the whole cluster when nothing was found), ObjRecRANSAC
   /// runs again on those points with another seed, up to max_attempts runs per cluster.
   int max_attempts = 3;
-  double unexplained_fraction = 0.4;
+  double unexplained_fraction = 0.25;
   /// ObjRecRANSAC's hypotheses are checked best first: a coarse ICP (10 iterations, the
   /// correspondence distance shrinking from icp_initial_distance to icp_coarse_final_distance)
   /// and a quick render-and-compare; a hypothesis that passes is refined with icp_iterations

@@ -161,7 +161,16 @@ RestingStarts restingStarts(const Cloud& cloud, const std::vector<int>& indices,
       }
     }
   };
-  addStarts(onPlane(mean), starts.middle);
+  // The mean of a part's points is not its middle's projection when only part of it is in
+  // view (a node behind a link lying on it shows its front face and a strip of its top): the
+  // same starts a quarter of the footprint's width along and across the main axis as well.
+  const Eigen::Vector3d middle = onPlane(mean);
+  addStarts(middle, starts.middle);
+  const double shift = 0.25 * std::min(bounds.sizes().x(), bounds.sizes().y());
+  for (const Eigen::Vector3d& offset : {Eigen::Vector3d(shift * axis), Eigen::Vector3d(-shift * axis),
+                                        Eigen::Vector3d(shift * side), Eigen::Vector3d(-shift * side)}) {
+    addStarts(middle + offset, starts.middle);
+  }
   for (const Eigen::Vector3d& end : ends) {
     addStarts(end, starts.ends);
   }

@@ -30,10 +30,12 @@ std::vector<world::Pose> principalAxisSeeds(const Cloud& points, const std::vect
 /// `object_class` resting upright on `support` under `indices` of `points`: its z along the
 /// plane's normal, its bottom on the plane under the points (pushed back from the camera by a
 /// quarter of its width: the seen faces are its top and the side facing the camera), turned
-/// about the normal in 15° steps from the points' main horizontal axis (12 poses: 0..165°).
-/// When the points' lowest (their 5th percentile) lie more than 1.5 cm above the plane, 12 more
-/// with its bottom at that height: resting on another part (a link on a node).
-/// Empty for fewer than 10 points.
+/// about the normal in 15° steps from the points' main horizontal axis (12 poses: 0..165°);
+/// the same 12 with the middle a quarter of the footprint's width along and across that axis
+/// (a part partly in view: its points' mean is not over its middle): 60 poses. When the points'
+/// lowest (their 5th percentile) lie more than 1.5 cm above the plane, as many more with its
+/// bottom at that height: resting on another part (a link on a node). Empty for fewer than 10
+/// points.
 std::vector<world::Pose> restingSeeds(const Cloud& points, const std::vector<int>& indices, const TablePlane& support,
                                       const world::ObjectClass& object_class);
 
