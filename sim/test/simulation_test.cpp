@@ -215,6 +215,32 @@ TEST(Simulation, ClosingOnNothingClosesFully) {
   EXPECT_FALSE(sim->fingers().pads_in_contact);
 }
 
+// A full close presses a part as thin as a wire with the set force, as an electric gripper's
+// motor current does: the position servo's setpoint at closed pressed a 2.5 mm wire with
+// kp x 1.25 mm = 3.75 N of a 20 N close, and a wire being bent turned and slid in the pads
+// (wire bending on iiwa-sim, seeds 1226, 1259, 1284: bends 6-12 degrees off).
+TEST(Simulation, AFullCloseSqueezesAThinWireWithTheSetForce) {
+  // The jig turned so that the wire runs along world y, across the fingers (they close along x).
+  const auto sim = Simulation::create(sceneOf(R"({"parts": [],
+    "jig": {"at": [0.5, -0.1, 90], "height": 0.03, "pins": []},
+    "wire": {"material": "steel_annealed", "diameter": 0.0025, "length": 0.2, "segments": 16}})"));
+  const Eigen::Vector3d grip(0.5, 0.05, 0.03);
+  ASSERT_LT(moveArm(*sim, toolDownAt(grip + Eigen::Vector3d(0, 0, 0.1)), 2.0), 0.003);
+  ASSERT_LT(moveArm(*sim, toolDownAt(grip), 1.5), 0.003);
+  sim->commandFingers(0.0, 0.1, 20.0);
+  waitSeconds(*sim, 1.0);
+  const FingerState closed = sim->fingers();
+  EXPECT_TRUE(closed.pads_in_contact);
+  EXPECT_NEAR(closed.opening, 0.0025, 0.0005);  // stopped on the wire
+  EXPECT_NEAR(closed.force, 20.0, 1.0);
+  ASSERT_TRUE(sim->jig());
+  EXPECT_EQ(sim->jig()->grip.holds, 1);
+  // Let go: the servo's setpoint comes back within the stroke and the fingers open as told.
+  sim->commandFingers(0.04, 0.1, 20.0);
+  waitSeconds(*sim, 1.0);
+  EXPECT_NEAR(sim->fingers().opening, 0.04, 0.001);
+}
+
 // A parallel gripper is its description (robots/grippers/NAME.json): the Franka Hand's stroke
 // is read back from its generated model, and it opens, closes and squeezes as described.
 TEST(Simulation, AParallelGripperHasTheStrokeItsDescriptionGives) {
