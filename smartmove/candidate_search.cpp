@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "smartmove/script.h"
@@ -45,14 +46,24 @@ std::optional<double> SmartMoveComponent::graspOpening(const world::Pose& tcp, c
 }
 
 double SmartMoveComponent::partHalfWidth(const world::Pose& tcp, const world::Pose& object,
-                                         const world::ObjectClass& object_class) {
-  // The part's bounding box in the tool's frame: its extent along y, either side of the TCP.
-  const Eigen::AlignedBox3d bounds = object_class.bounds();
+                                         const world::ObjectClass& object_class) const {
+  // The part's boxes in the tool's frame: their extent along y, either side of the TCP. A box
+  // wholly beyond the finger pads' reach along the approach is not between the fingers (the
+  // sander's 10 cm pad under the 36 mm knob they hold).
   const world::Pose part_in_tool = tcp.inverse() * object;
   double half = 0.0;
-  for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d p = part_in_tool * bounds.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
-    half = std::max(half, std::abs(p.y()));
+  for (const world::Box& box : object_class.boxes) {
+    const Eigen::AlignedBox3d bounds(box.center - box.half_size, box.center + box.half_size);
+    double nearest = std::numeric_limits<double>::infinity();
+    double box_half = 0.0;
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d p = part_in_tool * bounds.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+      nearest = std::min(nearest, p.z());
+      box_half = std::max(box_half, std::abs(p.y()));
+    }
+    if (nearest <= config_.finger_reach + 1e-9) {
+      half = std::max(half, box_half);
+    }
   }
   return half;
 }

@@ -108,7 +108,7 @@ struct SmartMoveConfig {
   double grasp_shift_keep = 0.003;
   /// m the finger pads reach past the tool centre point along the approach (the simulated
   /// 2-finger gripper's 40 mm pads are centred on it): how far they rise to clear a part before
-  /// SmartGrasp centre="true" turns them.
+  /// SmartGrasp centre="true" turns them, and which of a part's boxes lie between them.
   double finger_reach = 0.02;
   CostWeights weights;
 };
@@ -225,9 +225,9 @@ class SmartMoveComponent final : public component::TableComponent {
   Selection withShiftedGrasps(Selection centred, const world::ObjectClass& object_class, double reach,
                               const FeasibilityCheck& feasible);
   /// Half the part's width between the fingers of a grasp with the tool centre point at `tcp`
-  /// (its extent along the tool's y, either side of the TCP).
-  static double partHalfWidth(const world::Pose& tcp, const world::Pose& object,
-                              const world::ObjectClass& object_class);
+  /// (its extent along the tool's y, either side of the TCP), of its boxes that reach within
+  /// finger_reach past the TCP along the approach.
+  double partHalfWidth(const world::Pose& tcp, const world::Pose& object, const world::ObjectClass& object_class) const;
 
   // SmartGrasp centre="true" (smart_grasp.cpp): after the close, open fully, rise `rise` m,
   // turn by `turn` about the tool axis, go down and close, which centres the part along the

@@ -809,8 +809,17 @@ TEST(PolishingCell, TheRobotDescriptionCarriesThePowerToolAndWhereItSitsInTheHan
   const Eigen::Quaterniond q(held["q"][3].get<double>(), held["q"][0].get<double>(), held["q"][1].get<double>(),
                              held["q"][2].get<double>());
   EXPECT_NEAR((q * Eigen::Vector3d::UnitZ() - Eigen::Vector3d(0, 0, -1)).norm(), 0.0, 1e-9);  // the knob up the arm
+  // The UR5 cell has the sander too, held by its knob between the two pads, 1 cm lower in the
+  // hand (its gripper's body clears the knob's top).
   Harness ur5(blindCell());
-  EXPECT_FALSE(ur5.get("/api/robot").contains("power_tool"));
+  const json ur5_robot = ur5.get("/api/robot");
+  ASSERT_TRUE(ur5_robot.contains("power_tool"));
+  EXPECT_EQ(ur5_robot["power_tool"]["grasp"], "knob");
+  EXPECT_NEAR(ur5_robot["power_tool"]["held_in_tcp"]["p"][2].get<double>(), 0.117, 1e-9);
+  workcell::WorkcellOptions without = blindCell();
+  without.name = "iiwa-sim";  // no power tool in this cell
+  Harness iiwa(without);
+  EXPECT_FALSE(iiwa.get("/api/robot").contains("power_tool"));
 }
 
 // GET /api/robot: the robot as the planner models it (the arm's URDF with the gripper's on its

@@ -1,7 +1,8 @@
 // The power tool in the simulated LBR iiwa cell with the 3-finger gripper (sim/scenes/
-// polishing.json): it sits on its stand, SmartGrasp picks it up by its knob with the taught
-// grasp, ToolOn and ToolOff switch it, the component switches it off when it leaves the hand,
-// and the simulator records which texels of the workpiece's marked area the running pad worked.
+// polishing.json; one test on the UR5 cell with the 2-finger gripper): it sits on its stand,
+// SmartGrasp picks it up by its knob with the taught grasp, ToolOn and ToolOff switch it, the
+// component switches it off when it leaves the hand, and the simulator records which texels of
+// the workpiece's marked area the running pad worked.
 
 #include <algorithm>
 #include <cmath>
@@ -138,6 +139,40 @@ TEST(Polishing, TheSanderSitsStraightInTheHandAndItsPadPressesFlatUnderThePath) 
   const world::Pose pad = simulation.powerTool()->toolPose();
   EXPECT_LT(tilt(pad.linear().col(2), Eigen::Vector3d::UnitZ()), 2.0);
   EXPECT_LT((pad.translation() - tcp.translation()).head<2>().norm(), 0.005);
+}
+
+// The UR5 cell has the same stand and sander: its 2-finger gripper takes the 36 mm knob between
+// its pads, the tool centre point 11.7 cm above the pad (at the 3-finger grasp's 10.7 cm the
+// gripper's body sat on the knob's top and the sander hung 11.2 cm below). SmartGrasp measured
+// the width between the fingers over the whole tool, the 10 cm pad below the pads' reach
+// included, and refused it: "4 candidates, none feasible (4 too wide for the fingers)".
+TEST(Polishing, TheUr5TakesTheSanderByItsKnobBetweenItsTwoPadsAndPressesFlat) {
+  const auto cell = makeWorkcell({.name = "ur5-sim",
+                                  .scene = dataRoot() / "sim/scenes/polishing.json",
+                                  .seed = 21,
+                                  .waypoints = dataRoot() / "examples/ur5/polishing_waypoints.json",
+                                  .memory_only = true,
+                                  .test_oracle_perception = true});
+  sim::Simulation& simulation = *cell->simulation();
+  const OperationResult grasp = run(*cell, "SmartGrasp", {{"object_class", "orbital_sander"}, {"grasp", "knob"}});
+  ASSERT_EQ(grasp.state, OperationState::kSuccess) << grasp.reason;
+  EXPECT_TRUE(holds(*cell, "tool_held"));
+  EXPECT_NEAR(simulation.fingers().opening, 0.036, 0.002);  // on the knob
+  const auto tilt = [](const Eigen::Vector3d& axis, const Eigen::Vector3d& along) {
+    return std::acos(std::clamp(axis.dot(along), -1.0, 1.0)) * 180.0 / M_PI;
+  };
+  const world::Pose hanging = simulation.tcpPose().inverse() * simulation.powerTool()->toolPose();
+  EXPECT_LT(tilt(-hanging.linear().col(2), Eigen::Vector3d::UnitZ()), 2.0);
+  EXPECT_LT((hanging.translation() - Eigen::Vector3d(0, 0, 0.117)).norm(), 0.003) << hanging.translation().transpose();
+  ASSERT_EQ(run(*cell, "ToolOn", {{"speed", 10000.0}}).state, OperationState::kSuccess);
+  const OperationResult press =
+      run(*cell, "PressAndFollow",
+          {{"path", std::vector<std::string>{"row1_start", "row1_end"}}, {"force", 10.0}, {"speed", 0.03}});
+  ASSERT_EQ(press.state, OperationState::kSuccess) << press.reason;
+  const world::Pose pad = simulation.powerTool()->toolPose();
+  EXPECT_LT(tilt(pad.linear().col(2), Eigen::Vector3d::UnitZ()), 2.0);
+  EXPECT_LT((pad.translation() - simulation.tcpPose().translation()).head<2>().norm(), 0.005);
+  EXPECT_TRUE(holds(*cell, "tool_held"));
 }
 
 // MuJoCo takes the larger of two geoms' friction: the pad slid with the workpiece's 1.0, not its
