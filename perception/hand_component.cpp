@@ -29,6 +29,9 @@ HandComponent::HandComponent(camera::RgbdCamera& camera, const Clock& clock, Han
 }
 
 void HandComponent::look() const {
+  if (!config_.watch) {
+    return;
+  }
   const TimePoint now = clock_.now();
   if (last_look_ && now - *last_look_ < config_.period) {
     return;

@@ -43,6 +43,9 @@ struct HandComponentConfig {
   /// +y, from 5 to 45 cm above the table).
   std::map<std::string, HandZone> zones = {
       {"handover", {Eigen::Vector3d(-0.3, 0.1, 0.05), Eigen::Vector3d(0.3, 0.5, 0.45)}}};
+  /// false: no person can be in the cell (a simulated scene without one): no frames are taken and
+  /// no hand is reported, the names declared all the same, so that plans using them validate.
+  bool watch = true;
   /// Where the camera is as calibrated (calibration/); absent: the pose each frame carries.
   std::function<world::Pose()> camera_pose;
 };

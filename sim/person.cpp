@@ -87,16 +87,17 @@ PersonStep parseStep(const json& value, const std::string& field, const Eigen::V
     step.kind = kind == "leave" ? PersonStep::Kind::kLeave : PersonStep::Kind::kEnter;
     step.speed = 1.0;
     speed();
-  } else if (kind == "gesture" || kind == "wait" || kind == "close" || kind == "open") {
+  } else if (kind == "gesture" || kind == "take" || kind == "wait" || kind == "close" || kind == "open") {
     onlyKnownFields(value, field, {"do", "seconds"});
     step.kind = kind == "gesture" ? PersonStep::Kind::kGesture
+                : kind == "take"  ? PersonStep::Kind::kTake
                 : kind == "wait"  ? PersonStep::Kind::kWait
                 : kind == "close" ? PersonStep::Kind::kClose
                                   : PersonStep::Kind::kOpen;
     seconds();
   } else {
     fail(field + ".do", "unknown step '" + kind +
-                            "' (known: reach, reach_random, gesture, wait, close, open, withdraw, leave, enter)");
+                            "' (known: reach, reach_random, gesture, take, wait, close, open, withdraw, leave, enter)");
   }
   return step;
 }
@@ -122,6 +123,8 @@ const char* stepName(PersonStep::Kind kind) {
       return "reach_random";
     case PersonStep::Kind::kGesture:
       return "gesture";
+    case PersonStep::Kind::kTake:
+      return "take";
     case PersonStep::Kind::kWait:
       return "wait";
     case PersonStep::Kind::kClose:
@@ -155,6 +158,34 @@ Eigen::Quaterniond handFrame(const Eigen::Vector3d& shoulder, const Eigen::Vecto
   return Eigen::Quaterniond(r);
 }
 
+/// One script's steps, checked against where the person is (away or at the table).
+std::vector<PersonStep> parseScript(const json& script, const std::string& field, const PersonSpec& spec) {
+  if (!script.is_array() || script.empty() || script.size() > 1000) {
+    fail(field, "must be a list of 1 to 1000 steps, not " + shown(script));
+  }
+  std::vector<PersonStep> steps;
+  bool away = spec.starts_away;
+  for (std::size_t i = 0; i < script.size(); ++i) {
+    const std::string item = field + "[" + std::to_string(i) + "]";
+    steps.push_back(parseStep(script[i], item, spec.shoulder));
+    const PersonStep::Kind kind = steps.back().kind;
+    if (away && kind != PersonStep::Kind::kEnter && kind != PersonStep::Kind::kWait &&
+        kind != PersonStep::Kind::kOpen && kind != PersonStep::Kind::kClose) {
+      fail(item + ".do", std::string("the person is away: only \"enter\", \"wait\", \"open\" or \"close\", not \"") +
+                             stepName(kind) + "\"");
+    }
+    if (!away && kind == PersonStep::Kind::kEnter) {
+      fail(item + ".do", "the person is already at the table");
+    }
+    away = kind == PersonStep::Kind::kLeave || (away && kind != PersonStep::Kind::kEnter);
+  }
+  if (spec.repeat && away != spec.starts_away) {
+    fail(field, std::string("a repeating script must end ") + (spec.starts_away ? "away" : "at the table") +
+                    ", where it starts");
+  }
+  return steps;
+}
+
 }  // namespace
 
 Eigen::Vector3d PersonSpec::awayOffset() const {
@@ -173,7 +204,7 @@ Eigen::Vector3d PersonSpec::restPosition() const {
 PersonSpec parsePerson(const std::string& json_text, const std::string& field) {
   const json value = core::parseJson(json_text);
   object(value, field);
-  onlyKnownFields(value, field, {"shoulder", "rest", "seed", "repeat", "start", "script"});
+  onlyKnownFields(value, field, {"shoulder", "rest", "seed", "repeat", "start", "script", "scripts"});
   PersonSpec spec;
   spec.source = json_text;
   if (value.contains("shoulder")) {
@@ -195,10 +226,6 @@ PersonSpec parsePerson(const std::string& json_text, const std::string& field) {
     }
     spec.repeat = value.at("repeat").get<bool>();
   }
-  const json& script = required(value, "script", field, "a list of steps: [{\"do\": \"reach\", ...}, ...]");
-  if (!script.is_array() || script.empty() || script.size() > 1000) {
-    fail(field + ".script", "must be a list of 1 to 1000 steps, not " + shown(script));
-  }
   if (value.contains("start")) {
     const std::string start = stringField(value.at("start"), field + ".start");
     if (start != "present" && start != "away") {
@@ -206,22 +233,26 @@ PersonSpec parsePerson(const std::string& json_text, const std::string& field) {
     }
     spec.starts_away = start == "away";
   }
-  bool away = spec.starts_away;
-  for (std::size_t i = 0; i < script.size(); ++i) {
-    const std::string item = field + ".script[" + std::to_string(i) + "]";
-    spec.script.push_back(parseStep(script[i], item, spec.shoulder));
-    const PersonStep::Kind kind = spec.script.back().kind;
-    if (away && kind != PersonStep::Kind::kEnter && kind != PersonStep::Kind::kWait) {
-      fail(item + ".do", std::string("the person is away: only \"enter\" or \"wait\", not \"") + stepName(kind) + "\"");
-    }
-    if (!away && kind == PersonStep::Kind::kEnter) {
-      fail(item + ".do", "the person is already at the table");
-    }
-    away = kind == PersonStep::Kind::kLeave || (away && kind != PersonStep::Kind::kEnter);
+  if (value.contains("script") == value.contains("scripts")) {
+    fail(field + ".script",
+         value.contains("script")
+             ? "give \"script\" or \"scripts\", not both"
+             : "missing: a list of steps: [{\"do\": \"reach\", ...}, ...] (or \"scripts\": a list of them)");
   }
-  if (spec.repeat && away != spec.starts_away) {
-    fail(field + ".script", std::string("a repeating script must end ") + (spec.starts_away ? "away" : "at the table") +
-                                ", where it starts");
+  std::vector<std::pair<const json*, std::string>> scripts;
+  if (value.contains("script")) {
+    scripts.emplace_back(&value.at("script"), field + ".script");
+  } else {
+    const json& list = value.at("scripts");
+    if (!list.is_array() || list.empty() || list.size() > 100) {
+      fail(field + ".scripts", "must be a list of 1 to 100 scripts (each a list of steps), not " + shown(list));
+    }
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      scripts.emplace_back(&list[i], field + ".scripts[" + std::to_string(i) + "]");
+    }
+  }
+  for (const auto& [script, name] : scripts) {
+    spec.scripts.push_back(parseScript(*script, name, spec));
   }
   return spec;
 }
@@ -252,8 +283,14 @@ PersonMotion::PersonMotion(const PersonSpec& spec, std::uint64_t seed, double ho
   double closure = 0.0;
   double t = 0.0;
   bool first_pass = true;
+  // One of several scripts drawn first (a single script draws nothing: its random reaches are
+  // what they were before scripts could be mixed).
+  if (spec.scripts.size() > 1) {
+    script_index_ = std::uniform_int_distribution<std::size_t>(0, spec.scripts.size() - 1)(random);
+  }
+  const std::vector<PersonStep>& script = spec.scripts.at(script_index_);
   while (true) {
-    for (const PersonStep& step : spec.script) {
+    for (const PersonStep& step : script) {
       Segment segment;
       segment.start = t;
       segment.from = at;
@@ -303,14 +340,19 @@ PersonMotion::PersonMotion(const PersonSpec& spec, std::uint64_t seed, double ho
           offset = step.kind == PersonStep::Kind::kLeave ? away : Eigen::Vector3d::Zero();
           segment.offset_to = offset;
           segment.to = rest + offset;
-          segment.palm_up_to = false;
-          palm_up = false;
+          // As on a reach: an open hand turns palm down as it goes, a closed one keeps what it
+          // holds upright (it turned over at once, flinging the part it carried).
+          const bool turn = palm_up && closure < 0.5;
+          segment.palm_up_to = palm_up && !turn;
+          segment.turn_seconds = turn ? kTurnSeconds : 0.0;
+          palm_up = segment.palm_up_to;
           const double distance = std::max((segment.to - segment.from).norm(), away.norm());
           seconds = 1.875 * distance / step.speed;
           at = segment.to;
           break;
         }
         case PersonStep::Kind::kGesture:
+        case PersonStep::Kind::kTake:
           segment.palm_up_to = true;
           segment.turn_seconds = palm_up ? 0.0 : kTurnSeconds;
           seconds += segment.turn_seconds;
@@ -368,9 +410,18 @@ PersonPose PersonMotion::at(double t) const {
   pose.shoulder = shoulder_ + pose.offset;
   pose.elbow = elbowPosition(pose.shoulder, pose.wrist);
   pose.step = found == segments_.end() ? "done" : stepName(segment.kind);
-  pose.offering =
-      found != segments_.end() && segment.kind == PersonStep::Kind::kGesture && turned >= 1.0 && pose.closure < 0.2;
+  pose.offering = found != segments_.end() &&
+                  (segment.kind == PersonStep::Kind::kGesture || segment.kind == PersonStep::Kind::kTake) &&
+                  turned >= 1.0 && pose.closure < 0.2;
   return pose;
+}
+
+PersonMotion::StepAt PersonMotion::stepAt(double t) const {
+  const auto found = std::upper_bound(segments_.begin(), segments_.end(), t,
+                                      [](double time, const Segment& segment) { return time < segment.end; });
+  const Segment& segment = found == segments_.end() ? segments_.back() : *found;
+  return {found == segments_.end() ? PersonStep::Kind::kWait : segment.kind, segment.end,
+          t >= segment.start + segment.turn_seconds};
 }
 
 }  // namespace costar::sim

@@ -19,6 +19,10 @@
 //   reach. A point beyond the arm's reach is pulled toward the shoulder until it is within it.
 // - "gesture": the offer gesture: the hand turns palm up in 0.4 s and holds still, open, for
 //   "seconds".
+// - "take": the hand offers (as "gesture") and waits, open and palm up, for a part to be put on
+//   it, at most "seconds": once a part lies on the palm (released onto it) the step ends and the
+//   script goes on (a "close" next holds it). The only step that reacts to the cell: a person
+//   taking a part closes the hand when it is in it, whenever the robot brings it.
 // - "wait": the hand holds still for "seconds".
 // - "close" / "open": the fingers close (or open) over "seconds"; closing around a part holds it
 //   (force-limited finger joints, contact and friction only: whoever else holds it must let go).
@@ -27,7 +31,10 @@
 //   top's height).
 // - "leave" / "enter": the whole person walks 1.5 m straight away from the table (along y, on
 //   the shoulder's side) or back, the hand at rest, at "speed" (m/s, default 1, at most 1.6);
-//   "start": "away" has the person away at first. Away, only "enter" and "wait" may follow.
+//   "start": "away" has the person away at first. Away, only "enter", "wait", "open" and
+//   "close" may follow (away, an "open" puts down what the hand carried off).
+// "scripts": [[steps], [steps], ...] in place of "script": one of them, drawn from the seed (a
+// mix of behaviours for trials: with a gesture, without one, reaching at random).
 // "repeat": true starts the script again when it ends (drawing new random reaches), for long
 // randomized runs. Every target must lie within the arm's reach (0.56 m from the shoulder) and at
 // least 3 cm above the table top's height (also beside the table: the simulator's table top is an
@@ -50,13 +57,13 @@
 namespace costar::sim {
 
 struct PersonStep {
-  enum class Kind { kReach, kReachRandom, kGesture, kWait, kClose, kOpen, kWithdraw, kLeave, kEnter };
+  enum class Kind { kReach, kReachRandom, kGesture, kTake, kWait, kClose, kOpen, kWithdraw, kLeave, kEnter };
   Kind kind = Kind::kWait;
   Eigen::Vector3d to = Eigen::Vector3d::Zero();       // kReach
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero();  // kReachRandom
   Eigen::Vector3d box_max = Eigen::Vector3d::Zero();
   double speed = 0.8;    // m/s: reaches' peak speed
-  double seconds = 1.0;  // gesture, wait, close, open
+  double seconds = 1.0;  // gesture, take (at most), wait, close, open
 };
 
 struct PersonSpec {
@@ -68,7 +75,8 @@ struct PersonSpec {
   bool repeat = false;
   /// The person starts away from the table ("start": "away"; an "enter" brings them).
   bool starts_away = false;
-  std::vector<PersonStep> script;
+  /// The script, or the scripts one of which is drawn from the seed ("scripts").
+  std::vector<std::vector<PersonStep>> scripts;
   /// The entry as the file wrote it (sceneFileText writes it back).
   std::string source;
 
@@ -122,6 +130,16 @@ class PersonMotion {
   PersonPose at(double t) const;
   /// When the (first pass of the) script ends.
   double duration() const { return duration_; }
+  /// Which of the spec's scripts was drawn.
+  std::size_t scriptIndex() const { return script_index_; }
+  /// The step being done at `t` and when it ends (the last step's end after the script).
+  struct StepAt {
+    PersonStep::Kind kind = PersonStep::Kind::kWait;
+    double end = 0.0;
+    /// The palm has finished turning: a take's hand is ready for the part.
+    bool settled = false;
+  };
+  StepAt stepAt(double t) const;
 
  private:
   struct Segment {
@@ -141,6 +159,7 @@ class PersonMotion {
   Eigen::Vector3d shoulder_;
   std::vector<Segment> segments_;
   double duration_ = 0.0;
+  std::size_t script_index_ = 0;
 };
 
 }  // namespace costar::sim

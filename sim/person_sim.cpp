@@ -11,8 +11,9 @@ namespace costar::sim {
 
 namespace {
 
-constexpr double kFingersClosed = 2.2;  // rad: the fingers curl back over the palm
-constexpr double kThumbClosed = 0.9;    // rad
+constexpr double kFingersClosed = 2.2;        // rad: the fingers curl back over the palm
+constexpr double kThumbClosed = 0.9;          // rad
+constexpr double kPalmHalfThickness = 0.012;  // m
 
 std::string format(double value) {
   std::ostringstream out;
@@ -67,7 +68,8 @@ std::string personBodiesMjcf(const PersonSpec& spec) {
   xml += "<body name=\"person_hand_target\" mocap=\"true\" pos=\"" + vec(rest.wrist) + "\" quat=\"" + quat(rest.hand) +
          "\"/>\n";
   xml += "<body name=\"person_hand\" pos=\"" + vec(rest.wrist) + "\" quat=\"" + quat(rest.hand) + "\"><freejoint/>";
-  xml += "<geom name=\"person_palm\" type=\"box\" pos=\"0.05 0 0\" size=\"0.05 0.042 0.012\" " + hand + "/>";
+  xml += "<geom name=\"person_palm\" type=\"box\" pos=\"0.05 0 0\" size=\"0.05 0.042 " + format(kPalmHalfThickness) +
+         "\" " + hand + "/>";
   // The palm's pinker skin on its palm side (-z), seen only: the camera tells a palm turned up by it.
   xml +=
       "<geom name=\"person_palm_skin\" type=\"box\" pos=\"0.05 0 -0.0122\" size=\"0.048 0.04 0.0004\" " + palm + "/>";
@@ -151,9 +153,10 @@ Capsule geomCapsule(const mjModel* model, const mjData* data, int geom) {
   return capsule;
 }
 
-SimPerson::SimPerson(mjModel* model, mjData* data, const PersonSpec& spec, std::uint64_t seed)
-    : model_(model), data_(data), motion_(spec, seed) {
+SimPerson::SimPerson(mjModel* model, mjData* data, const PersonSpec& spec, std::uint64_t seed, std::vector<int> parts)
+    : model_(model), data_(data), motion_(spec, seed), parts_(std::move(parts)) {
   hand_mocap_ = model->body_mocapid[requireId(model, mjOBJ_BODY, "person_hand_target")];
+  hand_body_ = requireId(model, mjOBJ_BODY, "person_hand");
   forearm_mocap_ = model->body_mocapid[requireId(model, mjOBJ_BODY, "person_forearm")];
   upper_arm_mocap_ = model->body_mocapid[requireId(model, mjOBJ_BODY, "person_upper_arm")];
   torso_mocap_ = model->body_mocapid[requireId(model, mjOBJ_BODY, "person_torso")];
@@ -184,8 +187,37 @@ std::string SimPerson::geomLabel(int geom) const {
   return name != nullptr ? name : "person";
 }
 
-void SimPerson::drive(double seconds) {
-  pose_ = motion_.at(seconds);
+int SimPerson::partOnPalm() const {
+  // The palm's side of the palm, as placed now (the hand's body, not its target: what the
+  // palm carries is where the palm is).
+  const int hand = hand_body_;
+  const Eigen::Vector3d wrist = Eigen::Map<const Eigen::Vector3d>(data_->xpos + 3 * hand);
+  Eigen::Matrix3d r;
+  const mjtNum* m = data_->xmat + 9 * hand;
+  r << m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8];
+  if (r.col(2).z() > -0.8) {
+    return -1;  // not turned up
+  }
+  for (const int body : parts_) {
+    // In the hand's frame: over the palm (x 0-11 cm from the wrist, within 5 cm of its
+    // middle), its centre less than 4 cm out of the palm's surface (a 5 cm node lying on it: 2.5 cm).
+    const Eigen::Vector3d local = r.transpose() * (Eigen::Map<const Eigen::Vector3d>(data_->xpos + 3 * body) - wrist);
+    const double out = -local.z() - kPalmHalfThickness;
+    if (local.x() > 0.0 && local.x() < 0.11 && std::abs(local.y()) < 0.05 && out > 0.0 && out < 0.04) {
+      return body;
+    }
+  }
+  return -1;
+}
+
+void SimPerson::drive(double seconds, double arm_clearance) {
+  if (seconds >= 0.0) {
+    const PersonMotion::StepAt step = motion_.stepAt(seconds + ahead_);
+    if (step.kind == PersonStep::Kind::kTake && step.settled && arm_clearance > kTakeClearance && partOnPalm() >= 0) {
+      ahead_ += step.end - (seconds + ahead_);
+    }
+  }
+  pose_ = motion_.at(seconds + ahead_);
   const auto place = [this](int mocap, const Eigen::Vector3d& position, const Eigen::Quaterniond& rotation) {
     Eigen::Map<Eigen::Vector3d>(data_->mocap_pos + 3 * mocap) = position;
     mjtNum* q = data_->mocap_quat + 4 * mocap;

@@ -16,6 +16,7 @@
 // No MuJoCo type appears here: the model and data are passed as MuJoCo's opaque structs.
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -39,14 +40,23 @@ std::string personActuatorsMjcf();
 /// bounding sphere.
 Capsule geomCapsule(const mjModel_* model, const mjData_* data, int geom);
 
+/// How far the robot must be from the person before a "take" closes the hand on the part (m).
+inline constexpr double kTakeClearance = 0.05;
+
 class SimPerson {
  public:
+  /// `parts`: the bodies of the parts a "take" waits for.
   /// @throws std::runtime_error when the model lacks the person's bodies.
-  SimPerson(mjModel_* model, mjData_* data, const PersonSpec& spec, std::uint64_t seed);
+  SimPerson(mjModel_* model, mjData_* data, const PersonSpec& spec, std::uint64_t seed, std::vector<int> parts = {});
 
   /// Places the person as the script has it at `seconds` and sets the fingers' servos; call
-  /// before every physics step.
-  void drive(double seconds);
+  /// before every physics step, with `seconds` never decreasing. A "take" step ends early once
+  /// a part lies on the palm and the robot is `kTakeClearance` clear of the person
+  /// (`arm_clearance`, m: the gripper has let go and withdrawn, so the closing fingers do not
+  /// catch it): the rest of the script runs that much sooner.
+  void drive(double seconds, double arm_clearance = std::numeric_limits<double>::infinity());
+  /// The body of the part lying on the open palm now, or -1.
+  int partOnPalm() const;
   const PersonPose& pose() const { return pose_; }
   /// The person's geoms, and whether a geom is one.
   const std::vector<int>& geoms() const { return geoms_; }
@@ -61,8 +71,12 @@ class SimPerson {
   mjData_* data_;
   PersonMotion motion_;
   PersonPose pose_;
+  std::vector<int> parts_;
+  /// How far the script is ahead of the clock: the time takes ended early saved.
+  double ahead_ = 0.0;
   std::vector<int> geoms_;
   int hand_mocap_ = 0;
+  int hand_body_ = 0;
   int forearm_mocap_ = 0;
   int upper_arm_mocap_ = 0;
   int torso_mocap_ = 0;

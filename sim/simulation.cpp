@@ -343,7 +343,8 @@ struct Simulation::Impl {
   /// updates the speed override and the record.
   void watchPerson() {
     const double dt = model->opt.timestep;
-    person->drive(settled ? toSeconds(now()) : -1.0);
+    // The separation of the step before: a take closes the hand once the robot has withdrawn.
+    person->drive(settled ? toSeconds(now()) : -1.0, status.separation);
     mj_kinematics(model, data);
     int arm_geom = -1;
     int person_geom = -1;
@@ -789,8 +790,8 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
     impl->part_bodies.push_back(impl->id(mjOBJ_BODY, part.name.c_str()));
   }
   if (scene.person) {
-    impl->person =
-        std::make_unique<SimPerson>(m, impl->data, *scene.person, options.placement_seed.value_or(scene.seed));
+    impl->person = std::make_unique<SimPerson>(m, impl->data, *scene.person,
+                                               options.placement_seed.value_or(scene.seed), impl->part_bodies);
     for (int geom = 0; geom < m->ngeom; ++geom) {
       if (impl->isArmBody(m->geom_bodyid[geom]) && (m->geom_contype[geom] != 0 || m->geom_conaffinity[geom] != 0)) {
         impl->arm_geoms.push_back(geom);

@@ -39,6 +39,7 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginRelease(const compone
     return failed(*problem);
   }
   const double speed = params.at("speed").asDouble();
+  const double drop = params.at("drop").asDouble();
   if (!held_) {
     return failed("nothing to release: no part was grasped with SmartGrasp");
   }
@@ -59,7 +60,7 @@ std::unique_ptr<RunningOperation> SmartMoveComponent::beginRelease(const compone
       Candidate candidate;
       candidate.object = name;
       candidate.symmetry = static_cast<int>(h);
-      candidate.goal = support * up(lift) * held_symmetry * held_grasp_;
+      candidate.goal = support * up(lift + drop) * held_symmetry * held_grasp_;
       candidates.push_back(std::move(candidate));
     }
   };

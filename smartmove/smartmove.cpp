@@ -64,6 +64,12 @@ SmartMoveComponent::SmartMoveComponent(const arm::MotionService& motion, compone
                      config_.approach};
   approach.min = 0.02;
   approach.max = 0.3;
+  ParamSpec drop{"drop", ValueType::kDouble,
+                 "let the part go this far above where it would rest (m): 0 sets it down; a little above 0 drops it "
+                 "onto a hand held open under it (target hand_1)",
+                 0.0};
+  drop.min = 0.0;
+  drop.max = 0.05;
   ParamSpec speed{"speed", ValueType::kDouble, "fraction of the arm's top speed", config_.default_speed};
   speed.min = 0.01;
   speed.max = 1.0;
@@ -132,7 +138,7 @@ SmartMoveComponent::SmartMoveComponent(const arm::MotionService& motion, compone
                  [this](const Params& params) { return beginMoveOrGrasp(true, params); });
   operations.add({"SmartRelease",
                   "Puts the part held on a part that satisfies the conditions, or at a frame.",
-                  {target_class, predicates, target, approach, speed},
+                  {target_class, predicates, target, approach, speed, drop},
                   component::OperationKind::kRobotAction,
                   check_release},
                  [this](const Params& params) { return beginRelease(params); });
@@ -223,6 +229,19 @@ void SmartMoveComponent::syncObstacles() {
     const Eigen::AlignedBox3d bounds = object->bounds();
     collisions_.setBox(partObstacle(is_a->args[0]), *pose * Eigen::Translation3d(bounds.center()), bounds.sizes());
     present.push_back(partObstacle(is_a->args[0]));
+  }
+  // The person's hand and forearm where the camera sees the hand: never planned through.
+  for (const std::string& frame : config_.person_frames) {
+    const auto pose = world_.worldPose(frame);
+    if (!pose) {
+      continue;
+    }
+    const double wrist = -config_.hand_size.x() / 2;
+    collisions_.setBox(partObstacle(frame), *pose, config_.hand_size);
+    collisions_.setBox(partObstacle(frame) + ":forearm",
+                       *pose * Eigen::Translation3d(wrist - config_.forearm_size.x() / 2, 0, 0), config_.forearm_size);
+    present.push_back(partObstacle(frame));
+    present.push_back(partObstacle(frame) + ":forearm");
   }
   for (const auto& name : obstacles_) {
     if (std::find(present.begin(), present.end(), name) == present.end()) {

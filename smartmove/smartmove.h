@@ -85,6 +85,13 @@ struct SmartMoveConfig {
   /// fingers closed) lands 1-3 cm off, one that slipped out farther.
   double misplaced_distance = 0.012;
   double misplaced_search = 0.15;
+  /// A person's hands as perception reports them (frames at the hand's centre, x toward the
+  /// fingertips, z up: perception/hand_component.h): obstacles no motion is planned through, the
+  /// hand a box of `hand_size` centred on the frame, the forearm one of `forearm_size` behind it
+  /// (along -x, from the wrist). SmartRelease target=HAND may touch the hand, not the forearm.
+  std::vector<std::string> person_frames = {"hand_1"};
+  Eigen::Vector3d hand_size{0.26, 0.12, 0.08};
+  Eigen::Vector3d forearm_size{0.30, 0.10, 0.10};
   /// Robot links that may touch the part being grasped (the gripper): the robot
   /// description's links.gripper (arm/robot_description.h).
   std::vector<std::string> gripper_links;

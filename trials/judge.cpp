@@ -14,6 +14,12 @@ namespace {
 
 constexpr double kNodeHalf = 0.025;
 constexpr double kLinkHalfHeight = 0.0125;
+// The simulated cells' table (workcells/*.json "table": centre x 0.4, 1.4 by 1.2 m): the
+// simulator's table top is an endless plane, so a part resting beyond these edges fell off it.
+constexpr double kTableNear = -0.3;
+constexpr double kTableFar = 1.1;
+constexpr double kTableHalfWidth = 0.6;
+constexpr double kCarriedAway = 0.6;  // m beyond the table's edge
 
 std::string millimetres(double metres) {
   char text[32];
@@ -104,6 +110,52 @@ Verdict blindPlace(sim::Simulation& simulation, const std::vector<sim::PartState
     }
   }
   return {false, "there is no node_0"};
+}
+
+bool isHandLabel(const std::string& label) {
+  return label == "person_hand" || label == "person_fingers" || label == "person_thumb";
+}
+
+Verdict collaborativeAssembly(sim::Simulation& simulation, const std::vector<sim::PartState>& initial) {
+  const auto contacts = simulation.contacts();
+  int handed = 0;
+  int placed = 0;
+  int nodes = 0;
+  for (const auto& part : simulation.parts()) {
+    const auto start = std::find_if(initial.begin(), initial.end(), [&](const auto& p) { return p.name == part.name; });
+    if (part.object_class != "node" || start == initial.end() || start->pose.translation().y() >= 0.0) {
+      continue;
+    }
+    ++nodes;
+    const Eigen::Vector3d at = part.pose.translation();
+    const bool in_hand =
+        at.z() > kNodeHalf + 0.03 && std::any_of(contacts.begin(), contacts.end(), [&part](const auto& pair) {
+          return (pair.first == part.name && isHandLabel(pair.second)) ||
+                 (pair.second == part.name && isHandLabel(pair.first));
+        });
+    const bool in_assembly_area = at.y() > 0.02 && at.y() < kTableHalfWidth && at.x() > kTableNear &&
+                                  at.x() < kTableFar && std::abs(heightAbove(part, 0.0, kNodeHalf)) < 0.005 &&
+                                  atRest(part);
+    // Beyond the table on the person's side, where only a person walking away with it takes it
+    // (sim/person.h "leave": 1.5 m; "open" there puts it down).
+    const bool carried_away = at.y() > kTableHalfWidth + kCarriedAway;
+    if (in_hand || carried_away) {
+      ++handed;
+    } else if (in_assembly_area) {
+      ++placed;
+    } else {
+      char where[96];
+      std::snprintf(where, sizeof where, " (%.3f, %.3f, %.3f)", at.x(), at.y(), at.z());
+      const bool untouched = (at - start->pose.translation()).norm() < 0.005;
+      return {false, part.name + (untouched ? " was never moved from the input area" + std::string(where)
+                                            : " is neither in the person's hand nor resting in the assembly area: at" +
+                                                  std::string(where))};
+    }
+  }
+  if (nodes == 0) {
+    return {false, "no node started right of table_center"};
+  }
+  return {true, std::to_string(handed) + " handed over, " + std::to_string(placed) + " put in the assembly area"};
 }
 
 constexpr double kPolishForce = kPolishingForce;
@@ -234,7 +286,10 @@ std::vector<JudgeInfo> judges() {
           {"polishing",
            "the sanding/polishing task (examples/iiwa/polishing.xml): marked area worked >= 95 %, pad force 10 +/- 4 N "
            ">= 90 % of the time it touches, off and still within 1 s of losing the tool, resumed within 20 mm, the arm "
-           "never on the workpiece"}};
+           "never on the workpiece"},
+          {"collaborative_assembly",
+           "every node from the right of table_center handed to the person (held off the table in their hand) or "
+           "resting on the table left of it, none elsewhere (examples/iiwa/collaborative_assembly.xml)"}};
 }
 
 Judge judge(const std::string& name) {
@@ -255,6 +310,9 @@ Judge judge(const std::string& name) {
   }
   if (name == "polishing") {
     return polishing;
+  }
+  if (name == "collaborative_assembly") {
+    return collaborativeAssembly;
   }
   std::string known;
   for (const auto& info : judges()) {

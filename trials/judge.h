@@ -37,6 +37,12 @@ struct JudgeInfo {
 ///   the tool off and the arm still (joints < 0.02 rad/s) within 1 s, and polishing, if it was
 ///   under way, resumed within 20 mm of where it stopped (or, its pass done, on ground it had not
 ///   polished yet: the next pass's start); the arm never on the workpiece; the tool off at the end.
+/// "collaborative_assembly" (the paper's third iiwa task, examples/iiwa/collaborative_assembly.xml):
+///   every node that started right of table_center (y < 0) is either the person's (held by their
+///   hand: touching the palm, fingers or thumb, its centre 3 cm or more above its resting height;
+///   or carried off: more than 0.6 m beyond the table's edge, where only the person walking away
+///   takes it) or rests on the table left of table_center (y > 0.02, on the table); any other
+///   node fails the trial, named.
 std::vector<JudgeInfo> judges();
 
 /// What the polishing judge finds of the tool's losses in the power tool's 100 Hz log: each time

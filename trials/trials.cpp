@@ -175,6 +175,9 @@ TrialResult runOne(const TrialOptions& options, const bt::Plan& plan, const Judg
       figures.stopped_contact_steps = record->stopped_contact_steps;
       figures.stops = record->stops;
       figures.stopped_s = record->stopped_seconds;
+      figures.collaborative_s = record->collaborative_seconds;
+      figures.hand_contact_steps = record->hand_contact_steps;
+      figures.max_hand_contact_n = record->max_hand_contact_force;
       result.separation = figures;
       if ((figures.violation_steps > 0 || figures.contact_steps > 0) && !result.interrupted) {
         result.success = false;
@@ -444,7 +447,10 @@ nlohmann::json Summary::toJson() const {
                             {"max_contact_n", f.max_contact_n},
                             {"stopped_contact_steps", f.stopped_contact_steps},
                             {"stops", f.stops},
-                            {"stopped_s", f.stopped_s}};
+                            {"stopped_s", f.stopped_s},
+                            {"collaborative_s", f.collaborative_s},
+                            {"hand_contact_steps", f.hand_contact_steps},
+                            {"max_hand_contact_n", f.max_hand_contact_n}};
     }
     if (!trial.success) {
       item["failure_path"] = trial.failure_path;
@@ -559,6 +565,12 @@ Summary Summary::fromJson(const nlohmann::json& json) {
       figures.stopped_contact_steps = field<std::uint64_t>(f, "stopped_contact_steps", in);
       figures.stops = field<int>(f, "stops", in);
       figures.stopped_s = field<double>(f, "stopped_s", in);
+      // Written since the hand-over's figures were recorded; older files lack them.
+      if (f.contains("collaborative_s")) {
+        figures.collaborative_s = field<double>(f, "collaborative_s", in);
+        figures.hand_contact_steps = field<std::uint64_t>(f, "hand_contact_steps", in);
+        figures.max_hand_contact_n = field<double>(f, "max_hand_contact_n", in);
+      }
       trial.separation = figures;
     }
     if (!trial.success) {
@@ -689,9 +701,15 @@ std::string Summary::text() const {
   std::uint64_t contacts = 0;
   std::uint64_t stopped_contacts = 0;
   double margin = 1e9;
+  double collaborative_s = 0.0;
+  std::uint64_t hand_contacts = 0;
+  double hand_force = 0.0;
   for (const TrialResult& trial : trials) {
     if (trial.separation) {
       ++with_person;
+      collaborative_s += trial.separation->collaborative_s;
+      hand_contacts += trial.separation->hand_contact_steps;
+      hand_force = std::max(hand_force, trial.separation->max_hand_contact_n);
       violations += trial.separation->violation_steps;
       contacts += trial.separation->contact_steps;
       stopped_contacts += trial.separation->stopped_contact_steps;
@@ -701,10 +719,23 @@ std::string Summary::text() const {
   if (with_person > 0) {
     std::snprintf(line, sizeof line,
                   "a person in %zu trials: %llu steps within the protective distance while fast, %llu touching the "
-                  "person while moving (%llu with the arm stopped); smallest margin over it %.3f m\n",
+                  "person while moving (%llu with the arm stopped); ",
                   with_person, static_cast<unsigned long long>(violations), static_cast<unsigned long long>(contacts),
-                  static_cast<unsigned long long>(stopped_contacts), margin);
+                  static_cast<unsigned long long>(stopped_contacts));
     out += line;
+    if (margin < 1e9) {
+      std::snprintf(line, sizeof line, "smallest margin over it %.3f m\n", margin);
+      out += line;
+    } else {
+      out += "the arm never moved faster than 0.25 m/s\n";
+    }
+    if (collaborative_s > 0.0) {
+      std::snprintf(line, sizeof line,
+                    "collaborative mode %.0f s in all: %llu steps touching the person's hand while moving, at most "
+                    "%.1f N\n",
+                    collaborative_s, static_cast<unsigned long long>(hand_contacts), hand_force);
+      out += line;
+    }
   }
   if (const auto memory = residentMemory(); memory.size() > 1) {
     out += "resident memory (MB) after trials:";

@@ -65,6 +65,11 @@ struct SeparationFigures {
   std::uint64_t stopped_contact_steps = 0;  // the person running into the stopped arm
   int stops = 0;                            // protective stops
   double stopped_s = 0.0;
+  /// In collaborative mode (a hand-over): its time, and the steps touching the person's hand
+  /// while the arm moved in it with the largest force (contact outside the hand: contact_steps).
+  double collaborative_s = 0.0;
+  std::uint64_t hand_contact_steps = 0;
+  double max_hand_contact_n = 0.0;
 };
 
 struct TrialResult {

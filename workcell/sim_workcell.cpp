@@ -70,8 +70,8 @@ class FixedFrames final : public component::TableComponent {
 /// separation its sensor last read, the protective distance at the arm's speed, the speed
 /// override, and whether it is slowing or holding the arm for the person; and its collaborative
 /// mode for a hand-over (Collaborate on=true: power and force limiting, the arm at most 0.2 m/s
-/// at any separation, stopped by contact outside the hand or a hand force above 140 N). In cells
-/// whose scene has a person.
+/// at any separation, stopped by contact outside the hand or a hand force above 140 N). In every
+/// simulated cell: without a person in the scene it reports nothing and Collaborate fails, naming why.
 class SeparationMonitor final : public component::TableComponent {
  public:
   explicit SeparationMonitor(sim::Simulation& simulation) : simulation_(simulation) {
@@ -93,6 +93,11 @@ class SeparationMonitor final : public component::TableComponent {
                     {{"on", component::ValueType::kBool, "collaborative mode on or off", true}},
                     component::OperationKind::kRobotAction},
                    [this](const component::ParamMap& params) {
+                     if (!simulation_.separation()) {
+                       return std::make_unique<component::FinishedOperation>(component::OperationResult::failure(
+                           "no person in this cell's scene: collaborative mode is the speed and separation "
+                           "monitor's, which watches a person (a scene with a \"person\", docs/PERSON.md)"));
+                     }
                      simulation_.setCollaborative(params.at("on").asBool());
                      return std::make_unique<component::FinishedOperation>(component::OperationResult::success());
                    });
@@ -320,9 +325,9 @@ class SimWorkcell final : public Workcell {
     add(calibration_);
     add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
         {"table_center", tableCenter()}, {"robot_base", cell_.robot_base}}));
-    if (simulation_->separation()) {
-      add(std::make_shared<SeparationMonitor>(*simulation_));
-    }
+    // In every simulated cell, so that a plan for a person beside the arm validates in any: its
+    // readings and Collaborate need a person in the scene.
+    add(std::make_shared<SeparationMonitor>(*simulation_));
     // The power tool on its driver (the simulator's); its shape is an object class SmartGrasp
     // picks it up by. The stand and the workpiece are obstacles the planner knows.
     std::vector<world::ObjectClass> classes = simulation_->objectClasses();
@@ -361,13 +366,13 @@ class SimWorkcell final : public Workcell {
       perception_config.camera_pose = [calibration = calibration_.get()] { return calibration->cameraPose(); };
       add(std::make_shared<perception::PerceptionComponent>(camera, clock(), threadPipeline(perception_config),
                                                             perception_config));
-      if (scene_.person) {
-        // The person's hand as the camera sees it (hand_1, gesture(hand_1, offer), in_zone).
-        perception::HandComponentConfig hand_config;
-        hand_config.detector.table_center = tableCenter();
-        hand_config.camera_pose = perception_config.camera_pose;
-        add(std::make_shared<perception::HandComponent>(camera, clock(), hand_config));
-      }
+      // The person's hand as the camera sees it (hand_1, gesture(hand_1, offer), in_zone); in a
+      // scene without a person it takes no frames (nothing there is skin-coloured) and reports no hand.
+      perception::HandComponentConfig hand_config;
+      hand_config.detector.table_center = tableCenter();
+      hand_config.camera_pose = perception_config.camera_pose;
+      hand_config.watch = scene_.person.has_value();
+      add(std::make_shared<perception::HandComponent>(camera, clock(), hand_config));
     }
     smartmove::SmartMoveConfig smartmove_config;
     smartmove_config.gripper_links = gripperLinks(robot_description_, gripper_model_);

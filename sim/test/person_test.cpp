@@ -36,13 +36,13 @@ TEST(PersonScript, ReadsEveryStepAndWritesTheEntryBack) {
       {"do": "open", "seconds": 0.4}]}})",
                                  "test");
   ASSERT_TRUE(scene.person);
-  EXPECT_EQ(scene.person->script.size(), 7u);
-  EXPECT_EQ(scene.person->script[1].kind, PersonStep::Kind::kGesture);
+  EXPECT_EQ(scene.person->scripts.at(0).size(), 7u);
+  EXPECT_EQ(scene.person->scripts.at(0)[1].kind, PersonStep::Kind::kGesture);
   EXPECT_EQ(scene.person->seed, 3u);
   const Scene again = parseScene(sceneFileText(scene), "again");
   ASSERT_TRUE(again.person);
-  EXPECT_EQ(again.person->script.size(), 7u);
-  EXPECT_EQ(again.person->script[5].box_max, Eigen::Vector3d(0.7, 0.4, 0.3));
+  EXPECT_EQ(again.person->scripts.at(0).size(), 7u);
+  EXPECT_EQ(again.person->scripts.at(0)[5].box_max, Eigen::Vector3d(0.7, 0.4, 0.3));
 }
 
 TEST(PersonScript, RefusesWhatItDoesNotKnowNamingTheField) {
@@ -84,6 +84,53 @@ TEST(PersonScript, TheSceneFilesWithAPersonLoad) {
     EXPECT_TRUE(scene.person->repeat) << name;
     EXPECT_GT(PersonMotion(*scene.person, 1).duration(), 1.0) << name;
   }
+}
+
+TEST(PersonScript, OneOfSeveralScriptsIsDrawnFromTheSeedAndEachIsChecked) {
+  const PersonSpec spec = personOf(R"({"scripts": [[{"do": "wait", "seconds": 1}],
+      [{"do": "reach", "to": [0.45, 0.35, 0.12]}, {"do": "take", "seconds": 5}],
+      [{"do": "leave"}, {"do": "open", "seconds": 0.5}, {"do": "wait", "seconds": 2}]]})");
+  ASSERT_EQ(spec.scripts.size(), 3u);
+  std::vector<int> drawn(3, 0);
+  for (std::uint64_t seed = 1; seed <= 60; ++seed) {
+    const PersonMotion motion(spec, seed);
+    EXPECT_EQ(PersonMotion(spec, seed).scriptIndex(), motion.scriptIndex());  // the seed decides
+    ++drawn.at(motion.scriptIndex());
+  }
+  for (const int count : drawn) {
+    EXPECT_GE(count, 10);  // each about a third of the time
+  }
+  // The scene file's mix loads, and each of its scripts is drawn.
+  const Scene scene = loadScene(dataRoot() / "sim/scenes/collaborative_assembly.json");
+  ASSERT_TRUE(scene.person);
+  EXPECT_EQ(scene.person->scripts.size(), 5u);
+  EXPECT_NE(errorOf(R"({"script": [{"do": "wait", "seconds": 1}], "scripts": [[{"do": "wait", "seconds": 1}]]})")
+                .find("person.script: give \"script\" or \"scripts\", not both"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"scripts": [[{"do": "wait", "seconds": 1}], [{"do": "take"}]]})")
+                .find("person.scripts[1][0].seconds: missing"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"scripts": []})").find("person.scripts: must be a list of 1 to 100 scripts"),
+            std::string::npos);
+  // Away, the hand may put down what it carried off, but not reach.
+  EXPECT_NE(errorOf(R"({"script": [{"do": "leave"}, {"do": "reach", "to": [0.45, 0.35, 0.12]}]})")
+                .find("person.script[1].do: the person is away: only \"enter\", \"wait\", \"open\" or \"close\""),
+            std::string::npos);
+}
+
+TEST(PersonMotion, ATakeOffersTheOpenPalmForItsTimeAtMost) {
+  const PersonSpec spec = personOf(R"({"script": [{"do": "reach", "to": [0.45, 0.35, 0.12]},
+      {"do": "take", "seconds": 3}, {"do": "close", "seconds": 0.5}]})");
+  const PersonMotion motion(spec, 1);
+  double offered = 0.0;
+  for (double t = 0.0; t < motion.duration(); t += 0.01) {
+    const PersonPose pose = motion.at(t);
+    offered += pose.offering ? 0.01 : 0.0;
+    if (pose.step == "take") {
+      EXPECT_EQ(motion.stepAt(t).kind, PersonStep::Kind::kTake);
+    }
+  }
+  EXPECT_NEAR(offered, 3.0, 0.03);  // the palm turned up (0.4 s), then offered for the take's time
 }
 
 TEST(PersonMotion, ReachesItsTargetsNoFasterThanAskedAndOffersAfterTheGesture) {
@@ -283,6 +330,46 @@ TEST(SimPerson, TheHandHoldsAPartByClosingAroundIt) {
                     ((a == "node_0" && b.rfind("person_", 0) == 0) || (b == "node_0" && a.rfind("person_", 0) == 0));
   }
   EXPECT_TRUE(fingers_touch);
+}
+
+TEST(SimPerson, ATakeEndsOnceAPartLiesOnThePalmAndTheHandClosesOnIt) {
+  // The hand offers for up to 30 s; a part dropped onto the palm 2 cm from above ends the take at
+  // once: the hand closes on it and withdraws with it. Without the part it would still offer.
+  const std::string text = R"({"parts": [{"class": "node", "color": "red", "at": [0.3, -0.3, 0]}],
+      "person": {"shoulder": [0.55, 0.8, 0.4], "script": [
+      {"do": "reach", "to": [0.5, 0.35, 0.2], "speed": 0.6}, {"do": "take", "seconds": 30},
+      {"do": "close", "seconds": 0.6}, {"do": "withdraw", "speed": 0.4}, {"do": "wait", "seconds": 60}]}})";
+  const Scene scene = parseScene(text, "test");
+  const auto sim = Simulation::create(scene);
+  const PersonMotion motion(*scene.person, scene.seed);
+  double t = 0.0;
+  while (!motion.at(t).offering) {
+    t += 0.01;
+  }
+  sim->stepTo(TimePoint(fromSeconds(t + 1.0)));
+  const PersonPose pose = *sim->person();
+  ASSERT_EQ(pose.step, "take");
+  const Eigen::Vector3d palm_centre = pose.wrist + pose.hand * Eigen::Vector3d(0.055, 0, -0.012);
+  world::Pose on = world::Pose::Identity();
+  on.linear() = Eigen::AngleAxisd(std::atan2(pose.hand.toRotationMatrix()(1, 0), pose.hand.toRotationMatrix()(0, 0)),
+                                  Eigen::Vector3d::UnitZ())
+                    .toRotationMatrix();
+  on.translation() = palm_centre + Eigen::Vector3d(0, 0, 0.025 + 0.02);
+  sim->movePart("node_0", on);
+  sim->stepTo(TimePoint(fromSeconds(t + 3.0)));
+  EXPECT_NE(sim->person()->step, "take");  // 28 s early
+  sim->stepTo(TimePoint(fromSeconds(t + 8.0)));
+  const PersonPose end = *sim->person();
+  EXPECT_EQ(end.step, "wait");
+  EXPECT_GT((end.wrist - pose.wrist).norm(), 0.15);  // withdrawn ...
+  const Eigen::Vector3d part = sim->parts()[0].pose.translation();
+  EXPECT_LT((part - (end.wrist + end.hand * Eigen::Vector3d(0.055, 0, 0))).norm(), 0.06);  // ... holding the part
+  EXPECT_GT(part.z(), 0.025 + 0.03);  // off the table (a node resting on it: 0.025)
+  // The same script with nothing put on the palm: still offering at that time.
+  const auto empty = Simulation::create(parseScene(text, "test"));
+  empty->stepTo(TimePoint(fromSeconds(t + 8.0)));
+  EXPECT_EQ(empty->person()->step, "take");
+  EXPECT_TRUE(empty->person()->offering);
 }
 
 TEST(SimPerson, TheRgbdCameraSeesTheHandOverTheTableAndNothingWhenThePersonHasLeft) {

@@ -14,6 +14,7 @@
 #include "bt/plan.h"
 #include "core/files.h"
 #include "core/paths.h"
+#include "sim/scene.h"
 #include "trials/judge.h"
 #include "trials/tool_plot.h"
 
@@ -443,6 +444,40 @@ TEST(Trials, APersonInTheSceneIsRecordedAndTheArmWaitsForThemSafely) {
   EXPECT_DOUBLE_EQ(again.trials[0].separation->min_margin_fast_m, trial.separation->min_margin_fast_m);
   // Without a person there is no record.
   EXPECT_FALSE(runTrials(blind(1, "blind_place")).trials[0].separation);
+}
+
+// The collaborative assembly's judge on the simulator's truth: each node from the input area
+// must end the person's (here: carried off beyond the table's edge) or in the assembly area.
+TEST(CollaborativeAssemblyJudge, EveryNodeMustBeThePersonsOrInTheAssemblyArea) {
+  sim::SimulationOptions options;
+  options.settle_seconds = 0.3;
+  const auto simulation =
+      sim::Simulation::create(sim::parseScene(R"({"parts": [{"class": "node", "color": "red", "at": [0.5, -0.2, 0]},
+                                   {"class": "node", "color": "blue", "at": [0.4, -0.3, 0]}]})",
+                                              "test"),
+                              options);
+  const std::vector<sim::PartState> initial = simulation->parts();
+  const Judge collaborative = judge("collaborative_assembly");
+  const auto put = [&](const std::string& part, const Eigen::Vector3d& at) {
+    world::Pose pose = world::Pose::Identity();
+    pose.translation() = at;
+    simulation->movePart(part, pose);
+    simulation->stepTo(simulation->time() + std::chrono::milliseconds(500));
+  };
+  put("node_0", {0.5, 0.25, 0.025});  // the assembly area
+  Verdict verdict = collaborative(*simulation, initial);
+  EXPECT_FALSE(verdict.success);
+  EXPECT_NE(verdict.reason.find("node_1 was never moved from the input area"), std::string::npos) << verdict.reason;
+  put("node_1", {0.5, 0.9, 0.025});  // off the table's edge on the person's side, not carried off
+  verdict = collaborative(*simulation, initial);
+  EXPECT_FALSE(verdict.success);
+  EXPECT_NE(verdict.reason.find("node_1 is neither in the person's hand nor resting in the assembly area"),
+            std::string::npos)
+      << verdict.reason;
+  put("node_1", {0.55, 2.2, 0.025});  // where the person walked away with it
+  verdict = collaborative(*simulation, initial);
+  EXPECT_TRUE(verdict.success) << verdict.reason;
+  EXPECT_EQ(verdict.reason, "1 handed over, 1 put in the assembly area");
 }
 
 // Issue 27: the default scene of `costar trials` was relative to the working directory.

@@ -2,6 +2,7 @@
 // reading and the hand the camera sees in the world state, as the editor and plans see them.
 #include <gtest/gtest.h>
 
+#include "arm/motion_service.h"
 #include "core/paths.h"
 #include "sim/simulation.h"
 #include "workcell/workcell.h"
@@ -55,12 +56,20 @@ TEST(PersonSimWorkcell, TheMonitorsReadingAndCollaborativeModeAreInTheWorldState
   static_cast<SimClock&>(near->clock()).advanceBy(std::chrono::milliseconds(100));
   near->beforeTick();
   EXPECT_FALSE(holds(near->components().world(), "arm_collaborative", {}));
-  // Without a person the cell has no such component.
+  // Without a person the cell has the components, so that a plan for a person validates in it,
+  // but they report nothing, and collaborative mode is refused, saying why.
   const auto none =
       makeWorkcell({.name = "iiwa-3f-sim", .scene = dataRoot() / "sim/scenes/one_node.json", .memory_only = true});
   none->beforeTick();
   EXPECT_EQ(none->components().world().symbol("person_separation"), nullptr);
   EXPECT_EQ(none->components().world().symbol("hand_1"), nullptr);
+  ASSERT_NE(none->components().find("hand"), nullptr);
+  component::Component* no_safety = none->components().find("safety");
+  ASSERT_NE(no_safety, nullptr);
+  const component::OperationResult refused = no_safety->poll(no_safety->start("Collaborate", {{"on", true}}));
+  EXPECT_EQ(refused.state, component::OperationState::kFailure);
+  EXPECT_NE(refused.reason.find("no person in this cell's scene"), std::string::npos) << refused.reason;
+  EXPECT_NE(none->nodes().find("Collaborate"), nullptr);
 }
 
 TEST(PersonSimWorkcell, TheHandAndItsGestureAreInTheWorldStateAsTheCameraSeesThem) {
@@ -85,6 +94,25 @@ TEST(PersonSimWorkcell, TheHandAndItsGestureAreInTheWorldStateAsTheCameraSeesThe
   EXPECT_TRUE(holds(world, "hand_still", {"hand_1"}));
   EXPECT_GT(number(*cell, "hand_still_seconds"), 0.5);
   EXPECT_FALSE(holds(world, "is_a", {"hand_1", "node"}));
+  // SmartMove plans no motion through the hand or the forearm behind it: the tool pointing down
+  // 2 cm above the hand's centre, or 22 cm behind it over the forearm, collides with them; 25 cm
+  // above the hand it is free.
+  const arm::MotionService* motion = cell->motion();
+  ASSERT_NE(motion, nullptr);
+  const auto contactAt = [&](const Eigen::Vector3d& offset) -> std::string {
+    world::Pose tool = world::Pose::Identity();
+    tool.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    tool.translation() = hand->frame()->pose * offset;
+    const auto solutions = motion->solutions(tool, motion->joints());
+    if (solutions.empty()) {
+      return "unreachable";
+    }
+    const auto contact = motion->collision(solutions.front(), {});
+    return contact ? contact->other : std::string();
+  };
+  EXPECT_EQ(contactAt({0, 0, 0.02}).rfind("part:hand_1", 0), 0u) << contactAt({0, 0, 0.02});
+  EXPECT_EQ(contactAt({-0.22, 0, 0.03}).rfind("part:hand_1", 0), 0u) << contactAt({-0.22, 0, 0.03});
+  EXPECT_EQ(contactAt({0, 0, 0.25}), "");
 }
 
 }  // namespace
