@@ -114,18 +114,6 @@ struct JointLimits {
 
   /// Number of joints (the length of min_position).
   int size() const { return min_position.size(); }
-
-  /// Universal Robots UR5: every joint turns through [-2*pi, 2*pi] at up to pi rad/s (the
-  /// 180 deg/s of the data sheet). UR publishes no joint acceleration limit; 4.0 rad/s^2 on
-  /// every joint is a conservative choice (well below what the controller accepts), so that
-  /// trajectories planned with it can be followed with a payload. (The same values as
-  /// robots/ur5/ur5.json.)
-  static JointLimits ur5() {
-    constexpr double kTwoPi = 2.0 * std::numbers::pi;
-    constexpr int kUr5Joints = 6;
-    return {JointVector(kUr5Joints, -kTwoPi), JointVector(kUr5Joints, kTwoPi),
-            JointVector(kUr5Joints, std::numbers::pi), JointVector(kUr5Joints, 4.0)};
-  }
 };
 
 /// `angle` wrapped into (-pi, pi]. Finite input only (NaN stays NaN).

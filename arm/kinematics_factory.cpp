@@ -15,45 +15,26 @@ namespace costar::arm {
 
 namespace {
 
-/// The parameter `key` of the robot's solver, exactly `size` numbers.
-std::vector<double> parameter(const RobotDescription& robot, const std::string& key, std::size_t size) {
-  const auto it = robot.solver_parameters.find(key);
-  if (it == robot.solver_parameters.end()) {
-    throw std::runtime_error("kinematics." + key + ": missing (solver '" + robot.solver + "')");
+/// Solvers whose geometry comes from the joints take no parameters.
+void requireNoParameters(const RobotDescription& robot) {
+  if (!robot.solver_parameters.empty()) {
+    throw std::runtime_error("kinematics." + robot.solver_parameters.begin()->first + ": solver '" + robot.solver +
+                             "' takes no parameters (its geometry comes from the joints)");
   }
-  if (it->second.size() != size) {
-    throw std::runtime_error("kinematics." + key + ": must be " + std::to_string(size) + " numbers, not " +
-                             std::to_string(it->second.size()));
-  }
-  return it->second;
 }
 
-/// "ur": the closed form of the UR arms from their DH table (d, a, alpha).
+/// "ur": the closed form of the UR arms; their DH table read back from the joints and tool of
+/// the robot's description file, which must be written in DH form (dhParametersOf).
 std::shared_ptr<const Kinematics> makeUr(const RobotDescription& robot) {
-  for (const auto& [key, values] : robot.solver_parameters) {
-    if (key != "d" && key != "a" && key != "alpha") {
-      throw std::runtime_error("kinematics." + key + ": unknown parameter of solver 'ur' (known: a, alpha, d)");
-    }
-  }
-  DhParameters dh;
-  const auto copy = [&robot](const std::string& key, std::array<double, 6>& out) {
-    const std::vector<double> values = parameter(robot, key, out.size());
-    std::copy(values.begin(), values.end(), out.begin());
-  };
-  copy("d", dh.d);
-  copy("a", dh.a);
-  copy("alpha", dh.alpha);
-  return std::make_shared<Ur5Kinematics>(dh, robot.limits);
+  requireNoParameters(robot);
+  return std::make_shared<Ur5Kinematics>(dhParametersOf(readChainGeometry(robot.file)), robot.limits);
 }
 
 /// "srs": 7-joint S-R-S arms (the LBR iiwa); the geometry from the joints and tool of the
 /// robot's description file (format costar-robot-description/1, checked for the S-R-S form by
 /// readSrsArmDescription), the limits from the description.
 std::shared_ptr<const Kinematics> makeSrs(const RobotDescription& robot) {
-  if (!robot.solver_parameters.empty()) {
-    throw std::runtime_error("kinematics." + robot.solver_parameters.begin()->first +
-                             ": solver 'srs' takes no parameters (its geometry comes from the joints)");
-  }
+  requireNoParameters(robot);
   const SrsArmDescription arm = readSrsArmDescription(robot.file);
   return std::make_shared<SrsArmKinematics>(arm.geometry, robot.limits);
 }
@@ -62,10 +43,7 @@ std::shared_ptr<const Kinematics> makeSrs(const RobotDescription& robot) {
 /// the geometry from the joints and tool of the robot's description file (format
 /// costar-robot-description/1), the limits from the description.
 std::shared_ptr<const Kinematics> makeChain(const RobotDescription& robot) {
-  if (!robot.solver_parameters.empty()) {
-    throw std::runtime_error("kinematics." + robot.solver_parameters.begin()->first +
-                             ": solver 'chain' takes no parameters (its geometry comes from the joints)");
-  }
+  requireNoParameters(robot);
   return std::make_shared<ChainKinematics>(readChainGeometry(robot.file), robot.limits);
 }
 

@@ -98,16 +98,6 @@ std::map<std::string, std::vector<double>> solverParameters(const json& kinemati
   return parameters;
 }
 
-std::filesystem::path modelFile(const json& models, const std::string& key, const std::filesystem::path& root) {
-  const std::string relative = text(models, "models", key);
-  const std::filesystem::path path = root / relative;
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) {
-    fail("models." + key, "no such file '" + path.string() + "' (paths are relative to the data root)");
-  }
-  return path;
-}
-
 /// How a format names a joint's limits and the home, and their unit.
 struct JointFields {
   const char* min;
@@ -175,74 +165,6 @@ void readJoints(const json& root_object, const JointFields& format, RobotDescrip
            "is outside joint " + std::to_string(j + 1) + "'s limits");
     }
   }
-}
-
-RobotDescription parse(const json& root_object, const std::filesystem::path& data_root) {
-  if (!root_object.is_object()) {
-    fail("(top level)", "must be an object {\"name\": ..., \"joints\": [...], ...}, not " + shown(root_object));
-  }
-  onlyKnown(root_object, "",
-            {"name", "type", "label", "notes", "kinematics", "models", "joints", "home", "tool", "links"});
-  RobotDescription robot;
-  robot.name = text(root_object, "", "name");
-  robot.type = text(root_object, "", "type");
-  robot.label = text(root_object, "", "label");
-
-  const json& kinematics = objectAt(root_object, "", "kinematics");
-  robot.solver = text(kinematics, "kinematics", "solver");
-  robot.solver_parameters = solverParameters(kinematics);
-
-  const json& models = objectAt(root_object, "", "models");
-  onlyKnown(models, "models", {"mjcf", "urdf", "urdf_base_link", "urdf_tool_link"});
-  robot.mjcf = modelFile(models, "mjcf", data_root);
-  robot.urdf = modelFile(models, "urdf", data_root);
-  robot.urdf_base_link = text(models, "models", "urdf_base_link");
-  robot.urdf_tool_link = text(models, "models", "urdf_tool_link");
-
-  readJoints(root_object,
-             {"min",
-              "max",
-              "max_velocity",
-              "max_acceleration",
-              "home",
-              1.0,
-              "radians",
-              " (rad/s)",
-              " (rad/s^2)",
-              {"name", "label", "min", "max", "max_velocity", "max_acceleration"}},
-             robot);
-
-  robot.tool_in_flange = world::Pose::Identity();
-  if (root_object.contains("tool")) {
-    const json& tool = objectAt(root_object, "", "tool");
-    onlyKnown(tool, "tool", {"position", "orientation"});
-    const auto p = numbers(member(tool, "tool", "position"), "tool.position", 3, "[x, y, z] (m)");
-    const auto q =
-        numbers(member(tool, "tool", "orientation"), "tool.orientation", 4, "a unit quaternion [w, x, y, z]");
-    const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
-    if (std::abs(rotation.norm() - 1.0) > 0.01) {
-      fail("tool.orientation", "must be a unit quaternion [w, x, y, z], not " + shown(tool.at("orientation")));
-    }
-    robot.tool_in_flange = world::Pose::Identity();
-    robot.tool_in_flange.translation() = Eigen::Vector3d(p[0], p[1], p[2]);
-    robot.tool_in_flange.linear() = rotation.normalized().toRotationMatrix();
-  }
-
-  const json& links = objectAt(root_object, "", "links");
-  onlyKnown(links, "links", {"base", "first_moving", "gripper"});
-  robot.base_link = text(links, "links", "base");
-  robot.first_moving_link = text(links, "links", "first_moving");
-  const json& gripper = member(links, "links", "gripper");
-  if (!gripper.is_array()) {
-    fail("links.gripper", "must be a list of link names, not " + shown(gripper));
-  }
-  for (std::size_t i = 0; i < gripper.size(); ++i) {
-    if (!gripper[i].is_string() || gripper[i].get<std::string>().empty()) {
-      fail("links.gripper[" + std::to_string(i) + "]", "must be a link name, not " + shown(gripper[i]));
-    }
-    robot.gripper_links.push_back(gripper[i].get<std::string>());
-  }
-  return robot;
 }
 
 /// Where the build writes generated models (robots/generate_models.py):
@@ -320,11 +242,10 @@ std::filesystem::path robotDescriptionFile(const std::string& name, const std::f
   return root / "robots" / name / (name + ".json");
 }
 
-RobotDescription loadRobotDescription(const std::filesystem::path& file, const std::filesystem::path& data_root) {
+RobotDescription loadRobotDescription(const std::filesystem::path& file) {
   const std::string label = "robot description '" + file.string() + "'";
   const std::string content = readFile(file, "robot description");
   RobotDescription robot;
-  bool generated = false;
   try {
     json parsed;
     try {
@@ -332,21 +253,22 @@ RobotDescription loadRobotDescription(const std::filesystem::path& file, const s
     } catch (const json::parse_error& e) {
       throw std::runtime_error(std::string("not valid JSON: ") + e.what());
     }
-    generated = parsed.is_object() && parsed.contains("format");
-    if (generated && parsed.at("format") != kGeneratedFormat) {
-      throw std::runtime_error("format: must be \"" + std::string(kGeneratedFormat) + "\", not " +
-                               shown(parsed.at("format")));
+    if (!parsed.is_object()) {
+      fail("(top level)",
+           "must be an object {\"format\": ..., \"name\": ..., \"joints\": [...], ...}, not " + shown(parsed));
     }
-    robot = generated ? parseGenerated(parsed) : parse(parsed, data_root.empty() ? dataRoot() : data_root);
+    if (parsed.value("format", json()) != kGeneratedFormat) {
+      fail("format", "must be \"" + std::string(kGeneratedFormat) + "\", not " +
+                         (parsed.contains("format") ? shown(parsed.at("format")) : std::string("missing")));
+    }
+    robot = parseGenerated(parsed);
     robot.file = file;
   } catch (const std::exception& e) {
     throw std::runtime_error(label + ": " + e.what());
   }
   // The simulator and the planner use the models generated from this file at build time: the
   // file must be the one they came from.
-  if (generated) {
-    checkGeneratedFrom(file, generatedRoot() / "robots" / robot.name / (robot.name + ".fingerprint"));
-  }
+  checkGeneratedFrom(file, generatedRoot() / "robots" / robot.name / (robot.name + ".fingerprint"));
   return robot;
 }
 

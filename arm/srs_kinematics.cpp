@@ -159,24 +159,6 @@ std::runtime_error descriptionError(const std::filesystem::path& file, const std
 
 }  // namespace
 
-SrsGeometry SrsGeometry::iiwa14() {
-  SrsGeometry geometry;
-  geometry.base_to_shoulder = 0.360;
-  geometry.shoulder_to_elbow = 0.420;
-  geometry.elbow_to_wrist = 0.400;
-  geometry.wrist_to_flange = world::Pose(Eigen::Translation3d(0.0, 0.0, 0.126));
-  geometry.axis_sign = {1, 1, 1, -1, 1, 1, 1};
-  return geometry;
-}
-
-SrsLimits SrsLimits::iiwa14() {
-  SrsLimits limits;
-  limits.upper << 170, 120, 170, 120, 170, 120, 175;
-  limits.upper *= kPi / 180.0;
-  limits.lower = -limits.upper;
-  return limits;
-}
-
 // ----------------------------------------------------------------------------------------------
 // The description file
 

@@ -47,10 +47,6 @@ struct SrsGeometry {
   /// +1 when joint i turns about the canonical axis (z, y, z, y, z, y, z), -1 when about its
   /// negative. The iiwa: {+1, +1, +1, -1, +1, +1, +1}.
   std::array<int, 7> axis_sign = {1, 1, 1, 1, 1, 1, 1};
-
-  /// KUKA LBR iiwa 14 R820: 0.360, 0.420, 0.400, flange 0.126 m beyond the wrist; joint 4
-  /// turns about -y. The same numbers as robots/iiwa14/iiwa14.json (a test checks it).
-  static SrsGeometry iiwa14();
 };
 
 /// Position limits of each joint, radians, lower < upper.
@@ -58,8 +54,6 @@ struct SrsLimits {
   Joints7 lower;
   Joints7 upper;
 
-  /// +/-170, +/-120, +/-170, +/-120, +/-170, +/-120, +/-175 degrees (KUKA LBR iiwa 14 R820).
-  static SrsLimits iiwa14();
   bool contains(const Joints7& q) const {
     return (q.array() >= lower.array()).all() && (q.array() <= upper.array()).all();
   }
@@ -94,7 +88,7 @@ class SrsKinematics {
 
   /// @throws std::invalid_argument when a length is not positive and finite, an axis sign is
   /// not +/-1, or wrist_to_flange is not a rigid transform.
-  explicit SrsKinematics(SrsGeometry geometry = SrsGeometry::iiwa14());
+  explicit SrsKinematics(SrsGeometry geometry);
 
   const SrsGeometry& geometry() const { return geometry_; }
 

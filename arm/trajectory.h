@@ -6,7 +6,7 @@
 // Every trajectory is a sequence of phases of constant joint acceleration (piecewise-quadratic
 // positions, piecewise-linear and continuous velocities). The generators choose the phases so
 // that each one respects the limits throughout, not only at sample times: the guarantees hold
-// by construction for every t. The limits are JointLimits (arm/joints.h; JointLimits::ur5()).
+// by construction for every t. The limits are JointLimits (arm/joints.h; a robot's from its description).
 
 #include <string>
 #include <vector>

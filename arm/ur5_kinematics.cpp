@@ -1,5 +1,6 @@
 #include "arm/ur5_kinematics.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -7,6 +8,8 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+
+#include "arm/chain_kinematics.h"
 
 namespace costar::arm {
 namespace {
@@ -38,11 +41,43 @@ void require(bool condition, const std::string& message) {
 
 }  // namespace
 
-DhParameters DhParameters::ur5() {
-  DhParameters parameters;
-  parameters.d = {0.089159, 0.0, 0.0, 0.10915, 0.09465, 0.0823};
-  parameters.a = {0.0, -0.425, -0.39225, 0.0, 0.0, 0.0};
-  parameters.alpha = {kPi / 2, 0.0, 0.0, kPi / 2, -kPi / 2, 0.0};
+DhParameters dhParametersOf(const ChainGeometry& chain) {
+  constexpr double kTolerance = 1e-9;
+  if (chain.joints.size() != static_cast<std::size_t>(Ur5Kinematics::kJointCount)) {
+    throw std::invalid_argument("joints: the UR closed form needs 6 joints, not " +
+                                std::to_string(chain.joints.size()));
+  }
+  const auto where = [](std::size_t i) -> std::string {
+    return i < static_cast<std::size_t>(Ur5Kinematics::kJointCount) ? "joints[" + std::to_string(i) + "]"
+                                                                    : std::string("tool");
+  };
+  for (std::size_t i = 0; i < chain.joints.size(); ++i) {
+    if (!chain.joints[i].axis.isApprox(Eigen::Vector3d::UnitZ(), kTolerance)) {
+      throw std::invalid_argument(where(i) + ".axis: must be [0, 0, 1] in DH form");
+    }
+  }
+  if (!chain.joints[0].origin.isApprox(world::Pose::Identity(), kTolerance)) {
+    throw std::invalid_argument(
+        "joints[0].origin: must be [0, 0, 0] with no rpy in DH form (joint 1 on the base frame)");
+  }
+  DhParameters parameters{};
+  for (std::size_t i = 0; i < parameters.d.size(); ++i) {
+    const world::Pose& next = i + 1 < chain.joints.size() ? chain.joints[i + 1].origin : chain.flange;
+    const Eigen::Vector3d p = next.translation();
+    const Eigen::Matrix3d r = next.linear();
+    const double alpha = std::atan2(r(2, 1), r(1, 1));
+    if (std::abs(p.y()) > kTolerance ||
+        !r.isApprox(Eigen::AngleAxisd(alpha, Eigen::Vector3d::UnitX()).toRotationMatrix(), kTolerance)) {
+      throw std::invalid_argument(where(i + 1) +
+                                  ".origin: must be [a, 0, d] turned about x only (rpy [alpha, 0, 0]) in DH form");
+    }
+    if (!(std::abs(p.x()) <= 10.0 && std::abs(p.z()) <= 10.0)) {  // NaN too
+      throw std::invalid_argument(where(i + 1) + ".origin: a and d must be from -10 to 10 m (no arm is 10 m long)");
+    }
+    parameters.d[i] = p.z();
+    parameters.a[i] = p.x();
+    parameters.alpha[i] = alpha;
+  }
   return parameters;
 }
 

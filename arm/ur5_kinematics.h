@@ -29,12 +29,16 @@ struct DhParameters {
   std::array<double, 6> d;
   std::array<double, 6> a;
   std::array<double, 6> alpha;
-
-  /// UR5 (CB-series) values published by Universal Robots:
-  /// d = {0.089159, 0, 0, 0.10915, 0.09465, 0.0823}, a = {0, -0.425, -0.39225, 0, 0, 0},
-  /// alpha = {pi/2, 0, 0, pi/2, -pi/2, 0}.
-  static DhParameters ur5();
 };
+
+struct ChainGeometry;
+
+/// The DH table of a chain written in DH form (robots/ur5/ur5.json): joint 1 at the base frame,
+/// joint i+1 (and then the flange) at translation (a_i, 0, d_i) turned by alpha_i about x in
+/// joint i's frame, every axis +z. Throws std::invalid_argument naming the joint when the chain
+/// has not 6 joints or is not of that form (an origin off the x-z plane, a turn about another
+/// axis than x, an axis other than z) or a length is beyond 10 m.
+DhParameters dhParametersOf(const ChainGeometry& chain);
 
 /// Forward and analytic inverse kinematics of a UR-structured arm, one implementation of the
 /// Kinematics interface. Immutable after construction, so one instance may be shared by
@@ -54,7 +58,7 @@ class Ur5Kinematics final : public Kinematics {
   /// form relies on: a1 = a4 = a5 = a6 = 0, d2 = d3 = 0, alpha = {pi/2, 0, 0, pi/2, -pi/2, 0},
   /// a2 and a3 non-zero, d6 non-zero, every value finite; or when `limits` are not valid
   /// limits of six joints.
-  explicit Ur5Kinematics(DhParameters parameters = DhParameters::ur5(), JointLimits limits = JointLimits::ur5());
+  Ur5Kinematics(DhParameters parameters, JointLimits limits);
 
   const DhParameters& parameters() const { return parameters_; }
 

@@ -9,6 +9,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <filesystem>
 #include <kdl/chain.hpp>
 #include <kdl/chainiksolverpos_lma.hpp>
 #include <kdl/frames.hpp>
@@ -18,6 +19,8 @@
 #include <random>
 #include <vector>
 
+#include "arm/chain_kinematics.h"
+#include "arm/robot_description.h"
 #include "arm/ur5_kinematics.h"
 #include "bench/alloc_counter.h"
 
@@ -32,11 +35,20 @@ using arm::Ur5Kinematics;
 
 constexpr int kPoseCount = 4096;
 
+/// The UR5 as robots/ur5/ur5.json describes it.
+const Ur5Kinematics& ur5() {
+  static const Ur5Kinematics kinematics = [] {
+    const std::filesystem::path file = arm::robotDescriptionFile("ur5");
+    return Ur5Kinematics(arm::dhParametersOf(arm::readChainGeometry(file)), arm::loadRobotDescription(file).limits);
+  }();
+  return kinematics;
+}
+
 /// Poses reached by random joint configurations (uniform in (-pi, pi], fixed seed): every one
 /// is reachable.
 const std::vector<world::Pose>& randomReachablePoses() {
   static const std::vector<world::Pose> poses = [] {
-    const Ur5Kinematics kinematics;
+    const Ur5Kinematics& kinematics = ur5();
     std::mt19937_64 random(20170529);
     std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
     std::vector<world::Pose> result;
@@ -53,7 +65,7 @@ const std::vector<world::Pose>& randomReachablePoses() {
 }
 
 void BM_Ur5ClosedFormInverse(benchmark::State& state) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics& kinematics = ur5();
   const std::vector<world::Pose>& poses = randomReachablePoses();
   std::array<JointVector, Ur5Kinematics::kMaxSolutions> solutions;
   std::size_t next = 0;
@@ -76,7 +88,7 @@ void BM_Ur5ClosedFormInverseNearest(benchmark::State& state) {
   // The usual call in a Cartesian move: the solution nearest the current joint angles, within
   // the UR5's limits, through the Kinematics interface (as the arm and SmartMove call it).
   // Seeds are the generating configurations, nudged.
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics& kinematics = ur5();
   const arm::Kinematics& generic = kinematics;
   const std::vector<world::Pose>& poses = randomReachablePoses();
   std::vector<JointVector> seeds;
@@ -115,7 +127,7 @@ KDL::Frame toKdl(const world::Pose& pose) {
 }
 
 void BM_KdlLmaInverse(benchmark::State& state) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics& kinematics = ur5();
   const KDL::Chain chain = ur5Chain(kinematics.parameters());
   KDL::ChainIkSolverPos_LMA solver(chain);  // KDL's defaults: eps 1e-5, 500 iterations
   const std::vector<world::Pose>& poses = randomReachablePoses();

@@ -17,6 +17,7 @@
 #include <random>
 #include <vector>
 
+#include "arm/robot_description.h"
 #include "arm/srs_kinematics.h"
 #include "bench/alloc_counter.h"
 #include "planning/robot_model.h"
@@ -27,6 +28,12 @@ namespace {
 using arm::Joints7;
 using arm::SrsKinematics;
 using arm::SrsLimits;
+
+/// The iiwa 14 as robots/iiwa14/iiwa14.json describes it.
+const arm::SrsArmDescription& iiwa14() {
+  static const arm::SrsArmDescription description = arm::readSrsArmDescription(arm::robotDescriptionFile("iiwa14"));
+  return description;
+}
 
 constexpr int kPoseCount = 4096;
 
@@ -44,8 +51,8 @@ struct Workload {
 
 const Workload& workload() {
   static const Workload work = [] {
-    const SrsKinematics kinematics;
-    const SrsLimits limits = SrsLimits::iiwa14();
+    const SrsKinematics kinematics(iiwa14().geometry);
+    const SrsLimits limits = iiwa14().limits;
     std::mt19937_64 random(20260);
     std::uniform_real_distribution<double> nudge(-0.05, 0.05);
     Workload result;
@@ -71,8 +78,8 @@ const Workload& workload() {
 /// `position_tolerance` (m) and `angle_tolerance` (rad).
 double solvedFraction(const std::vector<std::optional<Joints7>>& answers, std::int64_t iterations,
                       double position_tolerance = 1e-6, double angle_tolerance = 1e-6) {
-  const SrsKinematics kinematics;
-  const SrsLimits limits = SrsLimits::iiwa14();
+  const SrsKinematics kinematics(iiwa14().geometry);
+  const SrsLimits limits = iiwa14().limits;
   const Workload& work = workload();
   const std::size_t visited = std::min<std::size_t>(answers.size(), static_cast<std::size_t>(iterations));
   std::size_t solved = 0;
@@ -89,8 +96,8 @@ double solvedFraction(const std::vector<std::optional<Joints7>>& answers, std::i
 // The analytic solver from one fixed seed (home) for every pose: most poses are far from the
 // seed, so this is the full search over the 8 branches and their feasible arm angles.
 void BM_Iiwa14AnalyticNearestFromHome(benchmark::State& state) {
-  const SrsKinematics kinematics;
-  const SrsLimits limits = SrsLimits::iiwa14();
+  const SrsKinematics kinematics(iiwa14().geometry);
+  const SrsLimits limits = iiwa14().limits;
   const Workload& work = workload();
   const Joints7 seed = home();
   std::vector<std::optional<Joints7>> answers(work.poses.size());
@@ -110,8 +117,8 @@ BENCHMARK(BM_Iiwa14AnalyticNearestFromHome)->MinTime(1.0);
 
 // The usual call in a Cartesian move: the seed is the current configuration, near the answer.
 void BM_Iiwa14AnalyticNearestTracking(benchmark::State& state) {
-  const SrsKinematics kinematics;
-  const SrsLimits limits = SrsLimits::iiwa14();
+  const SrsKinematics kinematics(iiwa14().geometry);
+  const SrsLimits limits = iiwa14().limits;
   const Workload& work = workload();
   std::vector<std::optional<Joints7>> answers(work.poses.size());
   std::size_t next = 0;
@@ -130,7 +137,7 @@ BENCHMARK(BM_Iiwa14AnalyticNearestTracking)->MinTime(1.0);
 
 // All (up to 8) closed-form solutions at one arm angle, limits not applied.
 void BM_Iiwa14AnalyticAllAtArmAngle(benchmark::State& state) {
-  const SrsKinematics kinematics;
+  const SrsKinematics kinematics(iiwa14().geometry);
   const Workload& work = workload();
   std::array<Joints7, SrsKinematics::kMaxSolutions> solutions;
   std::size_t next = 0;

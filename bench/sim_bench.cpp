@@ -70,10 +70,9 @@ void BM_PhysicsArmMoving(benchmark::State& state) {
   arm::JointVector b = a;
   b[0] = -1.5;
   b[1] = -1.8;
-  const auto out =
-      std::make_shared<arm::JointTrajectory>(arm::JointTrajectory::pointToPoint(a, b, arm::JointLimits::ur5(), 1.0));
-  const auto back =
-      std::make_shared<arm::JointTrajectory>(arm::JointTrajectory::pointToPoint(b, a, arm::JointLimits::ur5(), 1.0));
+  const arm::JointLimits limits = arm::loadRobotDescription(arm::robotDescriptionFile("ur5")).limits;
+  const auto out = std::make_shared<arm::JointTrajectory>(arm::JointTrajectory::pointToPoint(a, b, limits, 1.0));
+  const auto back = std::make_shared<arm::JointTrajectory>(arm::JointTrajectory::pointToPoint(b, a, limits, 1.0));
   const Duration period = out->duration() + back->duration();
   simulation->setArmSetpointSource([&](TimePoint t) {
     const Duration phase = Duration(t.time_since_epoch().count() % period.count());

@@ -85,7 +85,7 @@ struct Cell {
     arm::ArmConfig c;
     c.base_in_world = description.robot_base;
     c.home = robot_description.home;
-    c.tcp_in_flange = robot_description.tool_in_flange * gripper_model.tcp_in_flange;
+    c.tcp_in_flange = gripper_model.tcp_in_flange;
     c.joint_names = robot_description.joint_names;
     c.joint_labels = robot_description.joint_labels;
     return c;

@@ -46,16 +46,8 @@ PlanResult planPath(const CollisionWorld& world, const Eigen::VectorXd& start, c
   const auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   };
-  if (const auto contact = query.check(start)) {
-    result.failure = "the arm is in collision where it starts: " + contact->str();
-    return result;
-  }
-  if (const auto contact = query.check(goal)) {
-    result.failure = "the goal is in collision: " + contact->str();
-    return result;
-  }
-  // A goal beyond a joint's limits is refused with the joint named (OMPL would only log
-  // "invalid bounds" to the console and find nothing).
+  // A goal beyond a joint's limits (or not a number) is refused with the joint named, before any
+  // collision check (OMPL would only log "invalid bounds" to the console and find nothing).
   const RobotModel& robot = world.robot();
   for (Eigen::Index j = 0; j < goal.size() && j < robot.lowerLimits().size(); ++j) {
     if (!(goal[j] >= robot.lowerLimits()[j] && goal[j] <= robot.upperLimits()[j])) {
@@ -66,6 +58,14 @@ PlanResult planPath(const CollisionWorld& world, const Eigen::VectorXd& start, c
           "the goal is outside joint " + robot.jointNames()[static_cast<std::size_t>(j)] + "'s limits" + bounds;
       return result;
     }
+  }
+  if (const auto contact = query.check(start)) {
+    result.failure = "the arm is in collision where it starts: " + contact->str();
+    return result;
+  }
+  if (const auto contact = query.check(goal)) {
+    result.failure = "the goal is in collision: " + contact->str();
+    return result;
   }
   if (!query.checkSegment(start, goal)) {
     result.path = {start, goal};

@@ -8,9 +8,11 @@ OUTPUT_DIR/NAME.xml, an MJCF model of the arm alone for MuJoCo, and OUTPUT_DIR/N
 same chain for Orocos KDL (kdl_parser) and collision checking (planning::RobotModel). Both are
 made from the same numbers, so the simulator and the planner cannot disagree.
 
-Conventions (those of sim/models/ur5_arm.xml and sim/models/ur5_arm.urdf):
-- The base link is fixed to the world at the origin; every link frame sits on its joint.
+Conventions:
+- The base link is fixed to the world at the origin (the workcell places it: "robot_base"); every
+  link frame sits on its joint.
 - MJCF: arm geoms contype 2, conaffinity 0 (they touch the table and parts, not each other);
+  a collision shape's optional rgba colours it (default the arm's orange);
   one motor actuator per joint named after it, ctrlrange the joint's torque limit (the
   simulation runs computed-torque control); joint damping 0.5, armature 0.1; a keyframe "home";
   the tool frame is a body with a site of the same name.
@@ -86,7 +88,11 @@ def read_description(path):
             radius = reader.get(shape, "radius", shape_field, "number", at_most=MAX_M)
             if radius <= 0 or math.dist(start, end) <= 0:
                 reader.fail(shape_field, "needs a positive radius and distinct from/to")
-            shapes.append({"type": kind, "from": start, "to": end, "radius": radius})
+            rgba = reader.get(shape, "rgba", shape_field, "list", optional=True)
+            if rgba is not None and (len(rgba) != 4 or not all(
+                    isinstance(x, (int, float)) and not isinstance(x, bool) and 0 <= x <= 1 for x in rgba)):
+                reader.fail(f"{shape_field}.rgba", f"must be 4 numbers from 0 to 1 (red, green, blue, alpha), not {rgba}")
+            shapes.append({"type": kind, "from": start, "to": end, "radius": radius, "rgba": rgba})
         links[name] = {"name": name, "mass": mass, "com": reader.get(link, "com", field, "vec3", at_most=MAX_M),
                        "inertia": inertia, "collision": shapes}
     if robot["base_link"] not in links:
@@ -174,8 +180,9 @@ def check_published_lengths(reader, root, robot):
 
 
 def capsule_or_cylinder_mjcf(name, shape):
+    colour = f' rgba="{fmt(shape["rgba"])}"' if shape["rgba"] is not None else ""
     return (f'<geom name="{name}" type="{shape["type"]}" fromto="{fmt(shape["from"] + shape["to"])}" '
-            f'size="{shape["radius"]:.12g}"/>')
+            f'size="{shape["radius"]:.12g}"{colour}/>')
 
 
 def inertial_mjcf(link):

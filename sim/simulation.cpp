@@ -615,7 +615,9 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   // The robot: its description names the model, the joints, home and links. The default
   // robot's model files are read from `root`, like everything else.
   const arm::RobotDescription robot =
-      options.robot ? *options.robot : arm::loadRobotDescription(arm::robotDescriptionFile(kDefaultRobot), root);
+      options.robot ? *options.robot : arm::loadRobotDescription(arm::robotDescriptionFile(kDefaultRobot, root));
+  const std::optional<world::Pose> robot_base =
+      options.robot_base || options.robot ? options.robot_base : std::optional<world::Pose>(defaultRobotBase());
 
   // Model: the cell, the robot and its gripper composed, plus a material per class colour and
   // a body per part.
@@ -626,11 +628,11 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
   if (!options.adaptive_gripper.empty()) {
     adaptive = gripper::loadAdaptiveGripperDescription(gripper::gripperDescriptionFile(options.adaptive_gripper, root));
   }
-  std::string xml = composeCellModel(
-      {under_root(options.cell_model), robot.mjcf,
-       options.gripper_model.empty() ? std::filesystem::path(COSTAR_GRIPPER_MODEL_DIR) / "parallel-2f_mount.xml"
-                                     : under_root(options.gripper_model),
-       robot.urdf_tool_link, options.robot_base, kForceTorqueSite, kForceSensor, kTorqueSensor});
+  std::string xml = composeCellModel({under_root(options.cell_model), robot.mjcf,
+                                      options.gripper_model.empty()
+                                          ? std::filesystem::path(COSTAR_GRIPPER_MODEL_DIR) / "parallel-2f_mount.xml"
+                                          : under_root(options.gripper_model),
+                                      robot.urdf_tool_link, robot_base, kForceTorqueSite, kForceSensor, kTorqueSensor});
   std::string assets;
   for (const auto& object : impl->classes) {
     for (const auto& [color_name, rgb] : object.colors) {
@@ -777,12 +779,12 @@ std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const Simulat
       scene.camera_offset ? cameraOffsetPose(*scene.camera_offset, options.placement_seed.value_or(scene.seed))
                           : world::Pose::Identity()));
   impl->tool_body = impl->id(mjOBJ_BODY, robot.urdf_tool_link.c_str());  // the flange, as the robot names it
-  if (options.robot_base) {
+  if (robot_base) {
     mj_kinematics(m, impl->data);
     const world::Pose base = impl->bodyPose(impl->id(mjOBJ_BODY, robot.base_link.c_str()));
-    if ((base.matrix() - options.robot_base->matrix()).cwiseAbs().maxCoeff() > 1e-9) {
+    if ((base.matrix() - robot_base->matrix()).cwiseAbs().maxCoeff() > 1e-9) {
       throw std::runtime_error("the robot's base body '" + robot.base_link + "' stands at " + vec(base.translation()) +
-                               " in the model, the workcell says " + vec(options.robot_base->translation()) +
+                               " in the model, the workcell says " + vec(robot_base->translation()) +
                                " (or turned otherwise)");
     }
   }

@@ -59,6 +59,11 @@ struct ArmSetpoint {
 /// The robot a Simulation has when none is given: robots/ur5/ur5.json.
 inline constexpr const char* kDefaultRobot = "ur5";
 
+/// Where that default robot stands when no robot is given: at the origin turned 180 degrees about
+/// z, so that q = 0 stretches it over the table, as the default cell stands it
+/// (workcells/ur5-sim.json "robot_base"; a workcell always gives its own).
+inline world::Pose defaultRobotBase() { return world::Pose(Eigen::AngleAxisd(EIGEN_PI, Eigen::Vector3d::UnitZ())); }
+
 struct SimulationOptions {
   /// Folder with data/objects and sim/models (default: the repository, see core/paths.h).
   std::filesystem::path data_root;

@@ -298,7 +298,7 @@ class SimWorkcell final : public Workcell {
     arm_config.type = robot_description_.type;
     arm_config.base_in_world = cell_.robot_base;
     arm_config.home = robot_description_.home;
-    arm_config.tcp_in_flange = robot_description_.tool_in_flange * gripper_model_.tcp_in_flange;
+    arm_config.tcp_in_flange = gripper_model_.tcp_in_flange;
     arm_config.joint_names = robot_description_.joint_names;
     arm_config.joint_labels = robot_description_.joint_labels;
     const std::shared_ptr<const arm::Kinematics> kinematics = arm::makeKinematics(robot_description_);

@@ -8,6 +8,7 @@
 
 #include "arm/chain_kinematics.h"
 #include "arm/test/dh_chain.h"
+#include "arm/test/published_arms.h"
 #include "arm/trajectory.h"
 #include "arm/ur5_kinematics.h"
 #include "bench/alloc_counter.h"
@@ -19,7 +20,7 @@ namespace {
 constexpr int kJointCount = arm::Ur5Kinematics::kJointCount;
 
 TEST(ArmAllocation, NoneInInverseKinematics) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   std::mt19937_64 random(21);
   std::uniform_real_distribution<double> angle(-3.0, 3.0);
   std::vector<world::Pose> poses;
@@ -32,7 +33,7 @@ TEST(ArmAllocation, NoneInInverseKinematics) {
   }
   std::array<JointVector, Ur5Kinematics::kMaxSolutions> solutions;
   int total = 0;
-  const JointLimits limits = JointLimits::ur5();
+  const JointLimits limits = published::ur5Limits();
   const std::uint64_t before = bench::allocations();
   for (const world::Pose& pose : poses) {
     total += kinematics.inverse(pose, solutions);
@@ -57,7 +58,7 @@ TEST(ArmAllocation, NoneInInverseKinematics) {
 // The general chain solver (6 joints here: the UR5's DH table as a chain), through the
 // interface; its geometry is built before counting.
 TEST(ArmAllocation, NoneInTheChainSolver) {
-  const ChainKinematics kinematics(testing::chainFromDh(DhParameters::ur5()), JointLimits::ur5());
+  const ChainKinematics kinematics(testing::chainFromDh(published::ur5Dh()), published::ur5Limits());
   std::mt19937_64 random(22);
   std::uniform_real_distribution<double> angle(-3.0, 3.0);
   std::vector<world::Pose> poses;
@@ -84,7 +85,7 @@ TEST(ArmAllocation, NoneInTheChainSolver) {
 
 TEST(ArmAllocation, NoneWhenSampling) {
   const JointTrajectory trajectory = JointTrajectory::alongPath(
-      {{0, 0, 0, 0, 0, 0}, {1, 0.5, 0, 0, 0, 0}, {1, 1, 1, 0, 0, 0}}, JointLimits::ur5(), 0.8);
+      {{0, 0, 0, 0, 0, 0}, {1, 0.5, 0, 0, 0, 0}, {1, 1, 1, 0, 0, 0}}, published::ur5Limits(), 0.8);
   double sum = 0.0;
   const std::uint64_t before = bench::allocations();
   for (Duration t(0); t <= trajectory.duration(); t += std::chrono::microseconds(100)) {

@@ -2,6 +2,7 @@
 // what it refuses and why, cancelling, teaching, waypoints and predicates.
 
 #include "arm/arm_component.h"
+#include "arm/robot_description.h"
 #include "arm/ur5_kinematics.h"
 
 #include <gtest/gtest.h>
@@ -12,6 +13,7 @@
 #include <filesystem>
 #include <functional>
 
+#include "arm/test/published_arms.h"
 #include "component/registry.h"
 #include "core/paths.h"
 
@@ -63,14 +65,14 @@ class ArmTest : public ::testing::Test {
   /// `waypoint_file`: where the arm's waypoints are kept (none: in memory).
   explicit ArmTest(std::filesystem::path waypoint_file = {})
       : waypoints(std::move(waypoint_file), /*persist=*/true, 6),
-        robot(planning::RobotModel::fromUrdf(dataRoot() / "sim/models/ur5_arm.urdf",
+        robot(planning::RobotModel::fromUrdf(arm::loadRobotDescription(arm::robotDescriptionFile("ur5")).urdf,
                                              std::filesystem::path(COSTAR_GRIPPER_MODEL_DIR) / "parallel-2f.urdf",
                                              "tool0", "base_link", "tcp")),
         collisions(robot, kBase, {.padding = 0.005}, {kHome.eigen()}),
         driver(clock, kHome),
         arm(
             driver, clock, collisions, waypoints, [this](const std::string& frame) { return frame_lookup(frame); },
-            std::make_shared<Ur5Kinematics>(), config()) {
+            std::make_shared<Ur5Kinematics>(published::ur5Dh(), published::ur5Limits()), config()) {
     collisions.setBox("table", world::Pose(Eigen::Translation3d(0.4, 0, -0.02)), {1.4, 1.2, 0.04});
     collisions.allow("base_link", "table");
   }
@@ -139,7 +141,7 @@ TEST_F(ArmTest, MovesToATaughtPoseWaypointWithinTheLimitsAndSaysWhereItIs) {
   EXPECT_TRUE(arm.endpoint().isApprox(toolDown(0.5, -0.2, 0.15), 1e-6));
   EXPECT_TRUE(holds("at_waypoint", {"above_part"}));
   ASSERT_EQ(driver.executed.size(), 1u);
-  EXPECT_NO_THROW(driver.executed[0]->validate(JointLimits::ur5()));
+  EXPECT_NO_THROW(driver.executed[0]->validate(published::ur5Limits()));
   // Moving took time on the clock, within the speed-scaled limits.
   EXPECT_GT(toSeconds(driver.executed[0]->duration()), 0.5);
 }
@@ -192,7 +194,7 @@ TEST_F(ArmTest, MoveRelativeFollowsAStraightLine) {
   EXPECT_TRUE(arm.endpoint().isApprox(toolDown(0.45, 0.1, 0.25), 1e-6));
   // Every sample of the motion is on the vertical line through the start.
   const auto& trajectory = *driver.executed.back();
-  Ur5Kinematics kinematics;
+  Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   for (Duration t{}; t <= trajectory.duration(); t += std::chrono::milliseconds(10)) {
     const world::Pose tcp = kBase * kinematics.forward(trajectory.sample(t).position) * config().tcp_in_flange;
     EXPECT_LT((tcp.translation().head<2>() - Eigen::Vector2d(0.45, 0.1)).norm(), 1e-3);
@@ -264,7 +266,8 @@ TEST_F(ArmTest, TeachSavesWhereTheArmIsAndJoggingMovesIt) {
 // here one on the same driver and collision world) and hands the plan's waypoints to the arm's
 // FollowJointPath, with the contacts the plan allowed passed to the query alone.
 TEST_F(ArmTest, FollowsAPathPlannedByTheMotionServiceExactlyAsItWouldItsOwn) {
-  const MotionPlanner service(driver, clock, collisions, std::make_shared<Ur5Kinematics>(), config());
+  const MotionPlanner service(driver, clock, collisions,
+                              std::make_shared<Ur5Kinematics>(published::ur5Dh(), published::ur5Limits()), config());
   const JointVector goal = {0.6, -1.8, 1.6, -M_PI / 2, -M_PI / 2, 0.0};
   const MotionPlan plan = service.planToJoints(service.joints(), goal, 0.4);
   ASSERT_TRUE(plan.ok()) << plan.failure;
@@ -285,12 +288,13 @@ TEST_F(ArmTest, FollowsAPathPlannedByTheMotionServiceExactlyAsItWouldItsOwn) {
 // 2e-7 after a grasp, seed 1835 of the 3-finger assembly); the next motion from there must be
 // planned, starting on the limit. Further beyond it, the plan fails naming the joint.
 TEST_F(ArmTest, AMotionStartingAHairBeyondAJointLimitStartsOnTheLimit) {
-  const double limit = JointLimits::ur5().max_position[5];
+  const double limit = published::ur5Limits().max_position[5];
   for (const double beyond : {2e-7, 5e-4, 0.01}) {
     JointVector start = kHome;
     start[5] = limit + beyond;
     const IdealDriver at_limit(clock, start);
-    const MotionPlanner service(at_limit, clock, collisions, std::make_shared<Ur5Kinematics>(), config());
+    const MotionPlanner service(at_limit, clock, collisions,
+                                std::make_shared<Ur5Kinematics>(published::ur5Dh(), published::ur5Limits()), config());
     JointVector goal = kHome;
     goal[5] = limit - 0.5;
     const MotionPlan joints = service.planToJoints(service.joints(), goal, 0.4);

@@ -14,6 +14,7 @@
 #include "arm/robot_description.h"
 #include "arm/srs_kinematics.h"
 #include "arm/test/dh_chain.h"
+#include "arm/test/published_arms.h"
 #include "arm/ur5_kinematics.h"
 
 namespace costar::arm {
@@ -44,11 +45,11 @@ const RobotDescription& iiwa() {
 }
 
 TEST(ChainKinematics, ForwardMatchesTheUr5ClosedFormOnAThousandConfigurations) {
-  const Ur5Kinematics closed;
-  const ChainKinematics chain(chainFromDh(DhParameters::ur5()), JointLimits::ur5());
+  const Ur5Kinematics closed(published::ur5Dh(), published::ur5Limits());
+  const ChainKinematics chain(chainFromDh(published::ur5Dh()), published::ur5Limits());
   std::mt19937_64 random(3501);
   for (int k = 0; k < 1000; ++k) {
-    const JointVector q = randomWithin(JointLimits::ur5(), random);
+    const JointVector q = randomWithin(published::ur5Limits(), random);
     const world::Pose a = closed.forward(q);
     const world::Pose b = chain.forward(q);
     ASSERT_LT((a.translation() - b.translation()).norm(), 1e-12) << k;
@@ -107,7 +108,7 @@ TEST(ChainKinematics, SolvesReachablePandaPosesFromRandomSeeds) {
 // (6 of 1000 on this seed) are folded-elbow poses, joint 3 within 0.25 rad of +/-pi, where the
 // elbow is singular.
 TEST(ChainKinematics, SolvesReachableUr5PosesFromRandomSeeds) {
-  expectSolvesReachablePoses(ChainKinematics(chainFromDh(DhParameters::ur5()), JointLimits::ur5()), 3504, 990);
+  expectSolvesReachablePoses(ChainKinematics(chainFromDh(published::ur5Dh()), published::ur5Limits()), 3504, 990);
 }
 
 // A Cartesian move's call: the seed within 0.05 rad per joint of a configuration, the answer the

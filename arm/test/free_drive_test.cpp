@@ -9,6 +9,8 @@
 
 #include <Eigen/Geometry>
 
+#include "arm/test/published_arms.h"
+
 namespace costar::arm {
 namespace {
 
@@ -214,7 +216,7 @@ TEST(FreeDrive, ALinkWhoseMotionAheadReachesAWallStopsTheStepThoughTheToolsLookA
 /// The UR5's own kinematics with a tool 15 cm beyond the flange, free of obstacles: what a step
 /// is checked against near its singularities.
 struct Ur5Steps {
-  Ur5Kinematics ur5;
+  Ur5Kinematics ur5{published::ur5Dh(), published::ur5Limits()};
   world::Pose tcp = world::Pose(Eigen::Translation3d(0.0, 0.0, 0.15));
   world::Pose tool(const JointVector& q) const { return ur5.forward(q) * tcp; }
   StepChecks checks(bool guard) const {

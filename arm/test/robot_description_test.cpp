@@ -1,5 +1,6 @@
-// The robot description files: the UR5's loads as the values the code used to hard-code, and
-// bad files are refused naming the file, the field and the problem.
+// The robot description files (format costar-robot-description/1): the UR5's and the iiwa's
+// load as their makers' numbers, and bad files are refused naming the file, the field and the
+// problem.
 
 #include "arm/robot_description.h"
 
@@ -12,7 +13,11 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <random>
+#include <string>
+#include <utility>
 
+#include "arm/chain_kinematics.h"
+#include "arm/test/published_arms.h"
 #include "arm/ur5_kinematics.h"
 #include "core/files.h"
 #include "core/paths.h"
@@ -26,32 +31,45 @@ TEST(RobotDescription, TheUr5FileHoldsTheUr5) {
   const RobotDescription ur5 = loadRobotDescription(robotDescriptionFile("ur5"));
   EXPECT_EQ(ur5.name, "ur5");
   EXPECT_EQ(ur5.type, "UR5");
+  EXPECT_EQ(ur5.solver, "ur");
   ASSERT_EQ(ur5.jointCount(), 6);
   EXPECT_EQ(ur5.joint_names.front(), "shoulder_pan_joint");
   EXPECT_EQ(ur5.joint_names.back(), "wrist_3_joint");
   EXPECT_EQ(ur5.joint_labels.back(), "wrist 3");
-  // Bit for bit what JointLimits::ur5() and the old hard-coded home were.
-  const JointLimits limits = JointLimits::ur5();
-  EXPECT_EQ(ur5.limits.min_position, limits.min_position);
-  EXPECT_EQ(ur5.limits.max_position, limits.max_position);
-  EXPECT_EQ(ur5.limits.max_velocity, limits.max_velocity);
-  EXPECT_EQ(ur5.limits.max_acceleration, limits.max_acceleration);
+  // The data sheet's limits (published::ur5Limits(), the maker's numbers kept for tests), to rounding
+  // of the degrees the file is written in.
+  const JointLimits limits = published::ur5Limits();
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_NEAR(ur5.limits.min_position[j], limits.min_position[j], 1e-12) << j;
+    EXPECT_NEAR(ur5.limits.max_position[j], limits.max_position[j], 1e-12) << j;
+    EXPECT_NEAR(ur5.limits.max_velocity[j], limits.max_velocity[j], 1e-12) << j;
+    EXPECT_NEAR(ur5.limits.max_acceleration[j], limits.max_acceleration[j], 1e-12) << j;
+  }
   const JointVector home = {0.0, -2.3, 1.9, -std::numbers::pi / 2 + 0.4, -std::numbers::pi / 2, 0.0};
-  EXPECT_EQ(ur5.home, home);
-  // No tool of its own: the gripper's tool centre point is the workcell's (workcells/*.json).
-  EXPECT_TRUE(ur5.tool_in_flange.isApprox(world::Pose::Identity(), 0.0));
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_NEAR(ur5.home[j], home[j], 1e-12) << j;
+  }
   EXPECT_EQ(ur5.urdf_tool_link, "tool0");
   EXPECT_EQ(ur5.gripper_links, (std::vector<std::string>{"tool0", "wrist_3_link", "fingers"}));
   EXPECT_EQ(ur5.base_link, "base_link");
-  EXPECT_TRUE(std::filesystem::is_regular_file(ur5.mjcf));
-  EXPECT_TRUE(std::filesystem::is_regular_file(ur5.urdf));
+  EXPECT_EQ(ur5.first_moving_link, "shoulder_link");
+  EXPECT_TRUE(std::filesystem::is_regular_file(ur5.mjcf)) << ur5.mjcf;
+  EXPECT_TRUE(std::filesystem::is_regular_file(ur5.urdf)) << ur5.urdf;
 }
 
+// Its joints are UR's DH table, read back exactly, and the closed form is built on it.
 TEST(RobotDescription, ItsKinematicsAreTheUrClosedFormWithItsDhTable) {
+  const DhParameters published = published::ur5Dh();
+  const DhParameters read = dhParametersOf(readChainGeometry(robotDescriptionFile("ur5")));
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_EQ(read.d[i], published.d[i]) << i;
+    EXPECT_EQ(read.a[i], published.a[i]) << i;
+    EXPECT_NEAR(read.alpha[i], published.alpha[i], 1e-15) << i;
+  }
   const RobotDescription ur5 = loadRobotDescription(robotDescriptionFile("ur5"));
   const std::shared_ptr<const Kinematics> kinematics = makeKinematics(ur5);
   ASSERT_NE(dynamic_cast<const Ur5Kinematics*>(kinematics.get()), nullptr);
-  const Ur5Kinematics reference;
+  const Ur5Kinematics reference(published, published::ur5Limits());
   std::mt19937_64 random(3);
   std::uniform_real_distribution<double> angle(-3.0, 3.0);
   for (int trial = 0; trial < 50; ++trial) {
@@ -59,92 +77,9 @@ TEST(RobotDescription, ItsKinematicsAreTheUrClosedFormWithItsDhTable) {
     for (double& value : q) {
       value = angle(random);
     }
-    EXPECT_TRUE(kinematics->forward(q).isApprox(reference.forward(q), 0.0)) << "trial " << trial;
+    EXPECT_TRUE(kinematics->forward(q).isApprox(reference.forward(q), 1e-14)) << "trial " << trial;
   }
   EXPECT_EQ(kinematicsSolvers(), (std::vector<std::string>{"chain", "srs", "ur"}));
-}
-
-class BadRobotFile : public ::testing::Test {
- protected:
-  void SetUp() override {
-    folder_ = std::filesystem::temp_directory_path() /
-              ("costar_robot_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-               ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(folder_);
-    std::ifstream in(robotDescriptionFile("ur5"));
-    good_ = json::parse(in);
-  }
-  void TearDown() override { std::filesystem::remove_all(folder_); }
-
-  /// The error loading `content`, without the "robot description 'PATH': " prefix.
-  std::string problem(const std::string& content) {
-    const auto file = folder_ / "robot.json";
-    std::ofstream(file) << content;
-    const std::string prefix = "robot description '" + file.string() + "': ";
-    try {
-      const RobotDescription robot = loadRobotDescription(file);
-      makeKinematics(robot);
-    } catch (const std::runtime_error& e) {
-      const std::string message = e.what();
-      return message.rfind(prefix, 0) == 0 ? message.substr(prefix.size()) : "(no file named) " + message;
-    }
-    return "no error";
-  }
-  std::string problem(const json& content) { return problem(content.dump(2)); }
-
-  std::filesystem::path folder_;
-  json good_;
-};
-
-TEST_F(BadRobotFile, EachProblemNamesItsField) {
-  EXPECT_EQ(problem(good_), "no error");
-  json j = good_;
-  j.erase("home");
-  EXPECT_EQ(problem(j), "home: missing");
-  j = good_;
-  j["home"].push_back(0.0);
-  EXPECT_EQ(problem(j),
-            "home: must be 6 angles (radians), one per joint, not "
-            "[0.0,-2.3,1.9,-1.1707963267948966,-1.5707963267948966,0.0...");
-  j = good_;
-  j["home"][1] = 7.0;
-  EXPECT_EQ(problem(j), "home[1]: is outside joint 2's limits");
-  j = good_;
-  j["joints"][2]["max_velocity"] = -1;
-  EXPECT_EQ(problem(j), "joints[2].max_velocity: must be positive (rad/s), not -1");
-  j = good_;
-  j["joints"][3]["name"] = "elbow_joint";
-  EXPECT_EQ(problem(j), "joints[3].name: 'elbow_joint' is taken already; joint names must differ");
-  j = good_;
-  j["joints"][0]["min"] = "low";
-  EXPECT_EQ(problem(j), "joints[0].min: must be a finite number, not \"low\"");
-  j = good_;
-  j["gripper_link"] = "tool0";
-  EXPECT_EQ(problem(j),
-            "gripper_link: unknown field (known: home, joints, kinematics, label, links, models, name, notes, tool, "
-            "type)");
-  j = good_;
-  j["models"]["mjcf"] = "sim/models/no_such_robot.xml";
-  EXPECT_EQ(problem(j).rfind("models.mjcf: no such file '", 0), 0u) << problem(j);
-  j = good_;
-  j["kinematics"]["solver"] = "kuka";
-  EXPECT_EQ(problem(j), "kinematics.solver: unknown solver 'kuka' (known: chain, srs, ur)");
-  j = good_;
-  j["kinematics"]["d"] = {0.1, 0.2};
-  EXPECT_EQ(problem(j), "kinematics.d: must be 6 numbers, not 2");
-  j = good_;
-  j["kinematics"]["alpha"][0] = 0.0;  // not a UR arm: the closed form refuses it
-  EXPECT_EQ(problem(j).rfind("Ur5Kinematics: the closed form needs alpha", 0), 0u) << problem(j);
-  j = good_;
-  j["joints"] = json::array();
-  EXPECT_EQ(problem(j), "joints: must be a list of 1 to 8 joints, not []");
-  // Issue 27 (found by scripts/hostile_cli.sh): 1e308 reached the closed form as a length.
-  j = good_;
-  j["kinematics"]["d"][0] = 1e308;
-  EXPECT_EQ(problem(j), "kinematics.d[0]: must be from -10 to 10 (m or rad: no arm is 10 m long), not 1e+308");
-  EXPECT_EQ(problem(std::string("{\"name\": ")).rfind("not valid JSON: ", 0), 0u);
-  EXPECT_EQ(problem(std::string("[1, 2]")),
-            "(top level): must be an object {\"name\": ..., \"joints\": [...], ...}, not [1,2]");
 }
 
 // The LBR iiwa 14: the runtime reads the file the model generator reads
@@ -171,24 +106,26 @@ TEST(RobotDescription, TheIiwaFileIsTheGeneratorsFile) {
   EXPECT_EQ(makeKinematics(iiwa)->jointCount(), 7);
 }
 
-/// A variant of iiwa14.json, loaded as if the models had been generated from it: the test's
-/// own generated folder ($COSTAR_GENERATED_DIR) holds the build's models and the variant's
-/// fingerprint, so that each check of the file is reached.
-class BadIiwaFile : public ::testing::Test {
+/// A variant of a robot's description, loaded as if the models had been generated from it: the
+/// test's own generated folder ($COSTAR_GENERATED_DIR) holds the build's models and the
+/// variant's fingerprint, so that each check of the file is reached.
+class GeneratedVariant : public ::testing::Test {
  protected:
+  explicit GeneratedVariant(std::string robot) : robot_(std::move(robot)) {}
+
   void SetUp() override {
     folder_ = std::filesystem::temp_directory_path() /
-              ("costar_iiwa_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+              ("costar_" + robot_ + "_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
                ::testing::UnitTest::GetInstance()->current_test_info()->name());
     std::filesystem::create_directories(folder_);
-    std::ifstream in(robotDescriptionFile("iiwa14"));
+    std::ifstream in(robotDescriptionFile(robot_));
     good_text_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     good_ = json::parse(good_text_);
-    const RobotDescription built = loadRobotDescription(robotDescriptionFile("iiwa14"));
-    generated_ = folder_ / "generated" / "robots" / "iiwa14";
+    const RobotDescription built = loadRobotDescription(robotDescriptionFile(robot_));
+    generated_ = folder_ / "generated" / "robots" / robot_;
     std::filesystem::create_directories(generated_);
-    std::filesystem::copy_file(built.mjcf, generated_ / "iiwa14.xml");
-    std::filesystem::copy_file(built.urdf, generated_ / "iiwa14.urdf");
+    std::filesystem::copy_file(built.mjcf, generated_ / (robot_ + ".xml"));
+    std::filesystem::copy_file(built.urdf, generated_ / (robot_ + ".urdf"));
     ::setenv("COSTAR_GENERATED_DIR", (folder_ / "generated").c_str(), 1);
   }
   void TearDown() override {
@@ -196,14 +133,15 @@ class BadIiwaFile : public ::testing::Test {
     std::filesystem::remove_all(folder_);
   }
 
-  /// The error loading `content` (as iiwa14.json, with models generated from it unless
-  /// `regenerated` is false), without the "robot description 'PATH': " prefix.
+  /// The error loading `content` (as NAME.json, with models generated from it unless
+  /// `regenerated` is false) and making its kinematics, without the "robot description 'PATH': "
+  /// prefix.
   std::string problem(const json& content) { return problem(content.dump(2)); }
   std::string problem(const std::string& text, bool regenerated = true) {
-    const auto file = folder_ / "iiwa14.json";
+    const auto file = folder_ / (robot_ + ".json");
     std::ofstream(file) << text;
     if (regenerated) {
-      std::ofstream(generated_ / "iiwa14.fingerprint") << fingerprint(text) << "\n";
+      std::ofstream(generated_ / (robot_ + ".fingerprint")) << fingerprint(text) << "\n";
     }
     const std::string prefix = "robot description '" + file.string() + "': ";
     try {
@@ -215,11 +153,84 @@ class BadIiwaFile : public ::testing::Test {
     return "no error";
   }
 
+  std::string robot_;
   std::filesystem::path folder_;
   std::filesystem::path generated_;
   std::string good_text_;  // the file the build's models were generated from, byte for byte
   json good_;
 };
+
+class BadIiwaFile : public GeneratedVariant {
+ protected:
+  BadIiwaFile() : GeneratedVariant("iiwa14") {}
+};
+
+class BadUr5File : public GeneratedVariant {
+ protected:
+  BadUr5File() : GeneratedVariant("ur5") {}
+};
+
+TEST_F(BadUr5File, EachProblemNamesItsField) {
+  EXPECT_EQ(problem(good_text_), "no error");
+  json j = good_;
+  j.erase("home_deg");
+  EXPECT_EQ(problem(j), "home_deg: missing");
+  j = good_;
+  j["home_deg"].push_back(0.0);
+  EXPECT_EQ(problem(j).rfind("home_deg: must be 6 angles (degrees), one per joint, not [", 0), 0u) << problem(j);
+  j = good_;
+  j["home_deg"][1] = 400.0;
+  EXPECT_EQ(problem(j), "home_deg[1]: is outside joint 2's limits");
+  j = good_;
+  j["joints"][2]["velocity_deg_s"] = -1;
+  EXPECT_EQ(problem(j), "joints[2].velocity_deg_s: must be positive, not -1");
+  j = good_;
+  j["joints"][3]["name"] = "elbow_joint";
+  EXPECT_EQ(problem(j), "joints[3].name: 'elbow_joint' is taken already; joint names must differ");
+  j = good_;
+  j["joints"][0]["lower_deg"] = "low";
+  EXPECT_EQ(problem(j), "joints[0].lower_deg: must be a finite number, not \"low\"");
+  j = good_;
+  j["gripper_link"] = "tool0";
+  EXPECT_EQ(problem(j).rfind("gripper_link: unknown field (known: ", 0), 0u) << problem(j);
+  j = good_;
+  j.erase("format");  // the UR5's older format, before issue 35
+  EXPECT_EQ(problem(j), "format: must be \"costar-robot-description/1\", not missing");
+  j = good_;
+  j["kinematics"]["solver"] = "kuka";
+  EXPECT_EQ(problem(j), "kinematics.solver: unknown solver 'kuka' (known: chain, srs, ur)");
+  j = good_;
+  j["kinematics"]["d"] = {0.1, 0.2};  // the older format's DH table: the joints are the table now
+  EXPECT_EQ(problem(j), "kinematics.d: solver 'ur' takes no parameters (its geometry comes from the joints)");
+  j = good_;
+  j["joints"] = json::array();
+  EXPECT_EQ(problem(j), "joints: must be a list of 1 to 8 joints, not []");
+  EXPECT_EQ(problem(std::string("{\"name\": ")).rfind("not valid JSON: ", 0), 0u);
+  EXPECT_EQ(problem(std::string("[1, 2]")).rfind("(top level): must be an object", 0), 0u);
+}
+
+// The closed form needs the joints in DH form and of the UR structure; anything else is refused
+// naming the joint, before an arm moves on wrong kinematics.
+TEST_F(BadUr5File, AChainNotInTheUrsDhFormIsRefusedNamingTheJoint) {
+  json j = good_;
+  j["joints"][1]["rpy"] = {1.5707963267948966, 0.1, 0};
+  EXPECT_EQ(problem(j), "joints[1].origin: must be [a, 0, d] turned about x only (rpy [alpha, 0, 0]) in DH form");
+  j = good_;
+  j["joints"][2]["origin"] = {-0.425, 0.01, 0};
+  EXPECT_EQ(problem(j), "joints[2].origin: must be [a, 0, d] turned about x only (rpy [alpha, 0, 0]) in DH form");
+  j = good_;
+  j["joints"][3]["axis"] = {0, 1, 0};
+  EXPECT_EQ(problem(j), "joints[3].axis: must be [0, 0, 1] in DH form");
+  j = good_;
+  j["joints"][0]["origin"] = {0, 0, 0.1};
+  EXPECT_EQ(problem(j).rfind("joints[0].origin: must be [0, 0, 0]", 0), 0u) << problem(j);
+  j = good_;
+  j["tool"]["origin"] = {0, 0, 1e308};  // issue 27 (scripts/hostile_cli.sh): 1e308 reached the closed form
+  EXPECT_EQ(problem(j), "tool.origin: a and d must be from -10 to 10 m (no arm is 10 m long)");
+  j = good_;
+  j["joints"][1].erase("rpy");  // DH form, but alpha1 = 0 is not a UR arm
+  EXPECT_EQ(problem(j).rfind("Ur5Kinematics: the closed form needs alpha", 0), 0u) << problem(j);
+}
 
 TEST_F(BadIiwaFile, EachProblemNamesItsField) {
   EXPECT_EQ(problem(good_text_), "no error");

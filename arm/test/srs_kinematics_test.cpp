@@ -13,6 +13,7 @@
 #include <random>
 
 #include "arm/robot_description.h"
+#include "arm/test/published_arms.h"
 #include "planning/robot_model.h"
 
 namespace costar::arm {
@@ -50,7 +51,7 @@ void expectSamePose(const world::Pose& actual, const world::Pose& expected, doub
 
 TEST(SrsDescription, FileMatchesTheBuiltInIiwa14) {
   const SrsArmDescription description = readSrsArmDescription(COSTAR_IIWA14_DESCRIPTION);
-  const SrsGeometry expected = SrsGeometry::iiwa14();
+  const SrsGeometry expected = published::iiwa14Geometry();
   EXPECT_EQ(description.name, "iiwa14");
   EXPECT_EQ(description.base_link, "iiwa_link_0");
   EXPECT_EQ(description.tool_frame, "tool0");
@@ -61,8 +62,8 @@ TEST(SrsDescription, FileMatchesTheBuiltInIiwa14) {
   EXPECT_NEAR(description.geometry.elbow_to_wrist, 0.400, 1e-12);
   EXPECT_TRUE(description.geometry.wrist_to_flange.isApprox(expected.wrist_to_flange, 1e-12));
   EXPECT_EQ(description.geometry.axis_sign, expected.axis_sign);
-  EXPECT_TRUE(description.limits.lower.isApprox(SrsLimits::iiwa14().lower, 1e-12));
-  EXPECT_TRUE(description.limits.upper.isApprox(SrsLimits::iiwa14().upper, 1e-12));
+  EXPECT_TRUE(description.limits.lower.isApprox(published::iiwa14Limits().lower, 1e-12));
+  EXPECT_TRUE(description.limits.upper.isApprox(published::iiwa14Limits().upper, 1e-12));
   EXPECT_TRUE(description.max_velocity.isApprox(degrees({85, 85, 100, 75, 130, 135, 135}), 1e-12));
   EXPECT_TRUE(description.home.isApprox(degrees({0, 6, 0, -108, 0, 66, -90}), 1e-12));
 }
@@ -118,10 +119,10 @@ TEST_F(SrsDescriptionErrors, NameTheFileAndTheField) {
 TEST(SrsKinematics, ForwardMatchesKdlOnTheGeneratedUrdf) {
   const planning::RobotModel model = planning::RobotModel::fromUrdf(COSTAR_IIWA14_URDF, "iiwa_link_0", "tool0");
   ASSERT_EQ(model.dof(), 7u);
-  const SrsLimits limits = SrsLimits::iiwa14();
+  const SrsLimits limits = published::iiwa14Limits();
   EXPECT_TRUE(model.lowerLimits().isApprox(limits.lower, 1e-9));
   EXPECT_TRUE(model.upperLimits().isApprox(limits.upper, 1e-9));
-  const SrsKinematics kinematics;
+  const SrsKinematics kinematics(published::iiwa14Geometry());
   std::mt19937_64 random(11);
   double worst_position = 0.0;
   double worst_angle = 0.0;
@@ -137,7 +138,7 @@ TEST(SrsKinematics, ForwardMatchesKdlOnTheGeneratedUrdf) {
 }
 
 TEST(SrsKinematics, ForwardKnownConfigurations) {
-  const SrsKinematics kinematics;
+  const SrsKinematics kinematics(published::iiwa14Geometry());
   // Straight up: the flange 0.36 + 0.42 + 0.40 + 0.126 m above the base, parallel to it.
   expectSamePose(kinematics.forward(Joints7::Zero()), world::Pose(Eigen::Translation3d(0, 0, 1.306)), 1e-12);
   // Joint 2 at +90 degrees lays the arm along +x (about +y).
@@ -153,7 +154,7 @@ TEST(SrsKinematics, ForwardKnownConfigurations) {
 // Closed-form solutions at a given arm angle
 
 TEST(SrsKinematics, EverySolutionAtAnArmAngleReproducesThePose) {
-  const SrsKinematics kinematics;
+  const SrsKinematics kinematics(published::iiwa14Geometry());
   std::mt19937_64 random(12);
   std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
   std::array<Joints7, SrsKinematics::kMaxSolutions> solutions;
@@ -200,8 +201,8 @@ struct RoundTripStatistics {
 };
 
 RoundTripStatistics roundTrip(std::uint64_t seed, int poses, bool random_seed_configuration) {
-  const SrsKinematics kinematics;
-  const SrsLimits limits = SrsLimits::iiwa14();
+  const SrsKinematics kinematics(published::iiwa14Geometry());
+  const SrsLimits limits = published::iiwa14Limits();
   const Joints7 home = degrees({0, 30, 0, -80, 0, 70, 0});
   std::mt19937_64 random(seed);
   RoundTripStatistics statistics;
@@ -242,8 +243,8 @@ TEST(SrsKinematics, RoundTripFromRandomSeedsOnTenThousandReachablePoses) {
 }
 
 TEST(SrsKinematics, NearestToASolutionIsThatSolution) {
-  const SrsKinematics kinematics;
-  const SrsLimits limits = SrsLimits::iiwa14();
+  const SrsKinematics kinematics(published::iiwa14Geometry());
+  const SrsLimits limits = published::iiwa14Limits();
   std::mt19937_64 random(13);
   for (int n = 0; n < 1000; ++n) {
     const Joints7 q = randomWithin(limits, random);
@@ -254,8 +255,8 @@ TEST(SrsKinematics, NearestToASolutionIsThatSolution) {
 }
 
 TEST(SrsKinematics, SmallPoseChangeGivesSmallJointChange) {
-  const SrsKinematics kinematics;
-  const SrsLimits limits = SrsLimits::iiwa14();
+  const SrsKinematics kinematics(published::iiwa14Geometry());
+  const SrsLimits limits = published::iiwa14Limits();
   std::mt19937_64 random(14);
   std::normal_distribution<double> noise(0.0, 1.0);
   double worst = 0.0;
@@ -283,8 +284,8 @@ TEST(SrsKinematics, SmallPoseChangeGivesSmallJointChange) {
 }
 
 TEST(SrsKinematics, UnreachablePosesHaveNoSolution) {
-  const SrsKinematics kinematics;
-  const SrsLimits limits = SrsLimits::iiwa14();
+  const SrsKinematics kinematics(published::iiwa14Geometry());
+  const SrsLimits limits = published::iiwa14Limits();
   const Joints7 home = degrees({0, 30, 0, -80, 0, 70, 0});
   std::array<Joints7, SrsKinematics::kMaxSolutions> solutions;
   // Beyond reach: the wrist centre 0.82 m from the shoulder at most.
@@ -313,8 +314,8 @@ TEST(SrsKinematics, UnreachablePosesHaveNoSolution) {
 }
 
 TEST(SrsKinematics, SingularConfigurationsGiveFiniteExactSolutions) {
-  const SrsKinematics kinematics;
-  const SrsLimits limits = SrsLimits::iiwa14();
+  const SrsKinematics kinematics(published::iiwa14Geometry());
+  const SrsLimits limits = published::iiwa14Limits();
   const Joints7 home = degrees({0, 30, 0, -80, 0, 70, 0});
   // The wrist centre on joint 1's axis: x = 0.42 sin(q2) + 0.40 sin(q2 - q4) = 0 with q3 = 0
   // (joint 4 turns about -y).
@@ -359,8 +360,8 @@ TEST(SrsKinematics, SingularConfigurationsGiveFiniteExactSolutions) {
 }
 
 TEST(SrsKinematics, AcceptableCallbackChoosesAmongSolutions) {
-  const SrsKinematics kinematics;
-  const SrsLimits limits = SrsLimits::iiwa14();
+  const SrsKinematics kinematics(published::iiwa14Geometry());
+  const SrsLimits limits = published::iiwa14Limits();
   const Joints7 q = degrees({10, 40, 0, -70, 20, 60, 0});
   const world::Pose pose = kinematics.forward(q);
   // Without a callback: q itself. With one that wants joint 3 above 30 degrees: another arm
@@ -392,8 +393,8 @@ TEST(SrsKinematics, KdlLevenbergMarquardtBaselineSolvesTheUrdf) {
   // The paper's solver on the same arm, as the benchmark's baseline: with 10 random restarts it
   // finds most poses; every answer it gives is within limits and reaches the pose.
   const planning::RobotModel model = planning::RobotModel::fromUrdf(COSTAR_IIWA14_URDF, "iiwa_link_0", "tool0");
-  const SrsKinematics kinematics;
-  const SrsLimits limits = SrsLimits::iiwa14();
+  const SrsKinematics kinematics(published::iiwa14Geometry());
+  const SrsLimits limits = published::iiwa14Limits();
   const Joints7 home = degrees({0, 30, 0, -80, 0, 70, 0});
   std::mt19937_64 random(15);
   int solved = 0;
@@ -410,13 +411,13 @@ TEST(SrsKinematics, KdlLevenbergMarquardtBaselineSolvesTheUrdf) {
 }
 
 TEST(SrsKinematics, RejectsBadGeometry) {
-  SrsGeometry geometry = SrsGeometry::iiwa14();
+  SrsGeometry geometry = published::iiwa14Geometry();
   geometry.shoulder_to_elbow = 0.0;
   EXPECT_THROW(SrsKinematics{geometry}, std::invalid_argument);
-  geometry = SrsGeometry::iiwa14();
+  geometry = published::iiwa14Geometry();
   geometry.axis_sign[2] = 0;
   EXPECT_THROW(SrsKinematics{geometry}, std::invalid_argument);
-  geometry = SrsGeometry::iiwa14();
+  geometry = published::iiwa14Geometry();
   geometry.wrist_to_flange.linear() *= 2.0;
   EXPECT_THROW(SrsKinematics{geometry}, std::invalid_argument);
 }
@@ -436,10 +437,10 @@ TEST_F(SrsAdapter, TheFactoryMakesItFromTheDescription) {
   EXPECT_EQ(kinematics_->jointCount(), 7);
   EXPECT_DOUBLE_EQ(kinematics_->limits().max_position[6], 175 * kDegree);
   EXPECT_DOUBLE_EQ(kinematics_->limits().max_velocity[0], 85 * kDegree);
-  const SrsKinematics reference;
+  const SrsKinematics reference(published::iiwa14Geometry());
   std::mt19937_64 random(11);
   for (int trial = 0; trial < 50; ++trial) {
-    const Joints7 q = randomWithin(SrsLimits::iiwa14(), random);
+    const Joints7 q = randomWithin(published::iiwa14Limits(), random);
     EXPECT_TRUE(kinematics_->forward(toVector(q)).isApprox(reference.forward(q), 1e-15)) << trial;
   }
 }
@@ -449,7 +450,7 @@ TEST_F(SrsAdapter, TheFactoryMakesItFromTheDescription) {
 // configurations always have solutions.
 TEST_F(SrsAdapter, SolutionsNearTheSeedReachThePoseWithinLimits) {
   std::mt19937_64 random(2026);
-  const SrsLimits limits = SrsLimits::iiwa14();
+  const SrsLimits limits = published::iiwa14Limits();
   int total = 0;
   for (int trial = 0; trial < 500; ++trial) {
     const Joints7 target = randomWithin(limits, random, 0.05);

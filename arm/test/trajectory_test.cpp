@@ -10,6 +10,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "arm/test/published_arms.h"
 #include "arm/ur5_kinematics.h"
 
 namespace costar::arm {
@@ -167,7 +168,7 @@ JointVector clampInside(JointVector q, const JointLimits& limits) {
 
 // Limits with different values per joint, to exercise the synchronization.
 JointLimits unevenLimits() {
-  JointLimits limits = JointLimits::ur5();
+  JointLimits limits = published::ur5Limits();
   limits.max_velocity = {2.0, 2.5, 3.0, 3.1, 1.5, 1.2};
   limits.max_acceleration = {1.0, 4.0, 8.0, 2.0, 6.0, 3.0};
   limits.min_position[2] = -3.0;
@@ -193,7 +194,7 @@ TEST(PointToPoint, RandomMovesRespectTheLimitsAndStartAndEndAtRest) {
   std::mt19937_64 random(11);
   std::uniform_real_distribution<double> scale_distribution(0.3, 1.0);
   for (int trial = 0; trial < 10000; ++trial) {
-    const JointLimits limits = trial % 2 == 0 ? JointLimits::ur5() : unevenLimits();
+    const JointLimits limits = trial % 2 == 0 ? published::ur5Limits() : unevenLimits();
     // Not a structured binding: the lambda below uses `from` (clang before 16 cannot capture one).
     const auto move = randomMove(random, limits);
     const JointVector& from = move.first;
@@ -236,7 +237,7 @@ double trapezoidTime(double v, double a) { return v * v / a >= 1.0 ? 2.0 * std::
 TEST(PointToPoint, DurationIsTheAnalyticTrapezoidTime) {
   std::mt19937_64 random(12);
   for (int trial = 0; trial < 1000; ++trial) {
-    const JointLimits limits = trial % 2 == 0 ? JointLimits::ur5() : unevenLimits();
+    const JointLimits limits = trial % 2 == 0 ? published::ur5Limits() : unevenLimits();
     const auto [from, to] = randomMove(random, limits);
     const double scale = 0.5 + 0.5 * (trial % 3) / 2.0;
     const JointTrajectory trajectory = JointTrajectory::pointToPoint(from, to, limits, scale);
@@ -259,27 +260,27 @@ TEST(PointToPoint, WithEqualLimitsTheLongestJointMoveSetsTheDuration) {
   const JointVector to = {0.5, -3.0, 1.0, 0.1, -0.2, 2.9};
   // Joint 2 moves 3 rad, more than the v^2 / a = pi^2 / 4 = 2.47 rad it needs to reach full
   // speed and stop: a trapezoid, d / v + v / a.
-  const JointTrajectory full = JointTrajectory::pointToPoint(from, to, JointLimits::ur5(), 1.0);
+  const JointTrajectory full = JointTrajectory::pointToPoint(from, to, published::ur5Limits(), 1.0);
   EXPECT_NEAR(toSeconds(full.duration()), 3.0 / kPi + kPi / 4.0, 1e-9);
   // Half speed scales velocity and acceleration: 3 / (pi / 2) + (pi / 2) / 2.
-  const JointTrajectory half = JointTrajectory::pointToPoint(from, to, JointLimits::ur5(), 0.5);
+  const JointTrajectory half = JointTrajectory::pointToPoint(from, to, published::ur5Limits(), 0.5);
   EXPECT_NEAR(toSeconds(half.duration()), 6.0 / kPi + kPi / 4.0, 1e-9);
   // A short move is triangular: 2 * sqrt(d / a).
   const JointVector near = {0.0, 0.1, 0.0, 0.0, 0.0, 0.0};
-  EXPECT_NEAR(toSeconds(JointTrajectory::pointToPoint(from, near, JointLimits::ur5(), 1.0).duration()),
+  EXPECT_NEAR(toSeconds(JointTrajectory::pointToPoint(from, near, published::ur5Limits(), 1.0).duration()),
               2.0 * std::sqrt(0.1 / 4.0), 1e-9);
 }
 
 TEST(PointToPoint, NoMotionHasZeroDuration) {
   const JointVector q = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
-  const JointTrajectory trajectory = JointTrajectory::pointToPoint(q, q, JointLimits::ur5(), 1.0);
+  const JointTrajectory trajectory = JointTrajectory::pointToPoint(q, q, published::ur5Limits(), 1.0);
   EXPECT_EQ(trajectory.duration(), Duration(0));
   expectAtRestAt(trajectory.sample(Duration(0)), q, 0.0);
   expectAtRestAt(trajectory.sample(milliseconds(5)), q, 0.0);
 }
 
 TEST(PointToPoint, RejectsInvalidInputWithClearMessages) {
-  const JointLimits limits = JointLimits::ur5();
+  const JointLimits limits = published::ur5Limits();
   const JointVector zero = JointVector::zero(kJointCount);
   JointVector not_finite = JointVector::zero(kJointCount);
   not_finite[1] = std::numeric_limits<double>::quiet_NaN();
@@ -318,7 +319,7 @@ TEST(PointToPoint, RejectsInvalidInputWithClearMessages) {
 TEST(JointTrajectory, SampleClampsOutsideTheMotionAndCopiesAreEqual) {
   const JointVector from = {0.0, -1.0, 1.0, 0.0, 0.5, 0.0};
   const JointVector to = {1.0, -0.5, 0.2, 0.3, 0.5, -1.0};
-  const JointTrajectory trajectory = JointTrajectory::pointToPoint(from, to, JointLimits::ur5(), 0.7);
+  const JointTrajectory trajectory = JointTrajectory::pointToPoint(from, to, published::ur5Limits(), 0.7);
   expectAtRestAt(trajectory.sample(Duration(-5'000'000)), from, 0.0);
   expectAtRestAt(trajectory.sample(trajectory.duration() + milliseconds(100)), to, 0.0);
   EXPECT_EQ(trajectory.initialPosition(), from);
@@ -340,7 +341,7 @@ std::vector<JointVector> randomPath(std::mt19937_64& random, const JointLimits& 
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::vector<JointVector> path;
   if (kind == 3) {
-    static const Ur5Kinematics kinematics;
+    static const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
     JointVector q = randomInside(random, limits, 0.5);
     q[1] = -1.0 + 0.5 * unit(random);
     q[2] = 1.5 + 0.5 * unit(random);  // away from the elbow singularity
@@ -480,7 +481,7 @@ TEST(AlongPath, RandomPathsRespectTheLimitsAndTheTolerance) {
   std::uniform_real_distribution<double> scale_distribution(0.3, 1.0);
   int kinds[4] = {0, 0, 0, 0};  // paths of at least 10 points, per kind
   for (int trial = 0; trial < 10000; ++trial) {
-    const JointLimits limits = trial % 3 == 0 ? unevenLimits() : JointLimits::ur5();
+    const JointLimits limits = trial % 3 == 0 ? unevenLimits() : published::ur5Limits();
     const int kind = trial % 4;
     const std::vector<JointVector> path = randomPath(random, limits, kind);
     kinds[kind] += path.size() >= 10;
@@ -503,7 +504,7 @@ TEST(AlongPath, RandomPathsRespectTheLimitsAndTheTolerance) {
 TEST(AlongPath, TwoPointsOrCollinearPointsGiveThePointToPointMotion) {
   std::mt19937_64 random(14);
   for (int trial = 0; trial < 200; ++trial) {
-    const JointLimits limits = trial % 2 == 0 ? JointLimits::ur5() : unevenLimits();
+    const JointLimits limits = trial % 2 == 0 ? published::ur5Limits() : unevenLimits();
     const auto [from, to] = randomMove(random, limits);
     const double scale = 0.3 + 0.7 * (trial % 5) / 4.0;
     const JointTrajectory direct = JointTrajectory::pointToPoint(from, to, limits, scale);
@@ -535,7 +536,7 @@ TEST(AlongPath, TwoPointsOrCollinearPointsGiveThePointToPointMotion) {
 TEST(AlongPath, BlendsCornersInsteadOfStopping) {
   // Two legs at right angles: blended, the motion takes less than two stops would, and it
   // passes the corner within the tolerance without stopping there.
-  const JointLimits limits = JointLimits::ur5();
+  const JointLimits limits = published::ur5Limits();
   const JointVector a = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
   const JointVector b = {1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
   const JointVector c = {1.0, 1.0, 0.0, 0.0, 0.0, 0.0};
@@ -569,7 +570,7 @@ TEST(AlongPath, BlendsCornersInsteadOfStopping) {
 }
 
 TEST(AlongPath, ReversalsAndSinglePoints) {
-  const JointLimits limits = JointLimits::ur5();
+  const JointLimits limits = published::ur5Limits();
   const JointVector a = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
   const JointVector b = {0.5, -0.5, 0.2, 0.0, 0.0, 0.1};
   const JointTrajectory there_and_back = JointTrajectory::alongPath({a, b, a}, limits, 1.0);
@@ -583,7 +584,7 @@ TEST(AlongPath, ReversalsAndSinglePoints) {
 }
 
 TEST(AlongPath, RejectsInvalidInputWithClearMessages) {
-  const JointLimits limits = JointLimits::ur5();
+  const JointLimits limits = published::ur5Limits();
   EXPECT_THROW(JointTrajectory::alongPath({}, limits, 1.0), std::invalid_argument);
   const JointVector zero = JointVector::zero(kJointCount);
   JointVector not_finite = JointVector::zero(kJointCount);
@@ -616,7 +617,7 @@ TEST(StopFrom, StopsAlongTheDirectionOfMotionWithinTheAccelerationLimits) {
   std::mt19937_64 random(15);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int trial = 0; trial < 10000; ++trial) {
-    const JointLimits limits = trial % 2 == 0 ? JointLimits::ur5() : unevenLimits();
+    const JointLimits limits = trial % 2 == 0 ? published::ur5Limits() : unevenLimits();
     const double scale = 0.2 + 0.8 * unit(random);
     // A state in the middle of a motion: a point-to-point move or a path.
     const bool straight = trial % 3 != 0;
@@ -673,7 +674,7 @@ TEST(StopFrom, AtRestStaysPut) {
   state.position = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
   state.velocity = JointVector::zero(kJointCount);
   state.acceleration = {1.0, 0.0, 0.0, 0.0, 0.0, 0.0};  // ignored
-  const JointTrajectory stop = JointTrajectory::stopFrom(state, JointLimits::ur5());
+  const JointTrajectory stop = JointTrajectory::stopFrom(state, published::ur5Limits());
   EXPECT_EQ(stop.duration(), Duration(0));
   expectAtRestAt(stop.sample(Duration(0)), state.position, 0.0);
 }
@@ -683,7 +684,7 @@ TEST(StopFrom, RejectsNonFiniteStates) {
   state.position = JointVector::zero(kJointCount);
   state.velocity = JointVector::zero(kJointCount);
   state.velocity[3] = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(JointTrajectory::stopFrom(state, JointLimits::ur5()), std::invalid_argument);
+  EXPECT_THROW(JointTrajectory::stopFrom(state, published::ur5Limits()), std::invalid_argument);
 }
 
 TEST(JointLengths, TrajectoriesTakeTheirLengthFromTheLimits) {

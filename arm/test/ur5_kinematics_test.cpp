@@ -1,4 +1,5 @@
 #include "arm/ur5_kinematics.h"
+#include "arm/test/published_arms.h"
 
 #include <gtest/gtest.h>
 
@@ -74,18 +75,19 @@ void expectValidSolutions(const Ur5Kinematics& kinematics, const world::Pose& ta
 }
 
 TEST(Ur5Kinematics, ForwardMatchesAnIndependentProductOfDhMatrices) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   std::mt19937_64 random(1);
   for (int trial = 0; trial < 1000; ++trial) {
     const JointVector q = randomJoints(random, -2 * kTwoPi, 2 * kTwoPi);
-    const world::Pose expected = dhProduct(DhParameters::ur5(), q);
+    const world::Pose expected = dhProduct(published::ur5Dh(), q);
     EXPECT_LE((kinematics.forward(q).matrix() - expected.matrix()).cwiseAbs().maxCoeff(), 1e-14);
   }
 }
 
 TEST(Ur5Kinematics, ZeroConfigurationIsTheArmStretchedAlongMinusX) {
   // Published UR5 zero pose: flange at (a2 + a3, -(d4 + d6), d1 - d5), tool z along -y.
-  const world::Pose flange = Ur5Kinematics().forward(JointVector::zero(kJointCount));
+  const world::Pose flange =
+      Ur5Kinematics(published::ur5Dh(), published::ur5Limits()).forward(JointVector::zero(kJointCount));
   EXPECT_NEAR(flange.translation().x(), -0.425 - 0.39225, 1e-15);
   EXPECT_NEAR(flange.translation().y(), -0.10915 - 0.0823, 1e-15);
   EXPECT_NEAR(flange.translation().z(), 0.089159 - 0.09465, 1e-15);
@@ -93,7 +95,7 @@ TEST(Ur5Kinematics, ZeroConfigurationIsTheArmStretchedAlongMinusX) {
 }
 
 TEST(Ur5Kinematics, EverySolutionReachesThePoseAndTheOriginalIsAmongThem) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   std::mt19937_64 random(2);
   std::array<JointVector, Ur5Kinematics::kMaxSolutions> solutions;
   int total_solutions = 0;
@@ -121,7 +123,7 @@ TEST(Ur5Kinematics, EverySolutionReachesThePoseAndTheOriginalIsAmongThem) {
 }
 
 TEST(Ur5Kinematics, VectorOverloadReturnsTheSameSolutions) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   std::mt19937_64 random(3);
   std::array<JointVector, Ur5Kinematics::kMaxSolutions> solutions;
   for (int trial = 0; trial < 100; ++trial) {
@@ -168,7 +170,7 @@ std::optional<JointVector> numericalInverse(const Ur5Kinematics& kinematics, con
 }
 
 TEST(Ur5Kinematics, NoSolutionIsMissedComparedWithANumericalSearch) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   std::mt19937_64 random(4);
   int numerical_solutions = 0;
   for (int trial = 0; trial < 100; ++trial) {
@@ -188,7 +190,7 @@ TEST(Ur5Kinematics, NoSolutionIsMissedComparedWithANumericalSearch) {
 TEST(Ur5Kinematics, WristSingularityGivesValidSolutionsWithTheChosenQ6) {
   // q5 = 0 or pi: joint 6's axis parallel to those of joints 2, 3 and 4, a one-parameter family
   // of solutions (q2, q3, q4 and q6 move together). q6 takes the chosen value.
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   std::mt19937_64 random(5);
   int adjusted = 0;
   for (int trial = 0; trial < 1000; ++trial) {
@@ -222,8 +224,8 @@ TEST(Ur5Kinematics, ShoulderSingularityGivesValidSolutions) {
   // The wrist centre (origin of frame 5) at distance d4 from joint 1's axis: the two shoulder
   // branches merge. In frame 1 its x coordinate is a2 c2 + a3 c23 + d5 sin(q2 + q3 + q4); zero
   // puts it there.
-  const Ur5Kinematics kinematics;
-  const DhParameters dh = DhParameters::ur5();
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
+  const DhParameters dh = published::ur5Dh();
   std::mt19937_64 random(6);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (int trial = 0; trial < 1000; ++trial) {
@@ -251,7 +253,7 @@ TEST(Ur5Kinematics, ShoulderSingularityGivesValidSolutions) {
 }
 
 TEST(Ur5Kinematics, ElbowSingularityGivesValidSolutions) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   std::mt19937_64 random(7);
   for (int trial = 0; trial < 1000; ++trial) {
     JointVector q = randomJoints(random);
@@ -265,7 +267,7 @@ TEST(Ur5Kinematics, ElbowSingularityGivesValidSolutions) {
 }
 
 TEST(Ur5Kinematics, UnreachablePosesHaveNoSolution) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   std::array<JointVector, Ur5Kinematics::kMaxSolutions> solutions;
   const auto expect_none = [&](const world::Pose& pose, const char* what) {
     EXPECT_EQ(kinematics.inverse(pose, solutions), 0) << what;
@@ -337,7 +339,7 @@ double euclidean(const JointVector& a, const JointVector& b) {
 }
 
 TEST(Ur5Kinematics, InverseNearestPicksTheClosestSolutionExpressedNearTheSeed) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   std::mt19937_64 random(9);
   std::uniform_real_distribution<double> nudge(-0.02, 0.02);
   std::uniform_int_distribution<int> turns(-1, 1);
@@ -390,7 +392,7 @@ TEST(Ur5Kinematics, InverseNearestPicksTheClosestSolutionExpressedNearTheSeed) {
 }
 
 TEST(Ur5Kinematics, InverseNearestRespectsJointLimits) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   const JointVector q = {0.3, -1.2, 1.5, -1.9, -1.4, 0.6};  // elbow "up" (q3 > 0)
   const world::Pose target = kinematics.forward(q);
   const std::vector<JointVector> solutions = kinematics.inverse(target);
@@ -401,7 +403,7 @@ TEST(Ur5Kinematics, InverseNearestRespectsJointLimits) {
   EXPECT_LE(maxWrappedDifference(*free, q), 1e-9);
 
   // Elbow limited to negative angles: another solution, with q3 < 0, the nearest allowed.
-  JointLimits limits = JointLimits::ur5();
+  JointLimits limits = published::ur5Limits();
   limits.max_position[2] = 0.0;
   const std::optional<JointVector> limited = kinematics.nearestWithin(target, q, &limits);
   ASSERT_TRUE(limited);
@@ -421,7 +423,7 @@ TEST(Ur5Kinematics, InverseNearestRespectsJointLimits) {
   std::uniform_real_distribution<double> bound(0.0, 2 * kTwoPi);
   int found = 0;
   for (int trial = 0; trial < 2000; ++trial) {
-    JointLimits random_limits = JointLimits::ur5();
+    JointLimits random_limits = published::ur5Limits();
     for (int j = 0; j < kJointCount; ++j) {
       random_limits.min_position[j] = -bound(random);
       random_limits.max_position[j] = random_limits.min_position[j] + bound(random);
@@ -444,7 +446,7 @@ TEST(Ur5Kinematics, InverseNearestRespectsJointLimits) {
   // A seed near the upper limit of joint 1, whose nearest equivalent is beyond it.
   JointVector seed = q;
   seed[0] = q[0] + kTwoPi - 0.001;
-  JointLimits tight = JointLimits::ur5();
+  JointLimits tight = published::ur5Limits();
   tight.max_position[0] = q[0] + kTwoPi - 0.01;
   const std::optional<JointVector> unlimited = kinematics.nearestWithin(target, seed);
   ASSERT_TRUE(unlimited);
@@ -455,14 +457,14 @@ TEST(Ur5Kinematics, InverseNearestRespectsJointLimits) {
   EXPECT_NEAR(euclidean(*wrapped, seed), euclidean(*bruteForceNearest(solutions, seed, &tight), seed), 1e-9);
 
   // Limits no solution satisfies: none.
-  JointLimits impossible = JointLimits::ur5();
+  JointLimits impossible = published::ur5Limits();
   impossible.min_position[4] = 3.0;
   impossible.max_position[4] = 3.0;
   EXPECT_FALSE(kinematics.nearestWithin(target, q, &impossible));
 }
 
 TEST(Ur5Kinematics, InverseNearestKeepsTheSeedsQ6AtTheWristSingularity) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   const JointVector q = {0.5, -1.0, 1.2, -0.7, 0.0, 0.4};
   const world::Pose target = kinematics.forward(q);
   JointVector seed = q;
@@ -479,7 +481,7 @@ TEST(Ur5Kinematics, InverseNearestKeepsTheSeedsQ6AtTheWristSingularity) {
 }
 
 TEST(Ur5Kinematics, InverseNearestRejectsANonFiniteSeed) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   JointVector seed = JointVector::zero(kJointCount);
   seed[2] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(kinematics.nearestWithin(kinematics.forward(JointVector::zero(kJointCount)), seed),
@@ -488,10 +490,10 @@ TEST(Ur5Kinematics, InverseNearestRejectsANonFiniteSeed) {
 
 TEST(Ur5Kinematics, OtherUrArmsWork) {
   // UR10 (CB-series) parameters.
-  DhParameters ur10 = DhParameters::ur5();
+  DhParameters ur10 = published::ur5Dh();
   ur10.d = {0.1273, 0.0, 0.0, 0.163941, 0.1157, 0.0922};
   ur10.a = {0.0, -0.612, -0.5723, 0.0, 0.0, 0.0};
-  const Ur5Kinematics kinematics(ur10);
+  const Ur5Kinematics kinematics(ur10, published::ur5Limits());
   std::mt19937_64 random(10);
   for (int trial = 0; trial < 1000; ++trial) {
     const JointVector q = randomJoints(random);
@@ -504,30 +506,31 @@ TEST(Ur5Kinematics, OtherUrArmsWork) {
 }
 
 TEST(Ur5Kinematics, RejectsParametersWithoutTheUrStructure) {
-  DhParameters offset_wrist = DhParameters::ur5();
+  DhParameters offset_wrist = published::ur5Dh();
   offset_wrist.a[3] = 0.05;
-  EXPECT_THROW(Ur5Kinematics{offset_wrist}, std::invalid_argument);
-  DhParameters twisted = DhParameters::ur5();
+  EXPECT_THROW(Ur5Kinematics(offset_wrist, published::ur5Limits()), std::invalid_argument);
+  DhParameters twisted = published::ur5Dh();
   twisted.alpha[1] = 0.1;
-  EXPECT_THROW(Ur5Kinematics{twisted}, std::invalid_argument);
-  DhParameters no_flange = DhParameters::ur5();
+  EXPECT_THROW(Ur5Kinematics(twisted, published::ur5Limits()), std::invalid_argument);
+  DhParameters no_flange = published::ur5Dh();
   no_flange.d[5] = 0.0;
-  EXPECT_THROW(Ur5Kinematics{no_flange}, std::invalid_argument);
-  DhParameters not_finite = DhParameters::ur5();
+  EXPECT_THROW(Ur5Kinematics(no_flange, published::ur5Limits()), std::invalid_argument);
+  DhParameters not_finite = published::ur5Dh();
   not_finite.d[0] = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(Ur5Kinematics{not_finite}, std::invalid_argument);
+  EXPECT_THROW(Ur5Kinematics(not_finite, published::ur5Limits()), std::invalid_argument);
 }
 
 // --- the Kinematics interface --------------------------------------------------------------
 
 TEST(Kinematics, TheUr5ThroughTheInterfaceGivesItsClosedFormWithinItsLimits) {
-  const std::shared_ptr<const Kinematics> kinematics = std::make_shared<Ur5Kinematics>();
+  const std::shared_ptr<const Kinematics> kinematics =
+      std::make_shared<Ur5Kinematics>(published::ur5Dh(), published::ur5Limits());
   EXPECT_EQ(kinematics->jointCount(), 6);
-  EXPECT_EQ(kinematics->limits().max_velocity, JointLimits::ur5().max_velocity);
+  EXPECT_EQ(kinematics->limits().max_velocity, published::ur5Limits().max_velocity);
   const Ur5Kinematics& concrete = static_cast<const Ur5Kinematics&>(*kinematics);
   std::mt19937_64 random(5);
   std::uniform_real_distribution<double> angle(-3.0, 3.0);
-  const JointLimits limits = JointLimits::ur5();
+  const JointLimits limits = published::ur5Limits();
   for (int trial = 0; trial < 200; ++trial) {
     JointVector q = JointVector::zero(kJointCount);
     for (double& value : q) {
@@ -561,7 +564,7 @@ TEST(Kinematics, TheUr5ThroughTheInterfaceGivesItsClosedFormWithinItsLimits) {
 }
 
 TEST(Kinematics, InverseNearestSkipsWhatTheCallerRejects) {
-  const Ur5Kinematics kinematics;
+  const Ur5Kinematics kinematics(published::ur5Dh(), published::ur5Limits());
   const JointVector q = {0.3, -1.2, 1.4, -0.9, -1.5, 0.2};
   const world::Pose target = kinematics.forward(q);
   IkSolutions near;
@@ -579,10 +582,10 @@ TEST(Kinematics, InverseNearestSkipsWhatTheCallerRejects) {
 
 TEST(Kinematics, LimitsOfTheWrongLengthAreRefused) {
   JointLimits seven{JointVector(7, -3.0), JointVector(7, 3.0), JointVector(7, 1.0), JointVector(7, 1.0)};
-  EXPECT_THROW(Ur5Kinematics(DhParameters::ur5(), seven), std::invalid_argument);
-  JointLimits broken = JointLimits::ur5();
+  EXPECT_THROW(Ur5Kinematics(published::ur5Dh(), seven), std::invalid_argument);
+  JointLimits broken = published::ur5Limits();
   broken.max_velocity[2] = 0.0;
-  EXPECT_THROW(Ur5Kinematics(DhParameters::ur5(), broken), std::invalid_argument);
+  EXPECT_THROW(Ur5Kinematics(published::ur5Dh(), broken), std::invalid_argument);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "arm/test/published_arms.h"
 #include "arm/ur5_kinematics.h"
 #include "calibration/hand_eye.h"
 #include "calibration/marker_corners.h"
@@ -22,7 +23,7 @@ TEST(SimMarker, CornersAreSeenWhereTheSimulatorPutsThem) {
   double worst_pose_deg = 0.0;
   const world::Pose base_in_world(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
   const world::Pose marker_in_flange = world::poseFromXyzRpy(0.0353, 0, 0.075, -M_PI / 2, 0, -M_PI / 2);
-  const arm::Ur5Kinematics kinematics;
+  const arm::Ur5Kinematics kinematics(arm::published::ur5Dh(), arm::published::ur5Limits());
   for (const Eigen::Vector3d& place :
        {Eigen::Vector3d(0.45, -0.15, 0.25), Eigen::Vector3d(0.55, 0.15, 0.3), Eigen::Vector3d(0.5, 0.0, 0.2)}) {
     // The marker facing the drawn camera there; the arm's configuration from the UR5's IK.

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "arm/srs_kinematics.h"
+#include "arm/test/published_arms.h"
 #include "planning/robot_model.h"
 #include "sim/test/arm_model_fixture.h"
 
@@ -35,7 +36,7 @@ TEST_F(Iiwa14Model, HasTheDescribedJointsActuatorsAndHome) {
   ASSERT_EQ(model_->nq, 7);
   ASSERT_EQ(model_->nv, 7);
   ASSERT_EQ(model_->nu, 7);
-  const arm::SrsLimits limits = arm::SrsLimits::iiwa14();
+  const arm::SrsLimits limits = arm::published::iiwa14Limits();
   const std::array<double, 7> torque = {320, 320, 176, 176, 110, 40, 40};
   for (int i = 0; i < 7; ++i) {
     const std::string name = "iiwa_joint_" + std::to_string(i + 1);
@@ -72,8 +73,8 @@ TEST_F(Iiwa14Model, HasTheDescribedJointsActuatorsAndHome) {
 
 TEST_F(Iiwa14Model, ForwardKinematicsAgreesWithKdlAndTheAnalyticSolver) {
   const planning::RobotModel kdl = planning::RobotModel::fromUrdf(COSTAR_IIWA14_URDF, "iiwa_link_0", "tool0");
-  const arm::SrsKinematics analytic;
-  const arm::SrsLimits limits = arm::SrsLimits::iiwa14();
+  const arm::SrsKinematics analytic(arm::published::iiwa14Geometry());
+  const arm::SrsLimits limits = arm::published::iiwa14Limits();
   std::mt19937_64 random(1111);
   double worst_position = 0.0;
   double worst_angle = 0.0;
@@ -129,7 +130,7 @@ TEST_F(Iiwa14Model, WithoutControlGravityPullsTheArmDownAndItStaysFinite) {
   }
   ASSERT_TRUE(positions().allFinite());
   EXPECT_GT((positions() - start).cwiseAbs().maxCoeff(), 0.1);
-  const arm::SrsLimits limits = arm::SrsLimits::iiwa14();
+  const arm::SrsLimits limits = arm::published::iiwa14Limits();
   // Joint limits hold it (within the soft constraint's give).
   EXPECT_TRUE((positions().array() >= limits.lower.array() - 0.05).all());
   EXPECT_TRUE((positions().array() <= limits.upper.array() + 0.05).all());

@@ -178,7 +178,7 @@ class SmartMoveMotion : public ::testing::Test {
   arm::ArmConfig armConfig() const {
     arm::ArmConfig c;
     c.home = robot.home;
-    c.tcp_in_flange = robot.tool_in_flange * Eigen::Translation3d(0, 0, 0.15);
+    c.tcp_in_flange = world::Pose(Eigen::Translation3d(0, 0, 0.15));
     c.joint_names = robot.joint_names;
     return c;
   }

@@ -1,6 +1,6 @@
 // The simulated LBR iiwa 14 cell (workcells/iiwa-sim.json), the second robot of the one generic
-// simulated workcell, with the 3-finger adaptive gripper on its flange: the composed MuJoCo
-// model and the composed URDF agree, random motions stay within the iiwa's limits and off the
+// simulated workcell, with the 3-finger adaptive gripper on its flange (the composed MuJoCo model
+// and URDF agree on every cell: every_cell_test.cpp): random motions stay within the iiwa's limits and off the
 // table, the gripper picks a part up in each of its four modes, and one of the paper's UR5
 // plans, unchanged, lifts a node (judged from the simulator's true state). One short plan:
 // trial batches are measured with `costar trials` (docs/BENCHMARKS.md), not here.
@@ -18,7 +18,6 @@
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
 #include "core/paths.h"
-#include "planning/robot_model.h"
 #include "sim/simulation.h"
 #include "smartmove/grasps.h"
 #include "workcell/grippers.h"
@@ -27,37 +26,6 @@
 
 namespace costar::workcell {
 namespace {
-
-TEST(IiwaSimWorkcell, TheComposedMujocoModelAndUrdfAgree) {
-  const SimCellDescription cell = loadSimCellDescription(simCellFile("iiwa-3f-sim"));
-  const arm::RobotDescription iiwa = arm::loadRobotDescription(arm::robotDescriptionFile(cell.robot));
-  EXPECT_EQ(cell.gripper, "robotiq3f");  // the 3-finger adaptive gripper
-  const GripperModel& gripper = gripperModel(cell.gripper);
-  const auto robot = planning::RobotModel::fromUrdf(iiwa.urdf, dataRoot() / gripper.urdf, iiwa.urdf_tool_link,
-                                                    iiwa.urdf_base_link, gripper.tcp_link);
-  ASSERT_EQ(robot.dof(), 7u);
-  std::mt19937 random(12);
-  const sim::Scene empty = sim::parseScene(R"({"parts": []})", "empty");
-  for (int trial = 0; trial < 8; ++trial) {
-    sim::ArmJoints q = sim::ArmJoints::zero(7);
-    for (int j = 0; j < 7; ++j) {
-      q[j] = std::uniform_real_distribution<double>(iiwa.limits.min_position[j], iiwa.limits.max_position[j])(random);
-    }
-    sim::SimulationOptions options;
-    options.robot = iiwa;
-    options.robot_base = cell.robot_base;
-    options.gripper_model = dataRoot() / gripper.mjcf;
-    options.adaptive_gripper = gripper.adaptive;
-    options.initial_arm = q;
-    options.settle_seconds = 0.0;
-    const auto simulation = sim::Simulation::create(empty, options);
-    EXPECT_EQ(simulation->armJointNames(), iiwa.joint_names);
-    const world::Pose urdf = cell.robot_base * robot.forward(q.eigen());
-    const world::Pose mujoco = simulation->tcpPose();
-    EXPECT_LT((urdf.translation() - mujoco.translation()).norm(), 1e-4) << "trial " << trial;
-    EXPECT_LT(world::rotationAngle(urdf, mujoco), 1e-5);
-  }
-}
 
 TEST(IiwaSimWorkcell, RandomMotionsStayWithinTheLimitsAndNeverTouchTheTable) {
   const auto cell =

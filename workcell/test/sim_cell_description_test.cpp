@@ -41,15 +41,6 @@ TEST(SimCellDescription, BothCellsLoadAndAreListed) {
   EXPECT_EQ(names, (std::vector<std::string>{"ur5-sim", "iiwa-3f-sim", "iiwa-sim", "panda-sim", "test", "none"}));
 }
 
-// Each simulated cell has its own SVM (its own arm and gripper seen as background), shipped.
-TEST(SimCellDescription, EachCellNamesItsOwnShippedPerceptionModel) {
-  for (const std::string name : {"ur5-sim", "iiwa-sim", "iiwa-3f-sim", "panda-sim"}) {
-    const SimCellDescription cell = loadSimCellDescription(simCellFile(name));
-    EXPECT_EQ(cell.perception_model, dataRoot() / "data/perception/svm" / (name + ".json")) << name;
-    EXPECT_TRUE(std::filesystem::is_regular_file(cell.perception_model)) << name;
-  }
-}
-
 class BadCellFile : public ::testing::Test {
  protected:
   void SetUp() override {
