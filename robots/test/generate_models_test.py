@@ -40,6 +40,10 @@ class GenerateModels(GeneratorCase):
         self.expect_error(lambda d: d.update(home_deg=[0, 0, 0]), "home_deg", "7 values")
         self.expect_error(lambda d: d["tool"].update(parent="iiwa_link_3"), "tool.parent")
         self.expect_error(lambda d: d["links"][1]["collision"][0].update(type="mesh"), "links[1].collision[0].type")
+        self.expect_error(lambda d: d["links"][1]["collision"][0].update(rgba=[2, 0, 0, 1]),
+                          "links[1].collision[0].rgba", "4 numbers from 0 to 1")
+        self.expect_error(lambda d: d["links"][1]["collision"][0].update(rgba=[0.5, 0.5, 0.5]),
+                          "links[1].collision[0].rgba", "4 numbers from 0 to 1")
         # The joint origins must add up to the manufacturer's lengths.
         self.expect_error(lambda d: d["joints"][3].update(origin=[0, 0, 0.2255]), "published_lengths.shoulder_to_elbow",
                           "0.43")
@@ -50,6 +54,19 @@ class GenerateModels(GeneratorCase):
                           "magnitude at most 10")
         self.expect_error(lambda d: d["links"][2].update(mass=1e308), "links[2].mass", "at most 1000")
         self.expect_error(lambda d: d["joints"][2].update(effort_nm=1e308), "joints[2].effort_nm", "at most 1e+06")
+
+    def test_a_shape_keeps_the_colour_it_is_given(self):
+        ur5 = ROOT / "robots" / "ur5" / "ur5.json"
+        result = self.run_generator(ur5, self.tmp)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        geoms = {g.get("name"): g.get("rgba") for g in ET.parse(self.tmp / "ur5.xml").getroot().iter("geom")}
+        self.assertEqual(geoms["base_link_collision_0"], "0.2 0.25 0.33 1")  # the UR5's dark blue cap
+        self.assertEqual(geoms["shoulder_link_collision_0"], "0.7 0.72 0.75 1")  # its grey cover
+        iiwa = self.run_generator(IIWA, self.tmp / "iiwa")
+        self.assertEqual(iiwa.returncode, 0, iiwa.stderr)
+        colours = [g.get("rgba") for g in ET.parse(self.tmp / "iiwa" / "iiwa14.xml").getroot().iter("geom")
+                   if g.get("name", "").endswith("_collision_0")]
+        self.assertTrue(colours and all(c is None for c in colours))  # the class's colour
 
     def test_the_models_carry_the_fingerprint_of_their_description(self):
         result = self.run_generator(IIWA, self.tmp)
