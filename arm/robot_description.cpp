@@ -98,22 +98,23 @@ std::map<std::string, std::vector<double>> solverParameters(const json& kinemati
   return parameters;
 }
 
-/// How a format names a joint's limits and the home, and their unit.
-struct JointFields {
-  const char* min;
-  const char* max;
-  const char* velocity;
-  const char* acceleration;
-  const char* home;
-  double to_radians;              // 1 for radians, pi/180 for degrees
-  const char* unit;               // "radians" or "degrees", for messages
-  const char* velocity_unit;      // after "must be positive" in messages: " (rad/s)" or ""
-  const char* acceleration_unit;  // the same for the acceleration limit
-  std::set<std::string> known;    // a joint object's fields
-};
+/// A joint object's fields (format costar-robot-description/1; angles in degrees).
+const std::set<std::string> kJointFields = {"name",
+                                            "label",
+                                            "parent",
+                                            "child",
+                                            "origin",
+                                            "rpy",
+                                            "axis",
+                                            "lower_deg",
+                                            "upper_deg",
+                                            "velocity_deg_s",
+                                            "acceleration_deg_s2",
+                                            "effort_nm"};
+constexpr double kRadiansPerDegree = std::numbers::pi / 180.0;
 
 /// joints[] (names, labels, limits) and the home of `root_object`, into `robot`.
-void readJoints(const json& root_object, const JointFields& format, RobotDescription& robot) {
+void readJoints(const json& root_object, RobotDescription& robot) {
   const json& joints = member(root_object, "", "joints");
   if (!joints.is_array() || joints.empty() || joints.size() > static_cast<std::size_t>(kMaxJoints)) {
     fail("joints", "must be a list of 1 to " + std::to_string(kMaxJoints) + " joints, not " + shown(joints));
@@ -121,48 +122,43 @@ void readJoints(const json& root_object, const JointFields& format, RobotDescrip
   const int count = static_cast<int>(joints.size());
   robot.limits = {JointVector(count), JointVector(count), JointVector(count), JointVector(count)};
   std::set<std::string> names;
-  const auto value = [&format](const json& joint, const std::string& field, const char* key) {
-    return number(member(joint, field, key), field + "." + key) * format.to_radians;
+  const auto value = [](const json& joint, const std::string& field, const char* key) {
+    return number(member(joint, field, key), field + "." + key) * kRadiansPerDegree;
   };
   for (int j = 0; j < count; ++j) {
     const std::string field = "joints[" + std::to_string(j) + "]";
     const json& joint = joints[j];
     if (!joint.is_object()) {
-      fail(field,
-           "must be an object {\"name\": ..., \"" + std::string(format.min) + "\": ..., ...}, not " + shown(joint));
+      fail(field, "must be an object {\"name\": ..., \"lower_deg\": ..., ...}, not " + shown(joint));
     }
-    onlyKnown(joint, field, format.known);
+    onlyKnown(joint, field, kJointFields);
     const std::string name = text(joint, field, "name");
     if (!names.insert(name).second) {
       fail(field + ".name", "'" + name + "' is taken already; joint names must differ");
     }
     robot.joint_names.push_back(name);
     robot.joint_labels.push_back(text(joint, field, "label"));
-    robot.limits.min_position[j] = value(joint, field, format.min);
-    robot.limits.max_position[j] = value(joint, field, format.max);
-    robot.limits.max_velocity[j] = value(joint, field, format.velocity);
-    robot.limits.max_acceleration[j] = value(joint, field, format.acceleration);
+    robot.limits.min_position[j] = value(joint, field, "lower_deg");
+    robot.limits.max_position[j] = value(joint, field, "upper_deg");
+    robot.limits.max_velocity[j] = value(joint, field, "velocity_deg_s");
+    robot.limits.max_acceleration[j] = value(joint, field, "acceleration_deg_s2");
     if (robot.limits.min_position[j] > robot.limits.max_position[j]) {
-      fail(field, std::string(format.min) + " " + shown(joint.at(format.min)) + " is above " + format.max + " " +
-                      shown(joint.at(format.max)));
+      fail(field, "lower_deg " + shown(joint.at("lower_deg")) + " is above upper_deg " + shown(joint.at("upper_deg")));
     }
     if (!(robot.limits.max_velocity[j] > 0.0)) {
-      fail(field + "." + format.velocity,
-           "must be positive" + std::string(format.velocity_unit) + ", not " + shown(joint.at(format.velocity)));
+      fail(field + ".velocity_deg_s", "must be positive, not " + shown(joint.at("velocity_deg_s")));
     }
     if (!(robot.limits.max_acceleration[j] > 0.0)) {
-      fail(field + "." + format.acceleration, "must be positive" + std::string(format.acceleration_unit) + ", not " +
-                                                  shown(joint.at(format.acceleration)));
+      fail(field + ".acceleration_deg_s2", "must be positive, not " + shown(joint.at("acceleration_deg_s2")));
     }
   }
-  const std::vector<double> home = numbers(member(root_object, "", format.home), format.home, joints.size(),
-                                           std::to_string(count) + " angles (" + format.unit + "), one per joint");
+  const std::vector<double> home = numbers(member(root_object, "", "home_deg"), "home_deg", joints.size(),
+                                           std::to_string(count) + " angles (degrees), one per joint");
   robot.home = JointVector(count);
   for (int j = 0; j < count; ++j) {
-    robot.home[j] = home[static_cast<std::size_t>(j)] * format.to_radians;
+    robot.home[j] = home[static_cast<std::size_t>(j)] * kRadiansPerDegree;
     if (robot.home[j] < robot.limits.min_position[j] || robot.home[j] > robot.limits.max_position[j]) {
-      fail(std::string(format.home) + "[" + std::to_string(j) + "]",
-           "is outside joint " + std::to_string(j + 1) + "'s limits");
+      fail("home_deg[" + std::to_string(j) + "]", "is outside joint " + std::to_string(j + 1) + "'s limits");
     }
   }
 }
@@ -202,19 +198,7 @@ RobotDescription parseGenerated(const json& root_object) {
   const json& kinematics = objectAt(root_object, "", "kinematics");
   robot.solver = text(kinematics, "kinematics", "solver");
   robot.solver_parameters = solverParameters(kinematics);
-  readJoints(root_object,
-             {"lower_deg",
-              "upper_deg",
-              "velocity_deg_s",
-              "acceleration_deg_s2",
-              "home_deg",
-              std::numbers::pi / 180.0,
-              "degrees",
-              "",
-              "",
-              {"name", "label", "parent", "child", "origin", "rpy", "axis", "lower_deg", "upper_deg", "velocity_deg_s",
-               "acceleration_deg_s2", "effort_nm"}},
-             robot);
+  readJoints(root_object, robot);
   robot.first_moving_link = text(root_object.at("joints")[0], "joints[0]", "child");
   robot.base_link = text(root_object, "", "base_link");
   const json& tool = objectAt(root_object, "", "tool");
