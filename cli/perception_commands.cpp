@@ -206,7 +206,8 @@ int evaluate(const EvalOptions& options) {
       std::printf(
           "pictures in %s (green: within 5 mm / 5 deg, red: not, orange: false detection, yellow: missed);\n"
           "each scene's file beside its picture (scene_NNN.json, scene_NNN_push_K.json): "
-          "`costar-robot perception detect FILE` runs it again\n",
+          "`costar-robot perception detect FILE` runs it again; with `--look scene_NNN_look.json` as the first look "
+          "saw it (the camera's noise, the arm over the parts)\n",
           eval.pictures.string().c_str());
     }
     const double found = summary.scores.foundWithinTolerance();
@@ -226,6 +227,7 @@ struct DetectOptions {
   std::string scene;
   std::string workcell = "ur5-sim";
   std::optional<std::uint64_t> seed;
+  std::string look;
   std::string out;
   int frames = 15;
 };
@@ -237,8 +239,12 @@ int detectScene(const DetectOptions& options) {
     if (!options.out.empty()) {
       checkOutputFile(options.out, "--out");
     }
+    std::optional<trials::SceneLook> look;
+    if (!options.look.empty()) {
+      look = trials::loadSceneLook(options.look);
+    }
     const trials::SceneDetection found =
-        trials::detectInScene(options.scene, options.seed, options.frames, options.workcell);
+        trials::detectInScene(options.scene, options.seed, options.frames, options.workcell, look);
     const trials::Match& match = found.match;
     std::printf("DetectObjects on %s: %zu object(s) in %.1f ms (%d frames; capture not included)\n",
                 options.scene.c_str(), found.detected.size(), found.milliseconds, options.frames);
@@ -481,6 +487,11 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
   detect_command->add_option("--seed", detect_options->seed, "seed of the part placement and the sensor noise")
       ->check(wholeNumber());
   detect_command->add_option("--out", detect_options->out, "write the picture to this PNG file");
+  detect_command
+      ->add_option("--look", detect_options->look,
+                   "scene_NNN_look.json that perception eval wrote beside the scene: the camera's noise and "
+                   "the arm over the parts as its first look had them")
+      ->check(CLI::ExistingFile);
   detect_command
       ->add_option("-w,--workcell", detect_options->workcell,
                    "simulated workcell: its robot, gripper, camera and perception model (workcells/NAME.json)")

@@ -12,6 +12,7 @@
 
 #include "core/clock.h"
 #include "core/files.h"
+#include "core/json_file.h"
 #include "perception/canonical_orientation.h"
 #include "perception/drawing.h"
 #include "perception/perception_component.h"
@@ -210,6 +211,14 @@ RgbImage labelPicture(const perception::PipelineResult& result, const perception
                                         perception::workspaceRegion(frame.intrinsics, frame.camera_pose, pictureArea()),
                                         2.0);
 }
+
+/// An arm posed over the table is simulated with a shorter settling (the fingers' half second
+/// follows: kFingersSettle).
+sim::SimulationOptions armOverOptions(sim::SimulationOptions options) {
+  options.settle_seconds = 0.5;
+  return options;
+}
+constexpr std::chrono::milliseconds kFingersSettle{600};
 
 /// A scene file `perception detect` can run again. @throws std::runtime_error when it cannot
 /// be written.
@@ -481,14 +490,17 @@ PerceptionEvalSummary evaluatePerception(const PerceptionEvalOptions& options,
     auto sim_clock = std::make_unique<SimClock>();
     sim::SimulationOptions sim_options = cell.options;
     std::unique_ptr<sim::Simulation> simulation;
+    SceneLook look;
+    look.workcell = options.workcell;
     if (options.arm_over > 0.0 && std::uniform_real_distribution<double>(0.0, 1.0)(random) < options.arm_over) {
-      sim::SimulationOptions arm_options = sim_options;
-      arm_options.settle_seconds = 0.5;
-      simulation = armOverTableSimulation(cell, *kinematics, generated.scene, arm_options, 0.1, random);
+      ArmOverPose posed;
+      simulation =
+          armOverTableSimulation(cell, *kinematics, generated.scene, armOverOptions(sim_options), 0.1, random, &posed);
       if (simulation) {
         report.arm_over = true;
         ++summary.scenes_arm_over;
         sim_options.initial_arm = simulation->armPositions();  // the pushes' scenes keep it there
+        look.arm_over = posed;
       }
     }
     if (!simulation) {
@@ -496,9 +508,10 @@ PerceptionEvalSummary evaluatePerception(const PerceptionEvalOptions& options,
     }
     simulation->attach(*sim_clock);
     if (report.arm_over) {
-      sim_clock->advanceBy(std::chrono::milliseconds(600));  // the fingers settle
+      sim_clock->advanceBy(kFingersSettle);
     }
-    camera.use(*simulation, random());
+    look.noise_seed = random();
+    camera.use(*simulation, look.noise_seed);
     clock.use(*sim_clock);
     perception::PerceptionComponent component(camera, clock, pipeline, config);
 
@@ -517,6 +530,7 @@ PerceptionEvalSummary evaluatePerception(const PerceptionEvalOptions& options,
       writePng(options.pictures / (stem + "_labels.png"), labelPicture(result, *pipeline));
       writeSceneFile(options.pictures / (stem + ".json"), generated.scene,
                      "perception eval --seed " + std::to_string(options.seed) + ", " + label);
+      writeOutputFile(options.pictures / (stem + "_look.json"), sceneLookJson(look).dump(2) + "\n");
     }
     std::vector<std::string> names(truth.size());  // after the first look
     for (std::size_t p = 0; p < truth.size(); ++p) {
@@ -713,19 +727,109 @@ std::string PerceptionEvalSummary::text() const {
   return out.str();
 }
 
+nlohmann::json sceneLookJson(const SceneLook& look) {
+  nlohmann::json json;
+  json["workcell"] = look.workcell;
+  json["camera_noise_seed"] = look.noise_seed;
+  if (look.arm_over) {
+    json["arm"] = std::vector<double>(look.arm_over->arm.begin(), look.arm_over->arm.end());
+    json["fingers"] = look.arm_over->fingers;
+  }
+  return json;
+}
+
+SceneLook loadSceneLook(const std::filesystem::path& file) {
+  const auto fail = [&file](const std::string& field, const std::string& problem) {
+    return std::runtime_error("look file '" + file.string() + "': " + field + ": " + problem);
+  };
+  nlohmann::json json;
+  try {
+    json = core::readJsonFile(file);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("look file '" + file.string() + "': " + e.what());
+  }
+  if (!json.is_object()) {
+    throw fail("(top level)", "must be an object");
+  }
+  for (const auto& [key, value] : json.items()) {
+    if (key != "workcell" && key != "camera_noise_seed" && key != "arm" && key != "fingers") {
+      throw fail(key, "unknown field (known: workcell, camera_noise_seed, arm, fingers)");
+    }
+  }
+  SceneLook look;
+  if (!json.contains("workcell") || !json["workcell"].is_string()) {
+    throw fail("workcell", "must be the cell's name");
+  }
+  look.workcell = json["workcell"].get<std::string>();
+  if (!json.contains("camera_noise_seed") || !json["camera_noise_seed"].is_number_unsigned()) {
+    throw fail("camera_noise_seed", "must be a whole number from 0");
+  }
+  look.noise_seed = json["camera_noise_seed"].get<std::uint64_t>();
+  if (json.contains("arm") != json.contains("fingers")) {
+    throw fail(json.contains("arm") ? "fingers" : "arm", "missing (the arm and its fingers are given together)");
+  }
+  if (json.contains("arm")) {
+    const auto numbers = [&](const std::string& field) {
+      const nlohmann::json& values = json[field];
+      if (!values.is_array() || values.empty()) {
+        throw fail(field, "must be a list of numbers");
+      }
+      std::vector<double> out;
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        if (!values[i].is_number() || !std::isfinite(values[i].get<double>())) {
+          throw fail(field + "[" + std::to_string(i) + "]", "must be a finite number");
+        }
+        out.push_back(values[i].get<double>());
+      }
+      return out;
+    };
+    ArmOverPose pose;
+    const std::vector<double> arm = numbers("arm");
+    if (arm.size() > static_cast<std::size_t>(arm::kMaxJoints)) {
+      throw fail("arm", "an arm has at most " + std::to_string(arm::kMaxJoints) + " joints, not " +
+                            std::to_string(arm.size()));
+    }
+    pose.arm = sim::ArmJoints(static_cast<int>(arm.size()));
+    for (std::size_t j = 0; j < arm.size(); ++j) {
+      pose.arm[static_cast<int>(j)] = arm[j];
+    }
+    pose.fingers = numbers("fingers");
+    look.arm_over = pose;
+  }
+  return look;
+}
+
 SceneDetection detectInScene(const std::filesystem::path& scene_file, std::optional<std::uint64_t> seed, int frames,
-                             const std::string& workcell) {
+                             const std::string& workcell, const std::optional<SceneLook>& look) {
+  if (look && look->workcell != workcell) {
+    throw std::runtime_error("the look was made in cell '" + look->workcell + "', not '" + workcell +
+                             "' (run it with -w " + look->workcell + ")");
+  }
   const workcell::CellSimulation cell = workcell::cellSimulation(workcell);
   perception::PerceptionConfig config = cellConfig(cell);
   config.frames = frames;
   const auto pipeline = perception::loadPipeline(config);
   const sim::Scene scene = sim::loadScene(scene_file);
   sim::SimulationOptions sim_options = cell.options;
-  sim_options.placement_seed = seed;
+  if (seed || !look) {
+    sim_options.placement_seed = seed;
+  }
   SimClock clock;
-  auto simulation = sim::Simulation::create(scene, sim_options);
+  std::unique_ptr<sim::Simulation> simulation;
+  if (look && look->arm_over) {
+    try {
+      simulation = simulationWithArmOver(scene, armOverOptions(sim_options), *look->arm_over);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error("the look's arm does not fit cell '" + workcell + "': " + e.what());
+    }
+  } else {
+    simulation = sim::Simulation::create(scene, sim_options);
+  }
   simulation->attach(clock);
-  sim::SimRgbdCamera camera(*simulation, seed.value_or(scene.seed));
+  if (look && look->arm_over) {
+    clock.advanceBy(kFingersSettle);
+  }
+  sim::SimRgbdCamera camera(*simulation, look ? look->noise_seed : seed.value_or(scene.seed));
   perception::PerceptionComponent component(camera, clock, pipeline, config);
   const perception::PipelineResult result = detectOnce(component, clock, frames);
   const std::vector<world::ObjectClass> classes = classesOf(*pipeline);

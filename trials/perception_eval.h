@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/image.h"
+#include "trials/perception_scenes.h"
 #include "world/object_class.h"
 #include "world/pose.h"
 
@@ -161,6 +162,18 @@ const std::vector<std::string>& latencyStages();
 PerceptionEvalSummary evaluatePerception(const PerceptionEvalOptions& options,
                                          const std::function<void(const SceneReport&)>& progress = {});
 
+/// How `perception eval` looked at a scene (scene_NNN_look.json beside its scene file), so that
+/// `perception detect --look` looks at it again the same way: the cell, the camera's noise seed
+/// and, when the cell's arm stood over the parts, where it stood and where its fingers were sent.
+struct SceneLook {
+  std::string workcell;
+  std::uint64_t noise_seed = 0;
+  std::optional<ArmOverPose> arm_over;
+};
+nlohmann::json sceneLookJson(const SceneLook& look);
+/// @throws std::runtime_error naming the file and the field for a file that is not a look.
+SceneLook loadSceneLook(const std::filesystem::path& file);
+
 /// DetectObjects once on a scene file, as a plan runs it, against the simulator's truth.
 struct SceneDetection {
   std::vector<DetectedPart> detected;
@@ -171,8 +184,10 @@ struct SceneDetection {
   /// false detection, yellow a missed part's outline), enlarged on the table.
   RgbImage picture;
 };
+/// With `look`: the camera's noise and the arm as `perception eval` had them at the scene's first
+/// look (`seed`, when given, still places the parts); `workcell` must be the look's.
 SceneDetection detectInScene(const std::filesystem::path& scene, std::optional<std::uint64_t> seed, int frames,
-                             const std::string& workcell = "ur5-sim");
+                             const std::string& workcell = "ur5-sim", const std::optional<SceneLook>& look = {});
 
 /// Percentile (0..100) by linear interpolation; 0 for none.
 double percentile(std::vector<double> values, double p);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "gripper/adaptive_gripper_driver.h"
 
@@ -34,7 +36,7 @@ std::optional<sim::ArmJoints> armOverTable(const workcell::CellSimulation& cell,
 std::unique_ptr<sim::Simulation> armOverTableSimulation(const workcell::CellSimulation& cell,
                                                         const arm::Kinematics& kinematics, const sim::Scene& scene,
                                                         sim::SimulationOptions sim_options, double min_height,
-                                                        std::mt19937_64& random) {
+                                                        std::mt19937_64& random, ArmOverPose* posed) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int attempt = 0; attempt < 50; ++attempt) {
     const std::optional<sim::ArmJoints> q = armOverTable(cell, kinematics, min_height, random);
@@ -48,14 +50,45 @@ std::unique_ptr<sim::Simulation> armOverTableSimulation(const workcell::CellSimu
         candidate->armTableContactSteps() != 0) {
       continue;
     }
+    ArmOverPose pose;
+    pose.arm = *q;
     if (gripper::AdaptiveGripperDriver* hand = candidate->adaptiveGripper()) {
-      hand->commandFingers({unit(random), unit(random), unit(random)}, 1.0, 20.0);
+      pose.fingers = {unit(random), unit(random), unit(random)};
+      hand->commandFingers({pose.fingers[0], pose.fingers[1], pose.fingers[2]}, 1.0, 20.0);
     } else {
-      candidate->commandFingers(candidate->maxOpening() * unit(random), 0.1, 20.0);
+      pose.fingers = {candidate->maxOpening() * unit(random)};
+      candidate->commandFingers(pose.fingers[0], 0.1, 20.0);
+    }
+    if (posed != nullptr) {
+      *posed = pose;
     }
     return candidate;
   }
   return nullptr;
+}
+
+std::unique_ptr<sim::Simulation> simulationWithArmOver(const sim::Scene& scene, sim::SimulationOptions sim_options,
+                                                       const ArmOverPose& pose) {
+  sim_options.initial_arm = pose.arm;
+  auto simulation = sim::Simulation::create(scene, sim_options);
+  if (pose.arm.size() != simulation->armPositions().size()) {
+    throw std::invalid_argument("the arm pose has " + std::to_string(pose.arm.size()) + " joints, the cell's arm " +
+                                std::to_string(simulation->armPositions().size()));
+  }
+  if (gripper::AdaptiveGripperDriver* hand = simulation->adaptiveGripper()) {
+    if (pose.fingers.size() != 3) {
+      throw std::invalid_argument("the 3-finger hand needs 3 finger positions, the pose has " +
+                                  std::to_string(pose.fingers.size()));
+    }
+    hand->commandFingers({pose.fingers[0], pose.fingers[1], pose.fingers[2]}, 1.0, 20.0);
+  } else {
+    if (pose.fingers.size() != 1) {
+      throw std::invalid_argument("the 2-finger gripper needs one opening, the pose has " +
+                                  std::to_string(pose.fingers.size()) + " finger values");
+    }
+    simulation->commandFingers(pose.fingers[0], 0.1, 20.0);
+  }
+  return simulation;
 }
 
 int stackLinksOnNodes(sim::Scene& scene, const std::vector<world::ObjectClass>& classes, int count,

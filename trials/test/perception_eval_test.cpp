@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <random>
 
+#include "core/files.h"
 #include "perception/training_data.h"
 #include "perception/workspace.h"
 #include "trials/perception_collect.h"
@@ -175,6 +176,100 @@ TEST(PerceptionEval, DetectInASceneFileFindsItsPartsAndDrawsThem) {
   EXPECT_GT(found.milliseconds, 0.0);
   EXPECT_GT(found.picture.width, 0);
   EXPECT_THROW(detectInScene(dataRoot() / "sim/scenes/no_such_scene.json", 1, 5), std::runtime_error);
+}
+
+// `perception detect --look` looks at an evaluation's scene again as its first look did: the
+// camera's noise and the arm standing over the parts (without the arm a false detection on it,
+// or a part it hid, could not be looked at again).
+TEST(PerceptionEval, ALookFileShowsTheSceneAgainWithTheArmWhereTheEvaluationHadIt) {
+  const auto folder = std::filesystem::temp_directory_path() / "costar_perception_look_test";
+  std::filesystem::remove_all(folder);
+  PerceptionEvalOptions options;
+  options.workcell = "iiwa-3f-sim";
+  options.scenes = 1;
+  options.seed = 101;
+  options.repeats = 0;
+  options.pushes = 0;
+  options.frames = 5;
+  options.stacked = 1;
+  options.arm_over = 1.0;
+  options.pictures = folder;
+  SceneReport report;
+  const PerceptionEvalSummary summary = evaluatePerception(options, [&](const SceneReport& r) { report = r; });
+  ASSERT_EQ(summary.scenes_arm_over, 1);
+  const SceneLook look = loadSceneLook(folder / "scene_001_look.json");
+  EXPECT_EQ(look.workcell, "iiwa-3f-sim");
+  ASSERT_TRUE(look.arm_over.has_value());
+  EXPECT_EQ(look.arm_over->arm.size(), 7);       // the LBR iiwa's joints
+  EXPECT_EQ(look.arm_over->fingers.size(), 3u);  // the 3-finger hand's
+  const SceneDetection again = detectInScene(folder / "scene_001.json", std::nullopt, 5, "iiwa-3f-sim", look);
+  int accurate = 0, hidden = 0;
+  for (std::size_t p = 0; p < again.truth.size(); ++p) {
+    accurate += again.match.accurate(p) ? 1 : 0;
+    hidden += again.truth[p].visible_fraction < kVisibleFraction ? 1 : 0;
+  }
+  EXPECT_EQ(static_cast<int>(again.truth.size()), report.parts);
+  EXPECT_EQ(accurate, report.accurate_first_look);
+  EXPECT_EQ(hidden, summary.scores.hidden_part_views);
+  int detections = 0;
+  for (const auto& [name, score] : summary.scores.classes) {
+    detections += score.detections;
+  }
+  EXPECT_EQ(static_cast<int>(again.detected.size()), detections);
+  // Without the arm, the parts it hid are seen.
+  SceneLook no_arm = look;
+  no_arm.arm_over.reset();
+  const SceneDetection bare = detectInScene(folder / "scene_001.json", std::nullopt, 5, "iiwa-3f-sim", no_arm);
+  double seen_with_arm = 0.0, seen_without = 0.0;
+  for (std::size_t p = 0; p < again.truth.size(); ++p) {
+    seen_with_arm += again.truth[p].visible_fraction;
+    seen_without += bare.truth[p].visible_fraction;
+  }
+  EXPECT_GT(seen_without, seen_with_arm + 0.05);
+  // A look made in another cell is refused, naming it.
+  try {
+    detectInScene(folder / "scene_001.json", std::nullopt, 5, "iiwa-sim", look);
+    ADD_FAILURE() << "a look of iiwa-3f-sim accepted in iiwa-sim";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("'iiwa-3f-sim'"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(folder);
+}
+
+TEST(PerceptionEval, ABadLookFileIsRefusedNamingTheFieldAndTheProblem) {
+  const auto file = std::filesystem::temp_directory_path() / "costar_bad_look.json";
+  const auto refusal = [&file](const std::string& text) {
+    writeOutputFile(file, text);
+    try {
+      loadSceneLook(file);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(refusal(R"({"camera_noise_seed": 3})").find("workcell: must be the cell's name"), std::string::npos);
+  EXPECT_NE(refusal(R"({"workcell": "ur5-sim", "camera_noise_seed": -3})").find("camera_noise_seed: must be a whole"),
+            std::string::npos);
+  EXPECT_NE(refusal(R"({"workcell": "ur5-sim", "camera_noise_seed": 3, "arm": [0, 1]})").find("fingers: missing"),
+            std::string::npos);
+  EXPECT_NE(refusal(R"({"workcell": "ur5-sim", "camera_noise_seed": 3, "arm": [0, "x"], "fingers": [0.01]})")
+                .find("arm[1]: must be a finite number"),
+            std::string::npos);
+  EXPECT_NE(refusal(R"({"workcell": "ur5-sim", "camera_noise_seed": 3, "arms": []})").find("arms: unknown field"),
+            std::string::npos);
+  EXPECT_NE(refusal("{").find(file.string()), std::string::npos);
+  // What the evaluation writes reads back.
+  SceneLook look;
+  look.workcell = "ur5-sim";
+  look.noise_seed = 18446744073709551615u;
+  look.arm_over = ArmOverPose{sim::ArmJoints{-1.0, -0.6, -0.2, 0.2, 0.6, 1.0}, {0.042}};
+  writeOutputFile(file, sceneLookJson(look).dump());
+  const SceneLook read = loadSceneLook(file);
+  EXPECT_EQ(read.noise_seed, look.noise_seed);
+  ASSERT_TRUE(read.arm_over.has_value());
+  EXPECT_EQ(read.arm_over->arm, look.arm_over->arm);
+  EXPECT_EQ(read.arm_over->fingers, look.arm_over->fingers);
+  std::filesystem::remove(file);
 }
 
 /// Every part of the scene file found within 5 mm / 5 degrees, for each sensor noise seed.
