@@ -6,7 +6,8 @@
 
 namespace costar::cli {
 
-/// Adds `host` to `app`; it sets `exit_code` when it ends.
+/// Adds `host` and `host-campaign` (the liveness campaign of remote components,
+/// trials/host_campaign.h) to `app`; each sets `exit_code` when it ends.
 void addHostCommand(CLI::App& app, int& exit_code);
 
 }  // namespace costar::cli

@@ -32,6 +32,11 @@ inline constexpr std::array kRobotCommands = {
                  "and the camera's pose is saved with the cell (the editor's Calibrate button)"},
     RobotCommand{"serve", "Serve the task editor (a web page) and its API: build, run and watch plans on a workcell"},
     RobotCommand{"host", "Serve components of a workcell to an executor in another process or machine (DDS)"},
+    RobotCommand{"host-campaign",
+                 "Liveness of remote components: runs a plan with the gripper and perception in a host (this "
+                 "executable), kills the host (SIGKILL) during a DetectObjects, an arm motion or between operations "
+                 "at moments drawn from the seed, and judges each run: FAILURE naming the component within the "
+                 "deadline, the arm at rest, the files unchanged"},
 };
 
 }  // namespace costar::cli

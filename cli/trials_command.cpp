@@ -243,6 +243,11 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
                     "run Calibrate in each trial's cell before the plan (as a technician would after set-up)");
   addInjectOption(command, options->trials.inject);
   command
+      ->add_option("--remote", options->trials.remote,
+                   "JSON file {components, domain, partition, interface}: the components served by `costar host` "
+                   "in lockstep with each trial's simulation (gripper, perception; trials then run one at a time)")
+      ->check(CLI::ExistingFile);
+  command
       ->add_option("--disturb", options->trials.disturb,
                    "disturb the simulated world in each trial (repeatable): " + trials::disturbanceGrammar())
       ->check(CLI::Validator(

@@ -1,5 +1,6 @@
 #include "dds/bus.h"
 
+#include <iterator>
 #include <stdexcept>
 
 namespace costar::dds {
@@ -9,6 +10,8 @@ struct TopicInfo {
   const char* name;
   const dds_topic_descriptor_t* descriptor;
   bool durable;
+  /// Only the newest sample counts (the clock).
+  bool latest_only = false;
 };
 
 const TopicInfo& info(Topic topic) {
@@ -23,7 +26,13 @@ const TopicInfo& info(Topic topic) {
       {"rt/costar/component_description", &costar_msgs_msg_dds__ComponentDescription__desc, true},
       {"rt/costar/component_report", &costar_msgs_msg_dds__ComponentReport__desc, true},
       {"rt/costar/host_heartbeat", &costar_msgs_msg_dds__HostHeartbeat__desc, false},
+      {"rq/costar/component/callRequest", &costar_msgs_srv_dds__Call_Request__desc, false},
+      {"rr/costar/component/callReply", &costar_msgs_srv_dds__Call_Response__desc, false},
+      {"rq/costar/sim/driverRequest", &costar_msgs_srv_dds__Call_Request__desc, false},
+      {"rr/costar/sim/driverReply", &costar_msgs_srv_dds__Call_Response__desc, false},
+      {"rt/clock", &rosgraph_msgs_msg_dds__Clock__desc, false, true},
   };
+  static_assert(std::size(kTopics) == kTopicCount);
   return kTopics[static_cast<int>(topic)];
 }
 
@@ -40,6 +49,10 @@ dds_qos_t* topicQos(const TopicInfo& topic) {
   dds_qos_t* qos = dds_create_qos();
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   if (topic.durable) {
+    dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+  } else if (topic.latest_only) {
+    // The newest only, kept for a reader that joins later (a host that starts mid-run).
     dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
     dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
   } else {

@@ -4,11 +4,14 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <condition_variable>
 #include <map>
+#include <mutex>
 #include <random>
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "component/description.h"
 #include "dds/bus.h"
@@ -61,7 +64,9 @@ struct ComponentHost::State {
   /// order): the goal is then never started. Bounded: the oldest are dropped.
   std::set<GoalKey> cancelled_early;
   static constexpr std::size_t kCancelledEarlyLimit = 1024;
-  dds_entity_t goal_reader = 0, cancel_reader = 0;
+  dds_entity_t goal_reader = 0, cancel_reader = 0, call_reader = 0, call_reply_writer = 0;
+  std::optional<ComponentHost::Lockstep> lockstep;
+  std::uint64_t executor = 0;  // lockstep: the executor of the present run
   dds_entity_t reply_writer = 0, feedback_writer = 0, result_writer = 0;
   dds_entity_t description_writer = 0, report_writer = 0, heartbeat_writer = 0;
   std::uint64_t heartbeats = 0;
@@ -195,6 +200,74 @@ struct ComponentHost::State {
     }
   }
 
+  /// Answers a lockstep call of an executor.
+  void answerCall(const costar_msgs_srv_dds__Call_Request_& request) {
+    if (!components.contains(std::string_view(request.target)) || (request.host_id != 0 && request.host_id != id)) {
+      return;  // another host's component
+    }
+    nlohmann::json result;
+    std::string error;
+    try {
+      if (!lockstep) {
+        throw std::runtime_error("this host does not run in lockstep with a simulated clock");
+      }
+      if (request.client != executor) {
+        // A new run: its components start afresh, as they would in its own process.
+        std::vector<std::shared_ptr<component::Component>> fresh = lockstep->new_run(request.client);
+        for (auto& component : fresh) {
+          const std::string name = component->description().name;
+          if (!components.contains(name)) {
+            throw std::logic_error("ComponentHost: new_run made a component '" + name + "' not served");
+          }
+          components[name] = std::move(component);
+        }
+        executor = request.client;
+      }
+      lockstep->reach_time(request.stamp_ns);
+      component::Component& component = *components.find(std::string_view(request.target))->second;
+      const std::string method = request.method;
+      const nlohmann::json args = nlohmann::json::parse(request.args_json);
+      if (method == "start") {
+        const std::string operation = args.at("operation").get<std::string>();
+        const component::OperationSpec* spec = component.description().operation(operation);
+        if (spec == nullptr) {
+          throw std::invalid_argument(component.description().name + " has no operation '" + operation + "'");
+        }
+        const auto params = component::paramsFromJson(spec->params, args.at("params"));
+        result = {{"id", component.start(operation, params)}};
+      } else if (method == "poll") {
+        try {
+          result = component::toJson(component.poll(args.at("id").get<component::OperationId>()));
+        } catch (const std::exception& failure) {
+          result = component::toJson(
+              component::OperationResult::failure(std::string(request.target) + ": " + failure.what()));
+        }
+      } else if (method == "cancel") {
+        component.cancel(args.at("id").get<component::OperationId>());
+        result = nlohmann::json::object();
+      } else if (method == "report") {
+        try {
+          result = toJson(component.report());
+        } catch (const std::exception& failure) {
+          result = {{"error", std::string(request.target) + ": " + failure.what()}};
+        }
+      } else {
+        throw std::invalid_argument("unknown call '" + method + "'");
+      }
+    } catch (const std::exception& failure) {
+      error = failure.what();
+    }
+    const std::string result_json = result.dump();
+    costar_msgs_srv_dds__Call_Response_ message{};
+    message.client = request.client;
+    message.host_id = id;
+    message.number = request.number;
+    message.ok = error.empty();
+    message.error = wire(error);
+    message.result_json = wire(result_json);
+    Bus::write(call_reply_writer, &message);
+  }
+
   void heartbeat() {
     static const std::string kHostName = hostName();
     std::vector<char*> listed;
@@ -213,12 +286,13 @@ struct ComponentHost::State {
   }
 };
 
-ComponentHost::ComponentHost(const RemoteConfig& config,
-                             std::vector<std::shared_ptr<component::Component>> components) {
+ComponentHost::ComponentHost(const RemoteConfig& config, std::vector<std::shared_ptr<component::Component>> components,
+                             std::optional<Lockstep> lockstep) {
   if (components.empty()) {
     throw std::invalid_argument("a component host needs at least one component to serve");
   }
   state_ = std::make_unique<State>(config);
+  state_->lockstep = std::move(lockstep);
   for (auto& component : components) {
     const std::string name = component->description().name;
     if (!state_->components.emplace(name, std::move(component)).second) {
@@ -235,6 +309,8 @@ ComponentHost::ComponentHost(const RemoteConfig& config,
   state_->heartbeat_writer = bus.writer(Topic::kHeartbeat);
   state_->goal_reader = bus.reader(Topic::kSendGoalRequest, nullptr);
   state_->cancel_reader = bus.reader(Topic::kCancelGoalRequest, nullptr);
+  state_->call_reader = bus.reader(Topic::kCallRequest, nullptr);
+  state_->call_reply_writer = bus.writer(Topic::kCallReply);
   for (const auto& [name, component] : state_->components) {
     const std::string description = component::toJson(component->description()).dump();
     costar_msgs_msg_dds__ComponentDescription_ message{};
@@ -243,7 +319,9 @@ ComponentHost::ComponentHost(const RemoteConfig& config,
     message.description_json = wire(description);
     Bus::write(state_->description_writer, &message);
   }
-  state_->publishReports();
+  if (!state_->lockstep) {
+    state_->publishReports();  // in lockstep, reports are read by the executor's calls
+  }
   state_->heartbeat();
 }
 
@@ -256,15 +334,31 @@ void ComponentHost::serve(const std::atomic<bool>& stop, const std::function<voi
   const dds_entity_t waitset = dds_create_waitset(state.bus.participant());
   const dds_entity_t goals = dds_create_readcondition(state.goal_reader, DDS_ANY_STATE);
   const dds_entity_t cancels = dds_create_readcondition(state.cancel_reader, DDS_ANY_STATE);
+  const dds_entity_t calls = dds_create_readcondition(state.call_reader, DDS_ANY_STATE);
   dds_waitset_attach(waitset, goals, 0);
   dds_waitset_attach(waitset, cancels, 0);
-  auto next_heartbeat = SteadyClock::now() + kHeartbeatPeriod;
+  dds_waitset_attach(waitset, calls, 0);
+  // The heartbeat, from its own thread: an operation's step may take longer than kHostTimeout.
+  std::atomic<bool> serving{true};
+  std::mutex beat_mutex;
+  std::condition_variable beat_wake;
+  std::thread beat([&] {
+    std::unique_lock lock(beat_mutex);
+    while (serving.load()) {
+      try {
+        state.heartbeat();
+      } catch (const std::exception& error) {
+        spdlog::error("component host: {}", error.what());
+      }
+      beat_wake.wait_for(lock, kHeartbeatPeriod);
+    }
+  });
   auto next_report = SteadyClock::now() + kReportPeriod;
   while (!stop.load()) {
-    // Sleep until a goal or cancel arrives, the next poll of running operations or the next
-    // heartbeat, whichever is first.
+    // Sleep until a goal, cancel or call arrives, the next poll of running operations or the
+    // next report, whichever is first (at most a heartbeat period, to notice `stop`).
     const auto now = SteadyClock::now();
-    auto wake = std::min(next_heartbeat, next_report);
+    auto wake = std::min(now + kHeartbeatPeriod, next_report);
     if (!state.running.empty()) {
       wake = std::min(wake, now + kPollPeriod);
     }
@@ -278,14 +372,14 @@ void ComponentHost::serve(const std::atomic<bool>& stop, const std::function<voi
           state.goal_reader, [&](const auto& goal) { state.startGoal(goal); });
       Bus::takeAll<costar_msgs_action_dds__Operation_CancelGoal_Request_>(
           state.cancel_reader, [&](const auto& cancel) { state.cancelGoal(cancel); });
+      Bus::takeAll<costar_msgs_srv_dds__Call_Request_>(state.call_reader,
+                                                       [&](const auto& call) { state.answerCall(call); });
       state.pollRunning();
       if (SteadyClock::now() >= next_report) {
-        state.publishReports();
+        if (!state.lockstep) {
+          state.publishReports();
+        }
         next_report = SteadyClock::now() + kReportPeriod;
-      }
-      if (SteadyClock::now() >= next_heartbeat) {
-        state.heartbeat();
-        next_heartbeat = SteadyClock::now() + kHeartbeatPeriod;
       }
     } catch (const std::exception& error) {
       spdlog::error("component host: {}", error.what());
@@ -295,9 +389,16 @@ void ComponentHost::serve(const std::atomic<bool>& stop, const std::function<voi
     goal.component->cancel(goal.id);
   }
   state.running.clear();
+  {
+    std::lock_guard lock(beat_mutex);
+    serving = false;
+  }
+  beat_wake.notify_all();
+  beat.join();
   dds_delete(waitset);
   dds_delete(goals);
   dds_delete(cancels);
+  dds_delete(calls);
 }
 
 }  // namespace costar::dds

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -76,6 +77,104 @@ struct RemoteClient::State {
   std::set<component::OperationId> cancelling;
   std::set<component::OperationId> cancel_confirmed;
   component::OperationId next_goal = 1;
+
+  // Lockstep (config.lockstep), used from the executor's thread only.
+  dds_entity_t call_writer = 0, call_reply_reader = 0, driver_request_reader = 0, driver_reply_writer = 0;
+  dds_entity_t clock_writer = 0, waitset = 0;
+  DriverServer driver_server;
+  std::int64_t clock_ns = 0;
+  std::uint64_t calls = 0;
+
+  /// Answers the driver calls of hosts to this executor.
+  void serveDrivers() {
+    Bus::takeAll<costar_msgs_srv_dds__Call_Request_>(
+        driver_request_reader, [this](const costar_msgs_srv_dds__Call_Request_& request) {
+          if (request.client != client_id) {
+            return;
+          }
+          DriverReply reply;
+          std::string error;
+          try {
+            if (!driver_server) {
+              throw std::runtime_error("this executor has no simulator to call");
+            }
+            reply = driver_server(request.target, request.method, nlohmann::json::parse(request.args_json));
+          } catch (const std::exception& failure) {
+            error = failure.what();
+          }
+          const std::string result = reply.result.dump();
+          costar_msgs_srv_dds__Call_Response_ message{};
+          message.client = request.client;
+          message.host_id = request.host_id;
+          message.number = request.number;
+          message.ok = error.empty();
+          message.error = wire(error);
+          message.result_json = wire(result);
+          message.floats._buffer = reply.floats.data();
+          message.floats._length = message.floats._maximum = static_cast<std::uint32_t>(reply.floats.size());
+          message.floats._release = false;
+          message.bytes._buffer = reply.bytes.data();
+          message.bytes._length = message.bytes._maximum = static_cast<std::uint32_t>(reply.bytes.size());
+          message.bytes._release = false;
+          Bus::write(driver_reply_writer, &message);
+        });
+  }
+
+  /// Calls `method` of `component` on its host and waits for the answer, serving the hosts'
+  /// driver calls meanwhile. @throws std::runtime_error with the host's error, or naming the
+  /// component when its host is lost.
+  nlohmann::json call(const std::string& component, const std::string& method, const nlohmann::json& args) {
+    std::uint64_t host_id = 0;
+    {
+      std::lock_guard lock(mutex);
+      const auto served_by = served.find(component);
+      host_id = served_by == served.end() ? 0 : served_by->second.host_id;
+      if (std::string reason = lost(component, host_id, SteadyClock::now()); !reason.empty()) {
+        throw std::runtime_error(reason);
+      }
+    }
+    const std::uint64_t number = ++calls;
+    const std::string args_json = args.dump();
+    costar_msgs_srv_dds__Call_Request_ request{};
+    request.client = client_id;
+    request.host_id = host_id;
+    request.number = number;
+    request.target = wire(component);
+    request.method = wire(method);
+    request.args_json = wire(args_json);
+    request.stamp_ns = clock_ns;
+    Bus::write(call_writer, &request);
+    for (;;) {
+      std::optional<nlohmann::json> result;
+      std::string error;
+      Bus::takeAll<costar_msgs_srv_dds__Call_Response_>(call_reply_reader,
+                                                        [&](const costar_msgs_srv_dds__Call_Response_& reply) {
+                                                          if (reply.client != client_id || reply.number != number) {
+                                                            return;  // another executor's, or one given up on
+                                                          }
+                                                          if (reply.ok) {
+                                                            result = nlohmann::json::parse(reply.result_json);
+                                                          } else {
+                                                            error = reply.error;
+                                                            result = nullptr;
+                                                          }
+                                                        });
+      if (result) {
+        if (!error.empty()) {
+          throw std::runtime_error(error);
+        }
+        return std::move(*result);
+      }
+      serveDrivers();
+      {
+        std::lock_guard lock(mutex);
+        if (std::string reason = lost(component, host_id, SteadyClock::now()); !reason.empty()) {
+          throw std::runtime_error(reason);
+        }
+      }
+      dds_waitset_wait(waitset, nullptr, 0, DDS_MSECS(20));
+    }
+  }
 
   /// Why `component`'s host `host_id` counts as gone, or empty while it answers. Under `mutex`.
   std::string lost(const std::string& component, std::uint64_t host_id, SteadyClock::time_point now) const {
@@ -226,6 +325,30 @@ RemoteClient::RemoteClient(const RemoteConfig& config) : state_(std::make_unique
   reader(Topic::kDescription, &S::listen<costar_msgs_msg_dds__ComponentDescription_, &S::onDescription>);
   reader(Topic::kReport, &S::listen<costar_msgs_msg_dds__ComponentReport_, &S::onReport>);
   reader(Topic::kHeartbeat, &S::listen<costar_msgs_msg_dds__HostHeartbeat_, &S::onHeartbeat>);
+  if (config.lockstep) {
+    state.call_writer = state.bus.writer(Topic::kCallRequest);
+    state.call_reply_reader = state.bus.reader(Topic::kCallReply, nullptr);
+    state.driver_request_reader = state.bus.reader(Topic::kDriverRequest, nullptr);
+    state.driver_reply_writer = state.bus.writer(Topic::kDriverReply);
+    state.clock_writer = state.bus.writer(Topic::kClock);
+    state.waitset = dds_create_waitset(state.bus.participant());
+    dds_waitset_attach(state.waitset, dds_create_readcondition(state.call_reply_reader, DDS_ANY_STATE), 0);
+    dds_waitset_attach(state.waitset, dds_create_readcondition(state.driver_request_reader, DDS_ANY_STATE), 0);
+  }
+}
+
+void RemoteClient::setDriverServer(DriverServer server) { state_->driver_server = std::move(server); }
+
+void RemoteClient::publishClock(TimePoint now) {
+  State& state = *state_;
+  if (!state.config.lockstep) {
+    throw std::logic_error("RemoteClient::publishClock: only in lockstep");
+  }
+  state.clock_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
+  rosgraph_msgs_msg_dds__Clock_ message{};
+  message.clock.sec = static_cast<std::int32_t>(state.clock_ns / 1'000'000'000);
+  message.clock.nanosec = static_cast<std::uint32_t>(state.clock_ns % 1'000'000'000);
+  Bus::write(state.clock_writer, &message);
 }
 
 // Deleting the participant first stops the listeners before the state they use goes.
@@ -248,7 +371,7 @@ std::shared_ptr<RemoteComponent> RemoteClient::connect(const std::string& compon
     const auto served = state.served.find(component);
     if (served != state.served.end() && !served->second.description_json.empty() &&
         state.lost(component, served->second.host_id, SteadyClock::now()).empty() && matched(state.goal_writer) &&
-        matched(state.cancel_writer)) {
+        matched(state.cancel_writer) && (!state.config.lockstep || matched(state.call_writer))) {
       try {
         auto description = component::descriptionFromJson(nlohmann::json::parse(served->second.description_json));
         lock.unlock();
@@ -273,6 +396,11 @@ RemoteComponent::RemoteComponent(std::shared_ptr<RemoteClient> client, component
 
 component::OperationId RemoteComponent::start(const std::string& operation, const component::ParamMap& params) {
   RemoteClient::State& state = *client_->state_;
+  if (state.config.lockstep) {
+    const nlohmann::json answer =
+        state.call(description_.name, "start", {{"operation", operation}, {"params", component::toJson(params)}});
+    return answer.at("id").get<component::OperationId>();
+  }
   const std::string params_json = component::toJson(params).dump();
   component::OperationId id = 0;
   {
@@ -306,6 +434,13 @@ component::OperationId RemoteComponent::start(const std::string& operation, cons
 
 component::OperationResult RemoteComponent::poll(component::OperationId id) {
   RemoteClient::State& state = *client_->state_;
+  if (state.config.lockstep) {
+    try {
+      return component::resultFromJson(state.call(description_.name, "poll", {{"id", id}}));
+    } catch (const std::exception& error) {
+      return component::OperationResult::failure(error.what());
+    }
+  }
   std::lock_guard lock(state.mutex);
   const auto it = state.goals.find(id);
   if (it == state.goals.end()) {
@@ -338,6 +473,14 @@ component::OperationResult RemoteComponent::poll(component::OperationId id) {
 
 void RemoteComponent::cancel(component::OperationId id) {
   RemoteClient::State& state = *client_->state_;
+  if (state.config.lockstep) {
+    try {
+      state.call(description_.name, "cancel", {{"id", id}});
+    } catch (const std::exception&) {
+      // A host that is gone has nothing running any more; cancel() never throws.
+    }
+    return;
+  }
   {
     std::lock_guard lock(state.mutex);
     const auto it = state.goals.find(id);
@@ -366,7 +509,14 @@ bool RemoteComponent::cancelConfirmed(component::OperationId id) const {
 }
 
 world::Report RemoteComponent::report() const {
-  const RemoteClient::State& state = *client_->state_;
+  RemoteClient::State& state = *client_->state_;
+  if (state.config.lockstep) {
+    const nlohmann::json answer = state.call(description_.name, "report", nlohmann::json::object());
+    if (answer.contains("error")) {
+      throw std::runtime_error(answer["error"].get<std::string>());
+    }
+    return reportFromJson(answer);
+  }
   std::lock_guard lock(state.mutex);
   const auto served = state.served.find(description_.name);
   const std::uint64_t host_id = served == state.served.end() ? 0 : served->second.host_id;

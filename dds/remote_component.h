@@ -5,12 +5,15 @@
 // host's reason. When the component's host has sent nothing for kHostTimeout (it died, hangs
 // or its network is gone), running operations end as FAILURE and report() throws, both naming
 // the component (the registry then stops the cell). A restarted host is used again at once.
+// In lockstep (RemoteConfig::lockstep, dds/lockstep.h) every call is answered by the host at
+// once at the executor's simulated time instead.
 
 #include <chrono>
 #include <memory>
 #include <string>
 
 #include "component/component.h"
+#include "dds/lockstep.h"
 #include "dds/remote_config.h"
 
 namespace costar::dds {
@@ -50,6 +53,11 @@ class RemoteClient : public std::enable_shared_from_this<RemoteClient> {
   /// @throws std::runtime_error naming the component, the domain and the partition when no
   /// host serves it within `timeout`.
   std::shared_ptr<RemoteComponent> connect(const std::string& component, std::chrono::milliseconds timeout);
+
+  /// Lockstep: answers the hosts' driver calls with `server` while a call waits for its host.
+  void setDriverServer(DriverServer server);
+  /// Lockstep: publishes the simulated time on rt/clock; the calls after it carry it.
+  void publishClock(TimePoint now);
 
  private:
   friend class RemoteComponent;

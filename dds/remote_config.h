@@ -19,6 +19,10 @@ struct RemoteConfig {
   std::string network_interface = "lo";
   /// The components served by hosts (`costar host`), not built in the executor's process.
   std::vector<std::string> components;
+  /// Set by a simulated cell, never read from the file: the executor's clock is simulated and
+  /// published on rt/clock, each call of a remote component is answered at once at that time,
+  /// and the executor answers the hosts' driver calls while it waits (dds/lockstep.h).
+  bool lockstep = false;
 
   bool isRemote(const std::string& component) const;
 };

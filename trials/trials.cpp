@@ -63,7 +63,8 @@ std::unique_ptr<workcell::Workcell> trialWorkcell(const TrialOptions& options, i
                                          .seed = seed,
                                          .waypoints = options.waypoints,
                                          .memory_only = true,
-                                         .faults = nullptr};
+                                         .faults = nullptr,
+                                         .remote = options.remote};
   // The faults asked for, and those the trial's disturbances need (drawn from the same seed as
   // the Disturber that runOne makes).
   std::vector<std::string> inject = options.inject;
@@ -249,6 +250,10 @@ void checkOptions(const TrialOptions& options) {
   if (options.jobs < 1) {
     throw std::invalid_argument("the number of trials run at once must be at least 1, not " +
                                 std::to_string(options.jobs));
+  }
+  if (!options.remote.empty() && options.jobs != 1) {
+    throw std::invalid_argument("--jobs " + std::to_string(options.jobs) + " with --remote: a host serves one run at " +
+                                "a time, so trials with remote components run one at a time (--jobs 1)");
   }
   if (options.shard_count < 1 || options.shard_index < 0 || options.shard_index >= options.shard_count) {
     throw std::invalid_argument("shard " + std::to_string(options.shard_index) + "/" +

@@ -53,6 +53,10 @@ struct TrialOptions {
   /// When set, every trial's status transitions are written to trace_dir/trial_SEED.jsonl
   /// (bt/trace.h JSON lines: each node's failure reason, also of failures a retry recovered).
   std::filesystem::path trace_dir;
+  /// A JSON file naming the cell's components served by hosts (`costar host`) in lockstep with
+  /// each trial's simulation (workcell::WorkcellOptions::remote); empty: as the cell says.
+  /// A host serves one run at a time: with it, trials run one at a time (jobs 1).
+  std::filesystem::path remote;
 };
 
 /// A trial's speed and separation record, in a scene with a person (sim::SeparationRecord).

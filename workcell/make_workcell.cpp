@@ -18,14 +18,13 @@ namespace {
 /// How long the executor waits for the host of a remote component when the cell is built.
 constexpr std::chrono::seconds kHostWait{5};
 
-/// The "test" cell with the components named in `options.remote` served by hosts elsewhere:
+/// The "test" cell with the components named in `options.remote` served by hosts elsewhere
+/// (a simulated cell's are in lockstep with its simulation: workcell/sim_workcell.cpp):
 /// proxies (dds::RemoteComponent) in their place, wrapped by the fault injector like the others.
 std::unique_ptr<Workcell> makeCellWithRemoteComponents(const WorkcellOptions& options) {
   const std::string where = options.remote.string();
   if (options.name != "test") {
-    throw std::invalid_argument(where + ": the components of '" + options.name +
-                                "' cannot run in other processes yet: a simulated cell's components share its "
-                                "simulation (only the test cell's can; docs/ARCHITECTURE.md)");
+    throw std::invalid_argument(where + ": the '" + options.name + "' cell has no components to serve elsewhere");
   }
   nlohmann::json json;
   try {
@@ -70,7 +69,7 @@ std::unique_ptr<Workcell> makeWorkcell(const WorkcellOptions& given) {
   if (!options.faults && !options.inject.empty()) {
     options.faults = faults::Injector::fromText(options.inject, options.seed.value_or(1));
   }
-  if (!options.remote.empty()) {
+  if (!options.remote.empty() && (options.name == "test" || options.name == "none")) {
     return makeCellWithRemoteComponents(options);
   }
   if (options.faults && options.name == "test") {

@@ -83,7 +83,7 @@ SimCellDescription parse(const json& root, const std::filesystem::path& data_roo
   }
   onlyKnown(root, "",
             {"name", "label", "notes", "robot", "gripper", "robot_base", "cell_model", "scene", "waypoints", "table",
-             "workspace", "part_area", "calibration", "perception_model", "power_tool"});
+             "workspace", "part_area", "calibration", "perception_model", "power_tool", "remote"});
   SimCellDescription cell;
   cell.name = text(root, "", "name");
   cell.label = text(root, "", "label");
@@ -104,6 +104,9 @@ SimCellDescription parse(const json& root, const std::filesystem::path& data_roo
     // Not checked here: `costar perception retrain -w NAME` writes it; DetectObjects names it
     // when it is missing.
     cell.perception_model = data_root / text(root, "", "perception_model");
+  }
+  if (root.contains("remote")) {
+    cell.remote = objectAt(root, "", "remote");
   }
   const json& table = objectAt(root, "", "table");
   onlyKnown(table, "table", {"centre", "size"});

@@ -29,11 +29,16 @@
 //   power_tool       optional {tool: NAME (data/tools/NAME.json), stand: {position, rpy}}: a
 //                    power tool (tool/power_tool.h) and where its stand stands on the table; the
 //                    scene says whether the tool sits on it (sim/scene.h "power_tool")
+//   remote           optional {components, domain, partition, interface} (dds/remote_config.h):
+//                    the cell's components served by hosts (`costar host`: gripper, perception)
+//                    in lockstep with this process's simulation (dds/lockstep.h); read when the
+//                    cell is built. Absent: every component runs in the executor's process.
 //
 // Paths are relative to the data root (core/paths.h). Unknown fields are refused.
 
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -64,6 +69,8 @@ struct SimCellDescription {
     world::Pose stand = world::Pose::Identity();
   };
   std::optional<PowerTool> power_tool;
+  /// The `remote` object as written (null: none); checked when the cell is built.
+  nlohmann::json remote;
 };
 
 /// Reads a workcell description. @throws std::runtime_error "workcell description 'FILE':

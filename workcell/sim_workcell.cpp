@@ -17,7 +17,9 @@
 #include "arm/robot_description.h"
 #include "calibration/calibration_component.h"
 #include "component/operation_table.h"
+#include "core/json_file.h"
 #include "core/paths.h"
+#include "dds/remote_component.h"
 #include "faults/injector.h"
 #include "perception/hand_component.h"
 #include "perception/perception_component.h"
@@ -34,6 +36,7 @@
 #include "tool/power_tool.h"
 #include "workcell/cell_simulation.h"
 #include "workcell/grippers.h"
+#include "workcell/remote_sim.h"
 #include "workcell/sim_cell_description.h"
 
 namespace costar::workcell {
@@ -244,6 +247,42 @@ std::vector<std::string> gripperLinks(const arm::RobotDescription& robot, const 
   return links;
 }
 
+/// How long the executor waits for the host of a remote component when the cell is built.
+constexpr std::chrono::seconds kHostWait{5};
+
+/// The components served by hosts: WorkcellOptions::remote (a file) or else the description's
+/// `remote`; nullopt when every component runs here. @throws std::invalid_argument naming the
+/// file and the field.
+std::optional<dds::RemoteConfig> remoteComponents(const WorkcellOptions& options, const SimCellDescription& cell) {
+  std::optional<dds::RemoteConfig> remote;
+  std::string where;
+  if (!options.remote.empty()) {
+    where = options.remote.string();
+    nlohmann::json json;
+    try {
+      json = core::readJsonFile(options.remote);
+    } catch (const nlohmann::json::exception& error) {
+      throw std::invalid_argument(where + ": " + error.what());
+    }
+    remote = dds::remoteConfigFromJson(json, where);
+  } else if (!cell.remote.is_null()) {
+    where = "workcell description '" + cell.file.string() + "': remote";
+    remote = dds::remoteConfigFromJson(cell.remote, where);
+  } else {
+    return std::nullopt;
+  }
+  const std::vector<std::string>& known = remotableSimComponents();
+  for (const std::string& name : remote->components) {
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      throw std::invalid_argument(where + ": components: '" + name + "' of " + cell.name +
+                                  " cannot run in a host (gripper and perception can: the others share the cell's "
+                                  "planner, world or simulation)");
+    }
+  }
+  remote->lockstep = true;
+  return remote;
+}
+
 /// The generic simulated workcell: everything comes from the cell's description.
 class SimWorkcell final : public Workcell {
  public:
@@ -268,6 +307,15 @@ class SimWorkcell final : public Workcell {
                 options.memory_only ? std::filesystem::path() : defaultGraspFile(cell_.name), gripper_model_.grasps),
         faults_(options.faults) {
     simulation_->attach(static_cast<SimClock&>(clock()));
+    // Components served by hosts, in lockstep with this simulation: its clock on rt/clock, the
+    // hosts' driver calls answered from it (workcell/remote_sim.h).
+    const std::optional<dds::RemoteConfig> remote = remoteComponents(options, cell_);
+    if (remote) {
+      remote_ = dds::RemoteClient::create(*remote);
+      remote_->publishClock(clock().now());
+      static_cast<SimClock&>(clock()).addStepListener([this](TimePoint, TimePoint to) { remote_->publishClock(to); });
+    }
+    const auto served = [&remote](const std::string& name) { return remote && remote->isRemote(name); };
     if (faults_) {
       faults_->attach(clock());
     }
@@ -313,7 +361,16 @@ class SimWorkcell final : public Workcell {
     motion_ = std::make_unique<arm::MotionPlanner>(arm_driver, clock(), collisions_, kinematics, arm_config);
     // SmartMove reaches the gripper through its operations, as the tree does: the same (possibly
     // fault-injected) component the registry holds.
-    std::shared_ptr<component::Component> gripper = gripper_model_.make_component(gripper_drivers, clock());
+    std::shared_ptr<component::Component> gripper;
+    if (served("gripper")) {
+      if (gripper_drivers.parallel == nullptr) {
+        throw std::invalid_argument("the gripper of " + cell_.name + " ('" + cell_.gripper +
+                                    "') cannot run in a host: only a 2-finger gripper can");
+      }
+      gripper = remote_->connect("gripper", kHostWait);
+    } else {
+      gripper = gripper_model_.make_component(gripper_drivers, clock());
+    }
     if (faults_) {
       gripper = faults_->wrap(std::move(gripper));
     }
@@ -323,6 +380,10 @@ class SimWorkcell final : public Workcell {
     // moves the arm as SmartMove does.
     calibration_ = makeCalibration(options, *arm, arm_config.tcp_in_flange, camera);
     add(calibration_);
+    if (remote_) {
+      remote_->setDriverServer(simDriverServer(
+          gripper_drivers.parallel, camera, [calibration = calibration_.get()] { return calibration->cameraPose(); }));
+    }
     add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
         {"table_center", tableCenter()}, {"robot_base", cell_.robot_base}}));
     // In every simulated cell, so that a plan for a person beside the arm validates in any: its
@@ -364,8 +425,12 @@ class SimWorkcell final : public Workcell {
         perception_config.files.svm_file = cell_.perception_model;
       }
       perception_config.camera_pose = [calibration = calibration_.get()] { return calibration->cameraPose(); };
-      add(std::make_shared<perception::PerceptionComponent>(camera, clock(), threadPipeline(perception_config),
-                                                            perception_config));
+      if (served("perception")) {
+        add(remote_->connect("perception", kHostWait));
+      } else {
+        add(std::make_shared<perception::PerceptionComponent>(camera, clock(), threadPipeline(perception_config),
+                                                              perception_config));
+      }
       // The person's hand as the camera sees it (hand_1, gesture(hand_1, offer), in_zone); in a
       // scene without a person it takes no frames (nothing there is skin-coloured) and reports no hand.
       perception::HandComponentConfig hand_config;
@@ -638,6 +703,7 @@ class SimWorkcell final : public Workcell {
   std::shared_ptr<smartmove::SmartMoveComponent> smartmove_;
   std::shared_ptr<calibration::CalibrationComponent> calibration_;
   std::shared_ptr<faults::Injector> faults_;
+  std::shared_ptr<dds::RemoteClient> remote_;  // the hosts of remote components, or null
 };
 
 }  // namespace

@@ -65,8 +65,9 @@ struct WorkcellOptions {
   std::vector<std::string> inject;
   /// A JSON file naming the components that run in hosts elsewhere (`costar host`), reached over
   /// DDS: {"domain", "partition", "interface", "components"} (dds/remote_config.h). Empty: every
-  /// component runs in this process. Only the "test" cell for now: a simulated cell's components
-  /// share its simulation in one process.
+  /// component runs in this process (or, in a simulated cell, as its description's `remote`
+  /// says). A simulated cell's remote components (gripper, perception) run in lockstep with its
+  /// simulation (dds/lockstep.h, workcell/remote_sim.h).
   std::filesystem::path remote;
   /// Simulated cells: a spare part of each class named here, parked off the table, for a
   /// disturbance that puts a part on it mid-task (sim::SimulationOptions::spare_classes).

@@ -84,8 +84,27 @@ check "remote: no host"     2 "component 'test_actions': no host serves it on DD
 printf '{"partition": "%s", "components": ["gripper"]}' "$partition" >"$tmp/remote_bad.json"
 check "remote: unknown"     2 "remote_bad.json: components: the test cell has no component 'gripper'" \
   -- "$costar" run "$tmp/remote.xml" -w test --remote "$tmp/remote_bad.json"
-check "remote: sim cell"    2 "the components of 'ur5-sim' cannot run in other processes yet" \
+check "remote: sim cell"    2 "remote.json: components: 'test_actions' of ur5-sim cannot run in a host \(gripper and perception can" \
   -- "$costar" run "$tmp/remote.xml" -w ur5-sim --remote "$tmp/remote.json"
+# A simulated cell's gripper and perception in a host, in lockstep with the executor's simulation
+# (rt/clock, dds/lockstep.h): the same trials, to the bit, as with every component in one process.
+printf '{"domain": 71, "partition": "%s", "components": ["gripper", "perception"]}' "$partition" >"$tmp/sim_remote.json"
+"$costar" host gripper perception -w ur5-sim --domain 71 --partition "$partition" 2>"$tmp/sim_host.log" &
+sim_host_pid=$!
+trial_args=(trials examples/ur5/pick_up_node.xml --judge lift -n 2 --seed 41 -j 1)
+check "remote sim: one process" 0 '^2 of 2 trials succeeded' -- "$costar" "${trial_args[@]}" --json "$tmp/local_trials.json"
+check "remote sim: trials"      0 '^2 of 2 trials succeeded' -- "$costar" "${trial_args[@]}" --remote "$tmp/sim_remote.json" \
+  --json "$tmp/remote_trials.json"
+check "remote sim: the same"    0 '^same: 2 trials$' -- python3 -c '
+import json, sys
+def trials(file):
+    return [(t["seed"], t["success"], t["cycle_time_s"], t["judged"]) for t in json.load(open(file))["results"]]
+a, b = trials(sys.argv[1]), trials(sys.argv[2])
+print(f"same: {len(a)} trials" if a == b and a else f"differ: {a} vs {b}")' "$tmp/local_trials.json" "$tmp/remote_trials.json"
+check "remote sim: -j 2"        2 'a host serves one run at a time' \
+  -- "$costar" trials examples/ur5/pick_up_node.xml --judge lift -n 2 --seed 41 -j 2 --remote "$tmp/sim_remote.json"
+kill "$sim_host_pid"; wait "$sim_host_pid"
+check "remote sim: host ended"  0 'serving gripper perception of ur5-sim in lockstep' -- cat "$tmp/sim_host.log"
 check "help"                0 'Exit code: 0 SUCCESS' -- "$costar" run --help
 check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit 0.1
 check "inject: bad spec"    2 "fault 'melt:arm@t=1': unknown kind 'melt'" \

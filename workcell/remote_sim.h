@@ -1,0 +1,48 @@
+#pragma once
+// A simulated cell's components served by a host (`costar host gripper perception -w ur5-sim`)
+// in lockstep with the executor that owns the simulation (dds/lockstep.h). The executor answers
+// its hosts' driver calls from its simulator (simDriverServer); a host builds the components on
+// drivers that call it (RemoteSimComponents). The gripper (a 2-finger one) and perception can
+// be remote: the others share the cell's planner, world or simulation in the executor.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "camera/rgbd.h"
+#include "component/component.h"
+#include "dds/lockstep.h"
+#include "gripper/gripper_driver.h"
+
+namespace costar::workcell {
+
+/// The components of a simulated cell that a host may serve.
+const std::vector<std::string>& remotableSimComponents();
+
+/// The executor's answers to its hosts' driver calls: `gripper` (read, command, max_opening) on
+/// the cell's 2-finger driver (may be null: the cell has none), `camera` (info, capture,
+/// capture_depth, stream_status) with the frames seen from `camera_pose()` (the calibrated pose,
+/// as perception in the executor's process sees them).
+dds::DriverServer simDriverServer(gripper::GripperDriver* gripper, camera::RgbdCamera& camera,
+                                  std::function<world::Pose()> camera_pose);
+
+/// A host's components of simulated cell `cell` on drivers that call the executor through
+/// `link`, and what they need kept alive.
+class RemoteSimComponents {
+ public:
+  /// @throws std::invalid_argument naming a component that cannot be remote, or the cell's
+  /// gripper when it is not a 2-finger one; std::runtime_error for an unreadable cell.
+  RemoteSimComponents(const std::string& cell, const std::vector<std::string>& names, dds::SimulatorLink& link);
+  ~RemoteSimComponents();
+  RemoteSimComponents(const RemoteSimComponents&) = delete;
+  RemoteSimComponents& operator=(const RemoteSimComponents&) = delete;
+
+  /// The components afresh (a new run), in the order of `names`.
+  std::vector<std::shared_ptr<component::Component>> make();
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace costar::workcell
