@@ -31,6 +31,8 @@ const TopicInfo& info(Topic topic) {
       {"rq/costar/sim/driverRequest", &costar_msgs_srv_dds__Call_Request__desc, false},
       {"rr/costar/sim/driverReply", &costar_msgs_srv_dds__Call_Response__desc, false},
       {"rt/clock", &rosgraph_msgs_msg_dds__Clock__desc, false, true},
+      {"rt/joint_states", &sensor_msgs_msg_dds__JointState__desc, false, true},
+      {"rt/wrench", &geometry_msgs_msg_dds__WrenchStamped__desc, false, true},
   };
   static_assert(std::size(kTopics) == kTopicCount);
   return kTopics[static_cast<int>(topic)];

@@ -33,8 +33,10 @@ enum class Topic {
   kDriverRequest,      // rq/costar/sim/driverRequest (lockstep)
   kDriverReply,        // rr/costar/sim/driverReply
   kClock,              // rt/clock (rosgraph_msgs/msg/Clock: the simulated time)
+  kJointStates,        // rt/joint_states (sensor_msgs/msg/JointState)
+  kWrench,             // rt/wrench (geometry_msgs/msg/WrenchStamped)
 };
-inline constexpr int kTopicCount = 13;
+inline constexpr int kTopicCount = 15;
 const char* topicName(Topic topic);
 
 /// Owns the participant and everything made from it. Not copyable.

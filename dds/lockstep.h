@@ -8,6 +8,7 @@
 // it waits. Simulated time stands still while a call is out, so a run is the same whichever
 // process its components run in, and the same for a seed.
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -27,6 +28,23 @@ struct DriverReply {
   nlohmann::json result;
   std::vector<float> floats;
   std::vector<std::uint8_t> bytes;
+};
+
+/// An arm's joints as ROS 2's sensor_msgs/msg/JointState carries them (rad, rad/s, N m).
+struct JointStateSample {
+  TimePoint stamp{};
+  std::vector<std::string> names;
+  std::vector<double> position;
+  std::vector<double> velocity;
+  std::vector<double> effort;
+};
+
+/// A wrist sensor's reading as geometry_msgs/msg/WrenchStamped carries it (N, N m, in `frame_id`).
+struct WrenchSample {
+  TimePoint stamp{};
+  std::string frame_id;
+  std::array<double, 3> force{};
+  std::array<double, 3> torque{};
 };
 
 /// The executor's side: answers `method` of `driver` with `args` (dds::RemoteClient calls it

@@ -80,7 +80,7 @@ struct RemoteClient::State {
 
   // Lockstep (config.lockstep), used from the executor's thread only.
   dds_entity_t call_writer = 0, call_reply_reader = 0, driver_request_reader = 0, driver_reply_writer = 0;
-  dds_entity_t clock_writer = 0, waitset = 0;
+  dds_entity_t clock_writer = 0, joint_state_writer = 0, wrench_writer = 0, waitset = 0;
   DriverServer driver_server;
   std::int64_t clock_ns = 0;
   std::uint64_t calls = 0;
@@ -331,10 +331,62 @@ RemoteClient::RemoteClient(const RemoteConfig& config) : state_(std::make_unique
     state.driver_request_reader = state.bus.reader(Topic::kDriverRequest, nullptr);
     state.driver_reply_writer = state.bus.writer(Topic::kDriverReply);
     state.clock_writer = state.bus.writer(Topic::kClock);
+    state.joint_state_writer = state.bus.writer(Topic::kJointStates);
+    state.wrench_writer = state.bus.writer(Topic::kWrench);
     state.waitset = dds_create_waitset(state.bus.participant());
     dds_waitset_attach(state.waitset, dds_create_readcondition(state.call_reply_reader, DDS_ANY_STATE), 0);
     dds_waitset_attach(state.waitset, dds_create_readcondition(state.driver_request_reader, DDS_ANY_STATE), 0);
   }
+}
+
+namespace {
+
+builtin_interfaces_msg_dds__Time_ rosTime(TimePoint t) {
+  const std::int64_t ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count();
+  return {static_cast<std::int32_t>(ns / 1'000'000'000), static_cast<std::uint32_t>(ns % 1'000'000'000)};
+}
+
+template <typename Sequence, typename T>
+void view(Sequence& sequence, std::vector<T>& values) {
+  sequence._buffer = values.data();
+  sequence._length = sequence._maximum = static_cast<std::uint32_t>(values.size());
+  sequence._release = false;
+}
+
+}  // namespace
+
+void RemoteClient::publishJointState(const JointStateSample& joints) {
+  State& state = *state_;
+  if (!state.config.lockstep) {
+    throw std::logic_error("RemoteClient::publishJointState: only in lockstep");
+  }
+  std::vector<char*> names;
+  for (const std::string& name : joints.names) {
+    names.push_back(wire(name));
+  }
+  std::vector<double> position = joints.position, velocity = joints.velocity, effort = joints.effort;
+  static const std::string kNoFrame;
+  sensor_msgs_msg_dds__JointState_ message{};
+  message.header.stamp = rosTime(joints.stamp);
+  message.header.frame_id = wire(kNoFrame);
+  view(message.name, names);
+  view(message.position, position);
+  view(message.velocity, velocity);
+  view(message.effort, effort);
+  Bus::write(state.joint_state_writer, &message);
+}
+
+void RemoteClient::publishWrench(const WrenchSample& wrench) {
+  State& state = *state_;
+  if (!state.config.lockstep) {
+    throw std::logic_error("RemoteClient::publishWrench: only in lockstep");
+  }
+  geometry_msgs_msg_dds__WrenchStamped_ message{};
+  message.header.stamp = rosTime(wrench.stamp);
+  message.header.frame_id = wire(wrench.frame_id);
+  message.wrench.force = {wrench.force[0], wrench.force[1], wrench.force[2]};
+  message.wrench.torque = {wrench.torque[0], wrench.torque[1], wrench.torque[2]};
+  Bus::write(state.wrench_writer, &message);
 }
 
 void RemoteClient::setDriverServer(DriverServer server) { state_->driver_server = std::move(server); }

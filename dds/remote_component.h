@@ -58,6 +58,10 @@ class RemoteClient : public std::enable_shared_from_this<RemoteClient> {
   void setDriverServer(DriverServer server);
   /// Lockstep: publishes the simulated time on rt/clock; the calls after it carry it.
   void publishClock(TimePoint now);
+  /// Lockstep: publishes the arm's joints on rt/joint_states (sensor_msgs/msg/JointState) and the
+  /// wrist's wrench on rt/wrench (geometry_msgs/msg/WrenchStamped), for ROS 2 tools on the domain.
+  void publishJointState(const JointStateSample& joints);
+  void publishWrench(const WrenchSample& wrench);
 
  private:
   friend class RemoteComponent;

@@ -203,7 +203,7 @@ dds::DriverServer simDriverServer(gripper::GripperDriver* gripper, camera::RgbdC
 }
 
 struct RemoteSimComponents::State {
-  explicit State(dds::SimulatorLink& link) : link(link), camera(link) {}
+  explicit State(dds::SimulatorLink& simulator) : link(simulator), camera(simulator) {}
 
   dds::SimulatorLink& link;
   std::vector<std::string> names;

@@ -313,7 +313,10 @@ class SimWorkcell final : public Workcell {
     if (remote) {
       remote_ = dds::RemoteClient::create(*remote);
       remote_->publishClock(clock().now());
-      static_cast<SimClock&>(clock()).addStepListener([this](TimePoint, TimePoint to) { remote_->publishClock(to); });
+      static_cast<SimClock&>(clock()).addStepListener([this](TimePoint, TimePoint to) {
+        remote_->publishClock(to);
+        publishRobotState(to);
+      });
     }
     const auto served = [&remote](const std::string& name) { return remote && remote->isRemote(name); };
     if (faults_) {
@@ -621,6 +624,28 @@ class SimWorkcell final : public Workcell {
       drawing["power_tool"] = std::move(power_tool);
     }
     return drawing;
+  }
+
+  /// The arm's joints and the wrist's wrench as ROS 2 types, for ROS 2 tools on the domain
+  /// (the simulator's readings, read without side effects).
+  void publishRobotState(TimePoint now) {
+    dds::JointStateSample joints;
+    joints.stamp = now;
+    joints.names = robot_description_.joint_names;
+    const sim::ArmJoints position = simulation_->armPositions();
+    const sim::ArmJoints velocity = simulation_->armVelocities();
+    for (int j = 0; j < position.size(); ++j) {
+      joints.position.push_back(position[j]);
+      joints.velocity.push_back(velocity[j]);
+    }
+    remote_->publishJointState(joints);
+    const arm::ForceTorqueReading reading = simulation_->forceTorqueSensor().read();
+    dds::WrenchSample wrench;
+    wrench.stamp = now;
+    wrench.frame_id = robot_description_.urdf_tool_link;
+    wrench.force = {reading.wrench.force.x(), reading.wrench.force.y(), reading.wrench.force.z()};
+    wrench.torque = {reading.wrench.torque.x(), reading.wrench.torque.y(), reading.wrench.torque.z()};
+    remote_->publishWrench(wrench);
   }
 
   std::string name() const override { return cell_.name; }

@@ -9,6 +9,8 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <functional>
+#include <optional>
 #include <thread>
 
 #include "dds/bus.h"
@@ -146,39 +148,96 @@ TEST(Lockstep, EachNewExecutorGetsTheComponentsAfresh) {
   }
 }
 
-TEST(Lockstep, TheClockIsRos2sOnTheWire) {
-  RemoteConfig config = lockstepConfig("clock");
-  const auto client = RemoteClient::create(config);
-  // A reader of its own, as a ROS 2 node would read /clock: topic rt/clock, type
-  // rosgraph_msgs::msg::dds_::Clock_ from the IDL written from ROS 2's Clock.msg and Time.msg.
+/// A reader of its own on `topic_name`, as a ROS 2 node would read it (no costar code): checks
+/// its type's name on the wire and the first sample that `publish` (called until one arrives)
+/// sends; whether one arrived.
+template <typename T>
+bool readAsRos2(const RemoteConfig& config, const dds_topic_descriptor_t* type, const char* topic_name,
+                const char* expected_type, const std::function<void()>& publish,
+                const std::function<void(const T&)>& check) {
   const dds_entity_t participant = dds_create_participant(kDomain, nullptr, nullptr);
-  ASSERT_GT(participant, 0);
-  const dds_entity_t topic =
-      dds_create_topic(participant, &rosgraph_msgs_msg_dds__Clock__desc, "rt/clock", nullptr, nullptr);
-  ASSERT_GT(topic, 0);
+  EXPECT_GT(participant, 0);
+  const dds_entity_t topic = dds_create_topic(participant, type, topic_name, nullptr, nullptr);
+  EXPECT_GT(topic, 0);
   char type_name[128] = {};
-  ASSERT_GE(dds_get_type_name(topic, type_name, sizeof(type_name)), 0);
-  EXPECT_STREQ(type_name, "rosgraph_msgs::msg::dds_::Clock_");
+  EXPECT_GE(dds_get_type_name(topic, type_name, sizeof(type_name)), 0);
+  EXPECT_STREQ(type_name, expected_type);
   dds_qos_t* qos = dds_create_qos();
   dds_qset_partition1(qos, config.partition.c_str());
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   const dds_entity_t subscriber = dds_create_subscriber(participant, qos, nullptr);
   const dds_entity_t reader = dds_create_reader(subscriber, topic, qos, nullptr);
   dds_delete_qos(qos);
-  ASSERT_GT(reader, 0);
-  // Published until the reader has it (discovery takes a moment; no result depends on how long).
-  std::optional<rosgraph_msgs_msg_dds__Clock_> got;
+  EXPECT_GT(reader, 0);
+  // Published until the reader has one (discovery takes a moment; no result depends on how long).
+  bool got = false;
   const auto guard = std::chrono::steady_clock::now() + seconds(20);
   while (!got && std::chrono::steady_clock::now() < guard) {
-    client->publishClock(TimePoint(std::chrono::nanoseconds(12'345'000'678)));
+    publish();
     std::this_thread::sleep_for(milliseconds(10));
-    Bus::takeAll<rosgraph_msgs_msg_dds__Clock_>(reader,
-                                                [&](const rosgraph_msgs_msg_dds__Clock_& clock) { got = clock; });
+    Bus::takeAll<T>(reader, [&](const T& sample) {
+      if (!got) {
+        check(sample);
+        got = true;
+      }
+    });
   }
   dds_delete(participant);
-  ASSERT_TRUE(got.has_value());
-  EXPECT_EQ(got->clock.sec, 12);
-  EXPECT_EQ(got->clock.nanosec, 345'000'678U);
+  return got;
+}
+
+TEST(Lockstep, TheClockIsRos2sOnTheWire) {
+  const RemoteConfig config = lockstepConfig("clock");
+  const auto client = RemoteClient::create(config);
+  // Read with rosgraph_msgs::msg::dds_::Clock_ from the IDL written from ROS 2's Clock.msg and Time.msg.
+  const auto got = readAsRos2<rosgraph_msgs_msg_dds__Clock_>(
+      config, &rosgraph_msgs_msg_dds__Clock__desc, "rt/clock", "rosgraph_msgs::msg::dds_::Clock_",
+      [&] { client->publishClock(TimePoint(std::chrono::nanoseconds(12'345'000'678))); },
+      [](const rosgraph_msgs_msg_dds__Clock_& clock) {
+        EXPECT_EQ(clock.clock.sec, 12);
+        EXPECT_EQ(clock.clock.nanosec, 345'000'678U);
+      });
+  EXPECT_TRUE(got);
+}
+
+TEST(Lockstep, JointStatesAndTheWrenchAreRos2sOnTheWire) {
+  const RemoteConfig config = lockstepConfig("robot");
+  const auto client = RemoteClient::create(config);
+  JointStateSample joints;
+  joints.stamp = TimePoint(milliseconds(2500));
+  joints.names = {"shoulder_pan_joint", "shoulder_lift_joint"};
+  joints.position = {0.5, -1.25};
+  joints.velocity = {0.0, 0.125};
+  const auto got_joints = readAsRos2<sensor_msgs_msg_dds__JointState_>(
+      config, &sensor_msgs_msg_dds__JointState__desc, "rt/joint_states", "sensor_msgs::msg::dds_::JointState_",
+      [&] { client->publishJointState(joints); },
+      [](const sensor_msgs_msg_dds__JointState_& state) {
+        EXPECT_EQ(state.header.stamp.sec, 2);
+        EXPECT_EQ(state.header.stamp.nanosec, 500'000'000U);
+        ASSERT_EQ(state.name._length, 2U);
+        EXPECT_STREQ(state.name._buffer[1], "shoulder_lift_joint");
+        ASSERT_EQ(state.position._length, 2U);
+        EXPECT_EQ(state.position._buffer[1], -1.25);
+        ASSERT_EQ(state.velocity._length, 2U);
+        EXPECT_EQ(state.velocity._buffer[1], 0.125);
+        EXPECT_EQ(state.effort._length, 0U);
+      });
+  EXPECT_TRUE(got_joints);
+  WrenchSample wrench;
+  wrench.stamp = TimePoint(milliseconds(2510));
+  wrench.frame_id = "tool0";
+  wrench.force = {1.5, -2.0, 10.25};
+  wrench.torque = {0.0, 0.5, -0.125};
+  const auto got_wrench = readAsRos2<geometry_msgs_msg_dds__WrenchStamped_>(
+      config, &geometry_msgs_msg_dds__WrenchStamped__desc, "rt/wrench", "geometry_msgs::msg::dds_::WrenchStamped_",
+      [&] { client->publishWrench(wrench); },
+      [](const geometry_msgs_msg_dds__WrenchStamped_& stamped) {
+        EXPECT_EQ(stamped.header.stamp.nanosec, 510'000'000U);
+        EXPECT_STREQ(stamped.header.frame_id, "tool0");
+        EXPECT_EQ(stamped.wrench.force.z, 10.25);
+        EXPECT_EQ(stamped.wrench.torque.z, -0.125);
+      });
+  EXPECT_TRUE(got_wrench);
 }
 
 }  // namespace
