@@ -15,6 +15,7 @@
 #include "server/run_lifecycle.h"
 #include "server/run_observer.h"
 #include "sim/simulation.h"
+#include "smartmove/grasps.h"
 #include "workcell/workcell.h"
 
 namespace costar::server {
@@ -26,6 +27,12 @@ Engine::Engine(std::unique_ptr<workcell::Workcell> cell, Store* store, EngineOpt
 
 Engine::Engine(workcell::Workcell& cell, Store* store, EngineOptions options)
     : cell_(&cell), options_(std::move(options)), palette_(describePalette(cell)), pace_(options_.pace) {
+  if (!options_.grasp_defaults.empty()) {
+    const nlohmann::json drawing = cell.robotDrawing();
+    grasp_gripper_ = drawing.is_object() && drawing.contains("gripper")
+                         ? drawing["gripper"].value("grasps", std::string(smartmove::kParallelGripper))
+                         : std::string(smartmove::kParallelGripper);
+  }
   if (store != nullptr) {
     next_run_id_ = store->maxRunId() + 1;
     log_ = std::make_unique<RunLogWriter>(*store);

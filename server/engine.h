@@ -159,6 +159,9 @@ class Engine final : public Backend {
   std::unique_ptr<workcell::Workcell> owned_cell_;  // a cell made by the engine (reset), or given to it
   workcell::Workcell* cell_;                        // the cell now (engine thread only, after construction)
   EngineOptions options_;
+  /// Whose grasps the choices offer: the cell's gripper's (robotDrawing's gripper.grasps; the
+  /// 3-finger gripper's on iiwa-3f-sim, not the 2-finger one's).
+  std::string grasp_gripper_;
   const Palette palette_;
 
   std::thread thread_;

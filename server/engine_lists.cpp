@@ -1,7 +1,8 @@
 // What the editor offers: the workcell's info (the palette's, with the engine's pace, active
 // run and counters), the choice lists read from what the cell knows now (waypoints, frames,
-// object classes, predicates, the grasps taught per class), and each object class's shape and
-// colours (for drawing the parts).
+// object classes, predicates, the grasps of the cell's gripper per class, each with the tool
+// centre point in the part's frame and its mode, for drawing it on the parts), and each object
+// class's shape and colours (for drawing the parts).
 
 #include "server/engine_parts.h"
 
@@ -9,6 +10,9 @@
 #include <functional>
 #include <set>
 #include <string_view>
+
+#include <Eigen/Geometry>
+
 #include "arm/arm_component.h"
 #include "server/cell_state.h"
 #include "sim/simulation.h"
@@ -236,24 +240,36 @@ json Engine::choices() {
       predicates.push_back({{"name", name}, {"arity", decl.arity}, {"description", decl.description}});
     }
     json grasps = json::object();
+    json grasp_poses = json::object();
     try {
       if (!options_.grasp_defaults.empty() && std::filesystem::exists(options_.grasp_defaults)) {
-        const smartmove::GraspLibrary library(options_.grasp_defaults, options_.grasp_taught);
+        const smartmove::GraspLibrary library(options_.grasp_defaults, options_.grasp_taught, grasp_gripper_);
         for (const std::string& object_class : classes) {
           json names = json::array();
+          json poses = json::object();
           for (const auto& grasp : library.forClass(object_class)) {
             names.push_back(grasp.name);
+            const Eigen::Vector3d& p = grasp.tcp_in_object.translation();
+            const Eigen::Quaterniond q(grasp.tcp_in_object.linear());
+            poses[grasp.name] = {
+                {"p", {p.x(), p.y(), p.z()}}, {"q", {q.x(), q.y(), q.z(), q.w()}}, {"mode", grasp.mode}};
           }
           grasps[object_class] = std::move(names);
+          grasp_poses[object_class] = std::move(poses);
         }
       }
     } catch (const std::exception&) {
       // An unreadable grasp file: SmartMove reports it when it runs; offer no list.
     }
-    return json{
-        {"waypoint", known.waypoints}, {"trajectory", known.trajectories}, {"trajectory_line", trajectoryLines(*cell_)},
-        {"frame", known.frames},       {"object_class", classes},          {"predicate", std::move(predicates)},
-        {"grasp", std::move(grasps)},  {"object_shape", std::move(shapes)}};
+    return json{{"waypoint", known.waypoints},
+                {"trajectory", known.trajectories},
+                {"trajectory_line", trajectoryLines(*cell_)},
+                {"frame", known.frames},
+                {"object_class", classes},
+                {"predicate", std::move(predicates)},
+                {"grasp", std::move(grasps)},
+                {"grasp_pose", std::move(grasp_poses)},
+                {"object_shape", std::move(shapes)}};
   });
 }
 

@@ -524,7 +524,8 @@ class SimWorkcell final : public Workcell {
     }
     // The fingers are drawn from the gripper's reading where the page knows how (in place of the
     // finger link's shapes); a gripper whose fingers are not modelled keeps its URDF shapes.
-    nlohmann::json gripper = {{"key", gripper_model_.key}, {"finger_links", nlohmann::json::array()}};
+    nlohmann::json gripper = {
+        {"key", gripper_model_.key}, {"grasps", gripper_model_.grasps}, {"finger_links", nlohmann::json::array()}};
     if (!gripper_model_.adaptive.empty()) {
       gripper["kind"] = "adaptive";
       std::ifstream in(gripper::gripperDescriptionFile(gripper_model_.adaptive));

@@ -100,8 +100,8 @@ class Workcell {
   /// use, or null for a cell without a robot: `urdf` (the arm's URDF with the gripper's mounted
   /// on its flange: the planner's model), `base_link`, `flange_link`, `tcp_link`,
   /// `base_in_world` {p, q [x, y, z, w]}, `joints` [{name, label, lower, upper}] (rad),
-  /// `gripper` {key, kind ("parallel": `max_opening`, `finger_boxes` of the +y finger closed, in
-  /// the flange frame; "adaptive": `description`, the gripper's description file),
+  /// `gripper` {key, grasps (its grasps' key in data/grasps.json), kind ("parallel": `max_opening`, `finger_boxes` of
+  /// the +y finger closed, in the flange frame; "adaptive": `description`, the gripper's description file),
   /// `finger_links` (drawn from the gripper's reading, not from the URDF)}, and the `table`
   /// {centre, size} it stands by (m).
   virtual nlohmann::json robotDrawing() const { return nullptr; }

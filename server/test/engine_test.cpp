@@ -477,6 +477,13 @@ TEST(Ur5Cell, ChoicesComeFromWhatTheCellKnows) {
   EXPECT_TRUE(has(choices["frame"], "table_center"));
   EXPECT_TRUE(has(choices["object_class"], "node"));
   EXPECT_TRUE(has(choices["grasp"]["node"], "top"));
+  EXPECT_FALSE(has(choices["grasp"]["node"], "pinch"));  // the 3-finger gripper's
+  // Each grasp's tool centre point in the part's frame (data/grasps.json: 5 mm above a node's
+  // centre, the tool pointing down), drawn on the parts by the page.
+  const json& top = choices["grasp_pose"]["node"]["top"];
+  EXPECT_NEAR(top["p"][2].get<double>(), 0.005, 1e-9);
+  EXPECT_NEAR(std::abs(top["q"][0].get<double>()), 1.0, 1e-9);  // 180 degrees about x
+  EXPECT_EQ(top["mode"], "");
   // The classes' shapes and colours, as the class files give them, for drawing the parts.
   const json& node_shape = choices["object_shape"]["node"];
   ASSERT_EQ(node_shape["boxes"].size(), 19u);
@@ -732,6 +739,27 @@ TEST(Ur5Cell, ThePaletteMarksTheModesTheGripperLacks) {
   for (const char* available : {"PinchMode", "Open", "Close", "SetMode", "Move"}) {
     EXPECT_FALSE(nodes[available].contains("unavailable")) << available;
   }
+}
+
+// The editor offered the 2-finger gripper's grasps on the 3-finger cell: its grasp lists read
+// data/grasps.json for parallel-2f whatever the cell's gripper, so SmartGrasp's list lacked
+// basic, pinch, wide and scissor (which the plan may name) and no grasp carried its mode.
+TEST(ThreeFingerCell, TheGraspsOfferedAreTheThreeFingerGrippersOwnWithTheirModes) {
+  workcell::WorkcellOptions options;
+  options.name = "iiwa-3f-sim";
+  Harness h(options);
+  const json choices = h.get("/api/choices");
+  std::vector<std::string> node;
+  for (const auto& name : choices["grasp"]["node"]) {
+    node.push_back(name.get<std::string>());
+  }
+  std::sort(node.begin(), node.end());
+  EXPECT_EQ(node, (std::vector<std::string>{"basic", "pinch", "scissor", "top", "wide"}));
+  const json& wide = choices["grasp_pose"]["node"]["wide"];
+  EXPECT_EQ(wide["mode"], "wide");
+  EXPECT_NEAR(wide["p"][1].get<double>(), -0.006, 1e-9);
+  EXPECT_EQ(choices["grasp_pose"]["node"]["top"]["mode"], "pinch");
+  EXPECT_EQ(choices["grasp_pose"]["link"]["scissor"]["mode"], "scissor");
 }
 
 // --- the iiwa with the power tool (iiwa-3f-sim, the polishing scene) ---------------------------

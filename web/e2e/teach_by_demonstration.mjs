@@ -150,6 +150,16 @@ async function main() {
   fs.writeFileSync(path.join(artifacts, 'actions_teach_pick.txt'), `${pickActions}\n`);
   const choices = (await api(url, token, 'GET', '/api/choices')).json;
   check((choices.grasp.node ?? []).includes('taught'), `the grasp is offered for nodes: ${(choices.grasp.node ?? []).join(', ')}`);
+  const taught = choices.grasp_pose?.node?.taught;
+  log(`the grasp taught: the tool centre point ${taught ? taught.p.map((v) => (v * 1000).toFixed(1)).join(', ') : '?'} mm from the node's centre (data/grasps.json's: 0, 0, 5)`);
+  // The taught grasp drawn on the part in the 3D view: the open gripper at the tool centre point.
+  await page.waitForFunction((name) => name in JSON.parse(document.querySelector('.view3d-canvas')?.getAttribute('data-grasp-screens') ?? '{}'), target.name, { timeout: 30000 });
+  const caption = await page.textContent('.view3d-grasp');
+  check(caption.includes("grasp 'taught'") && caption.includes(target.name), `the 3D view draws the taught grasp on the part: "${caption}"`);
+  const drawnAt = JSON.parse(await view.getAttribute('data-grasp-screens'))[target.name];
+  const partAt = JSON.parse(await view.getAttribute('data-part-screens'))[target.name];
+  check(norm(sub(drawnAt, partAt)) < 20, `the grasp is drawn on ${target.name}: ${norm(sub(drawnAt, partAt)).toFixed(1)} px from the part's centre on the screen`);
+  await page.screenshot({ path: path.join(artifacts, 'teach_grasp_drawn_1280x800.png') });
 
   // --- record a stroke: up and across (side view) -----------------------------------------------
   await fill('type the trajectory name carry', 'input[aria-label="trajectory name"]', 'carry');

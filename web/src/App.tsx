@@ -38,7 +38,7 @@ import { SignIn } from './components/SignIn';
 import { NodeEditor } from './components/NodeEditor';
 import { candidatesOf, ObjectsPane } from './components/ObjectsPane';
 import { Waypoints } from './components/Waypoints';
-import { HandGuiding } from './components/HandGuiding';
+import { HandGuiding, type ShownGrasp } from './components/HandGuiding';
 import { freeDriveAttributes, type Guiding } from './model/handGuide';
 import { View3D } from './components/View3D';
 import { Replay } from './components/Replay';
@@ -106,6 +106,8 @@ export function App() {
   const [choices, setChoices] = useState<Choices | null>(null);
   const [robot, setRobot] = useState<RobotDescription | null>(null);
   const [guiding, setGuiding] = useState<Guiding>({ mode: 'free', locked: [], record: '', recordFrame: 'world' });
+  /** The grasp drawn on the parts in the 3D view (the one taught last, or chosen under the waypoints). */
+  const [shownGrasp, setShownGrasp] = useState<ShownGrasp | null>(null);
   const guidingRef = useRef(guiding);
   guidingRef.current = guiding;
   const [cell, setCell] = useState<CellState | null>(null);
@@ -811,6 +813,10 @@ export function App() {
   const selectedData = selected ? candidatesOf(shownStatuses.get(selected.key)?.data) : null;
   // What the lists offer: what the cell knows now (the live snapshot), not what it knew when
   // the page loaded.
+  const shownGraspPose = useMemo(() => {
+    const pose = shownGrasp ? choices?.grasp_pose?.[shownGrasp.objectClass]?.[shownGrasp.name] : undefined;
+    return shownGrasp && pose ? { ...shownGrasp, pose } : undefined;
+  }, [shownGrasp, choices]);
   const liveChoices = useMemo(() => {
     if (!choices) return null;
     if (!cell) return choices;
@@ -1185,6 +1191,7 @@ export function App() {
         robot={robot}
         onGrab={replay || !info?.features.free_drive ? undefined : grabTool}
         trajectoryLines={choices?.trajectory_line}
+        grasp={shownGraspPose}
         replayLabel={replay ? (replayed ? `run #${replay.log.id} at t = ${replayed.t.toFixed(1)} s (replay)` : `run #${replay.log.id}: no snapshots logged (the cell now)`) : undefined}
       />
       <Waypoints
@@ -1203,6 +1210,9 @@ export function App() {
             classes={choices?.object_class ?? []}
             trajectories={choices?.trajectory ?? []}
             graspModes={(nodes.find((n) => n.id === 'TeachGrasp')?.ports.find((p) => p.name === 'mode')?.choices ?? []).filter((m) => m !== '')}
+            grasps={choices?.grasp ?? {}}
+            shownGrasp={shownGrasp}
+            onShowGrasp={setShownGrasp}
             refusal={refusedMotion}
             run={runOperation}
           />

@@ -3,6 +3,7 @@
 import type { PlanJson } from './model/tree';
 import type { NodeStatus, RunNode, Transition } from './model/status';
 import type { FingerReading, RobotDescription } from './model/robot';
+import type { GraspPose } from './model/graspDrawing';
 
 export interface PortInfo {
   name: string;
@@ -39,6 +40,8 @@ export interface Choices {
   object_class: string[];
   predicate: { name: string; arity: number; description: string }[];
   grasp: Record<string, string[]>;
+  /** Each grasp's tool centre point in its class's frame ({p, q [x, y, z, w]}) and the gripper mode it needs. */
+  grasp_pose?: Record<string, Record<string, GraspPose>>;
   /** Each object class's shape (boxes in its frame, metres) and named colours (RGB in [0, 1]). */
   object_shape?: Record<string, ObjectShape>;
   /** Trajectories recorded by hand guiding (FreeDrive's record), and their kept points in the world. */

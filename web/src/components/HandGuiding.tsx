@@ -1,7 +1,8 @@
 // Teaching by demonstration (docs/TEACHING.md), under the waypoint pane: the guiding mode the
 // tool's handle in the 3D view moves the arm in (Franka's: free, translation only, rotation only,
 // world axes locked: x, y, z), recording the guided path as a trajectory, replaying one, and teaching a grasp
-// of the part the gripper is around now (SmartMove's relative transform for that class).
+// of the part the gripper is around now (SmartMove's relative transform for that class), drawn on
+// the parts of that class in the 3D view (the one taught last, or any of the class's chosen).
 
 import { useState } from 'react';
 import type { Guiding } from '../model/handGuide';
@@ -15,8 +16,18 @@ interface Props {
   trajectories: string[];
   /** The gripper's modes a grasp may need (TeachGrasp's mode: the 3-finger gripper's); none: no choice. */
   graspModes: string[];
+  /** The grasps of each class (GET /api/choices), for the one drawn on the parts. */
+  grasps: Record<string, string[]>;
+  /** The grasp drawn on the parts in the 3D view (the one taught last, or chosen), or null. */
+  shownGrasp: ShownGrasp | null;
+  onShowGrasp: (shown: ShownGrasp | null) => void;
   refusal: string | null;
   run: (node: string, attributes?: Record<string, string>) => void;
+}
+
+export interface ShownGrasp {
+  objectClass: string;
+  name: string;
 }
 
 const MODES: { mode: Guiding['mode']; label: string; title: string }[] = [
@@ -25,7 +36,7 @@ const MODES: { mode: Guiding['mode']; label: string; title: string }[] = [
   { mode: 'rotation', label: 'Rotate', title: 'the tool keeps its place and turns' },
 ];
 
-export function HandGuiding({ guiding, onGuiding, frames, classes, trajectories, graspModes, refusal, run }: Props) {
+export function HandGuiding({ guiding, onGuiding, frames, classes, trajectories, graspModes, grasps, shownGrasp, onShowGrasp, refusal, run }: Props) {
   const busy = refusal !== null;
   const why = refusal ?? undefined;
   const [graspClass, setGraspClass] = useState('');
@@ -131,11 +142,25 @@ export function HandGuiding({ guiding, onGuiding, frames, classes, trajectories,
           title={why ?? (!graspName ? 'name the grasp first' : 'the gripper is around a detected part of this class now: SmartGrasp will hold parts of it like this')}
           onClick={() => {
             run('TeachGrasp', graspMode ? { object_class: objectClass, grasp: graspName, mode: graspMode } : { object_class: objectClass, grasp: graspName });
+            onShowGrasp({ objectClass, name: graspName });
             setGraspName('');
           }}
         >
           Teach grasp
         </button>
+        <select
+          value={shownGrasp && shownGrasp.objectClass === objectClass ? shownGrasp.name : ''}
+          aria-label="grasp shown"
+          title="the grasp drawn on the parts of this class in the 3D view: where SmartGrasp puts the tool centre point"
+          onChange={(e) => onShowGrasp(e.target.value ? { objectClass, name: e.target.value } : null)}
+        >
+          <option value="">draw no grasp</option>
+          {(grasps[objectClass] ?? []).map((g) => (
+            <option key={g} value={g}>
+              draw {g}
+            </option>
+          ))}
+        </select>
       </div>
     </div>
   );

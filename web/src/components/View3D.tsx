@@ -3,7 +3,9 @@
 // the fingers from the gripper's reading, the table, the parts the system believes are there
 // (object symbols; a held part moves with the tool), each drawn as its class's boxes in its
 // class's colour, the waypoints, SmartMove's candidates, and on request the RGB-D camera's
-// point cloud, and the trajectories recorded by hand guiding as lines. During a replay it shows
+// point cloud, the trajectories recorded by hand guiding as lines, and a grasp (the one taught
+// last, or chosen under the waypoints) as the open gripper on every part of its class, with its
+// name and the gripper mode it needs. During a replay it shows
 // the run's logged snapshots, not the cell now. Drag to orbit, wheel to zoom; grab the tool's
 // handle (the sphere at the tool) and drag to guide the arm by hand (free-drive, model/handGuide.ts:
 // the arm moves while the pointer is held and stops when it is let go).
@@ -19,6 +21,7 @@ import type { RobotDescription } from '../model/robot';
 import type { Candidate } from './ObjectsPane';
 import { ForceStrip } from './ForceStrip';
 import { handForce, HAND_PERIOD_MS, type Vec3 } from '../model/handGuide';
+import { graspCaption, graspOnParts, type GraspPose, type PlacedGrasp } from '../model/graspDrawing';
 
 interface Props {
   state: CellState | null;
@@ -39,6 +42,8 @@ interface Props {
   onGrab?: () => Promise<boolean>;
   /** Recorded trajectories' kept points in the world, drawn as lines. */
   trajectoryLines?: Record<string, { points: [number, number, number][] }>;
+  /** A grasp drawn on every part of its class: the open gripper where SmartGrasp would hold it. */
+  grasp?: { objectClass: string; name: string; pose: GraspPose };
 }
 
 interface Scene {
@@ -54,6 +59,7 @@ interface Scene {
   candidates: THREE.Group;
   cloud: THREE.Group;
   trajectories: THREE.Group;
+  grasps: THREE.Group;
   handle: THREE.Mesh;
   render: () => void;
 }
@@ -91,7 +97,31 @@ function partMesh(objectClass: string, shapes: Record<string, ObjectShape> | und
   return group;
 }
 
-export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAvailable, shapes, believed, robot, replayLabel, onGrab, trajectoryLines }: Props) {
+/** The open gripper at a grasp, in the tool centre point's frame (z along the approach, the
+ *  fingers closing along y): two pads either side of the tool centre point, the palm behind them
+ *  and the way the arm comes in, in teal. */
+function graspMarker(placed: PlacedGrasp) {
+  const material = new THREE.MeshLambertMaterial({ color: 0x0f9d9a, transparent: true, opacity: 0.75 });
+  const group = new THREE.Group();
+  group.name = placed.part;
+  for (const side of [-1, 1]) {
+    const pad = new THREE.Mesh(new THREE.BoxGeometry(0.022, 0.006, 0.04), material);
+    pad.position.set(0, side * 0.035, 0);
+    group.add(pad);
+  }
+  const palm = new THREE.Mesh(new THREE.BoxGeometry(0.022, 0.076, 0.008), material);
+  palm.position.set(0, 0, -0.024);
+  group.add(palm);
+  const tcp = new THREE.Mesh(new THREE.SphereGeometry(0.004, 10, 8), material);
+  group.add(tcp);
+  const approach = new THREE.BufferGeometry().setFromPoints([new THREE.Vector3(0, 0, -0.028), new THREE.Vector3(0, 0, -0.1)]);
+  group.add(new THREE.Line(approach, new THREE.LineBasicMaterial({ color: 0x0f9d9a })));
+  group.position.set(...placed.p);
+  group.quaternion.set(...placed.q);
+  return group;
+}
+
+export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAvailable, shapes, believed, robot, replayLabel, onGrab, trajectoryLines, grasp }: Props) {
   const mount = useRef<HTMLDivElement>(null);
   const sceneRef = useRef<Scene | null>(null);
   const [drawn, setDrawn] = useState<DrawnRobot | null>(null);
@@ -103,6 +133,8 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
   const [cloudTime, setCloudTime] = useState<number | null>(null);
   const [toolScreen, setToolScreen] = useState('');
   const [partScreens, setPartScreens] = useState('{}');
+  const [graspScreens, setGraspScreens] = useState('{}');
+  const [graspText, setGraspText] = useState('');
   const [guiding, setGuiding] = useState(false);
   /** Why free-drive holds the tool back while it is guided (the server's answer to each push). */
   const [heldBack, setHeldBack] = useState('');
@@ -151,13 +183,14 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     const candidateGroup = new THREE.Group();
     const cloud = new THREE.Group();
     const trajectories = new THREE.Group();
+    const grasps = new THREE.Group();
     // The tool's handle: what the user grabs to guide the arm.
     const handle = new THREE.Mesh(
       new THREE.SphereGeometry(0.03, 16, 12),
       new THREE.MeshLambertMaterial({ color: 0x7a4fd6, transparent: true, opacity: 0.35, depthWrite: false }),
     );
     handle.visible = false;
-    scene.add(robotGroup, parts, waypoints, candidateGroup, cloud, trajectories, handle);
+    scene.add(robotGroup, parts, waypoints, candidateGroup, cloud, trajectories, grasps, handle);
     const render = () => {
       renderer.render(scene, camera);
       // Where the tool and the parts are drawn (canvas pixels): what a user aims at.
@@ -168,6 +201,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       };
       if (handle.visible) setToolScreen(onScreen(handle.position).join(','));
       setPartScreens(JSON.stringify(Object.fromEntries(parts.children.map((part) => [part.name, onScreen(part.position)]))));
+      setGraspScreens(JSON.stringify(Object.fromEntries(grasps.children.map((g) => [g.name, onScreen(g.position)]))));
     };
     controls.addEventListener('change', render);
     const resize = () => {
@@ -181,7 +215,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     const observer = new ResizeObserver(resize);
     observer.observe(element);
     resize();
-    sceneRef.current = { renderer, scene, camera, controls, robot: robotGroup, table, grid, parts, waypoints, candidates: candidateGroup, cloud, trajectories, handle, render };
+    sceneRef.current = { renderer, scene, camera, controls, robot: robotGroup, table, grid, parts, waypoints, candidates: candidateGroup, cloud, trajectories, grasps, handle, render };
 
     // Grabbing the handle: the pointer holds the tool on the plane through it facing the camera;
     // every 50 ms the page sends the hand's push toward where the pointer holds it.
@@ -320,6 +354,18 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       mesh.quaternion.set(...pose.q);
       s.parts.add(mesh);
     }
+    clear(s.grasps);
+    if (grasp) {
+      const poses = state.objects.map((object) => {
+        const pose = believed?.poses.get(object.name) ?? object;
+        return { name: object.name, class: object.class, p: pose.p, q: pose.q };
+      });
+      const placed = graspOnParts(poses, grasp.objectClass, grasp.pose);
+      for (const g of placed) s.grasps.add(graspMarker(g));
+      setGraspText(graspCaption(grasp.name, grasp.pose, placed));
+    } else {
+      setGraspText('');
+    }
     clear(s.waypoints);
     for (const waypoint of state.waypoints) {
       if (!waypoint.p) continue;
@@ -336,7 +382,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
       }
     }
     s.render();
-  }, [state, selectedWaypoint, shapes, believed, drawn, onGrab]);
+  }, [state, selectedWaypoint, shapes, believed, drawn, onGrab, grasp]);
 
   useEffect(() => {
     const s = sceneRef.current;
@@ -461,6 +507,11 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
           Held back: {heldBack}
         </div>
       )}
+      {graspText && (
+        <div className="view3d-grasp" role="note" title="the open gripper drawn where SmartGrasp puts the tool centre point on each part of the class">
+          {graspText}
+        </div>
+      )}
       <ForceStrip state={state} />
       {error ? (
         <p className="empty">{error}</p>
@@ -471,6 +522,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
           data-tool-screen={toolScreen}
           data-part-screens={partScreens}
           data-trajectories={Object.keys(trajectoryLines ?? {}).length}
+          data-grasp-screens={graspScreens}
           data-drawn-tool={drawnTool} data-drawn-tool-q={drawnToolQ} data-robot={robot?.name ?? ''} data-finger-boxes={drawn?.fingerBoxes() ?? 0} />
       )}
     </section>
