@@ -160,7 +160,7 @@ void ClassPoseEstimator::levelResting(std::vector<Detection>& detections, const 
     return;
   }
   constexpr double kLevelFrom = 1.0 * M_PI / 180.0;
-  constexpr double kLevelUpTo = 20.0 * M_PI / 180.0;
+  constexpr double kLevelUpTo = kLeaning;
   constexpr double kAgreementSlack = 0.005;
   const Eigen::Vector3d up = support_plane_->normal.normalized();
   for (Detection& detection : detections) {

@@ -54,6 +54,7 @@ std::vector<Detection> keepSupported(const std::vector<Detection>& detections, c
     double low = 0.0, high = 0.0;
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // the origin projected onto the table
     double radius = 0.0;                               // of the footprint about it
+    bool leaning = false;                              // no face within kLeaning of lying flat
   };
   std::vector<Extent> extents;
   for (const Detection& detection : detections) {
@@ -65,6 +66,8 @@ std::vector<Detection> keepSupported(const std::vector<Detection>& detections, c
     Extent extent;
     const Eigen::Vector3d origin = detection.pose_in_camera.translation();
     extent.centre = origin - table.normal * (table.normal.dot(origin) + table.offset);
+    const Eigen::Matrix3d rotation = detection.pose_in_camera.linear();
+    extent.leaning = (rotation.transpose() * table.normal.normalized()).cwiseAbs().maxCoeff() < std::cos(kLeaning);
     extent.low = std::numeric_limits<double>::infinity();
     extent.high = -std::numeric_limits<double>::infinity();
     for (const world::Box& box : model->object_class.boxes) {
@@ -84,7 +87,7 @@ std::vector<Detection> keepSupported(const std::vector<Detection>& detections, c
   }
   std::vector<bool> kept(detections.size(), false);
   for (std::size_t d = 0; d < detections.size(); ++d) {
-    kept[d] = std::abs(extents[d].low) <= tolerance;
+    kept[d] = std::abs(extents[d].low) <= tolerance && !extents[d].leaning;
   }
   // A cluster where nothing was found, standing on the table, holds up what lies on its top as
   // a kept detection does: a part hidden but for its sides (a node under a link across it).
@@ -116,15 +119,35 @@ std::vector<Detection> keepSupported(const std::vector<Detection>& detections, c
     extents.push_back(extent);
     kept.push_back(true);
   }
+  // Resting on a kept one: its bottom at the other's top, their footprints meeting.
+  const auto restsOn = [&](std::size_t d, std::size_t e) {
+    return std::abs(extents[d].low - extents[e].high) <= tolerance &&
+           (extents[d].centre - extents[e].centre).norm() < extents[d].radius + extents[e].radius;
+  };
+  // A leaning part is held up at its raised end: a kept one rising above its bottom, its
+  // footprint reaching under the leaning one's middle half (it may rise higher: a node tilted
+  // against a link that leans more steeply); or what holds it is hidden, and more of it is seen.
+  const auto holdsUp = [&](std::size_t e, std::size_t d) {
+    return extents[e].high > extents[d].low + tolerance &&
+           (extents[d].centre - extents[e].centre).norm() < extents[e].radius + 0.5 * extents[d].radius;
+  };
   for (bool changed = true; changed;) {
     changed = false;
     for (std::size_t d = 0; d < detections.size(); ++d) {
-      for (std::size_t e = 0; e < extents.size() && !kept[d]; ++e) {
-        if (kept[e] && e != d && std::abs(extents[d].low - extents[e].high) <= tolerance &&
-            (extents[d].centre - extents[e].centre).norm() < extents[d].radius + extents[e].radius) {
-          kept[d] = true;
-          changed = true;
+      if (kept[d]) {
+        continue;
+      }
+      bool rests = extents[d].leaning && std::abs(extents[d].low) <= tolerance;
+      bool held = !extents[d].leaning || detections[d].visible_fraction >= kLeaningSeen;
+      for (std::size_t e = 0; e < extents.size(); ++e) {
+        if (kept[e] && e != d) {
+          rests = rests || restsOn(d, e);
+          held = held || holdsUp(e, d);
         }
+      }
+      if (rests && held) {
+        kept[d] = true;
+        changed = true;
       }
     }
   }
