@@ -21,10 +21,18 @@ HandComponent::HandComponent(camera::RgbdCamera& camera, const Clock& clock, Han
   description.symbols = {
       {"hand_1", world::SymbolKind::kFrame, "the person's hand as the camera sees it (x toward the fingertips)"},
       {"hand_still_seconds", world::SymbolKind::kNumber, "how long the hand has been still (s)"}};
-  description.predicates = {{"hand_still", 1, "the hand has not moved more than 1.5 cm since it came to rest"},
-                            {"palm_up", 1, "an open palm turned up is seen"},
-                            {"gesture", 2, "gesture(hand_1, offer): the open palm up held still"},
-                            {"in_zone", 2, "in_zone(hand_1, zone): the hand's centre lies in the named zone"}};
+  // The signatures quote the words an argument takes ('a'|'b'): the editor offers them to choose.
+  std::string zones;
+  for (const auto& [zone, box] : config_.zones) {
+    zones += (zones.empty() ? "'" : "|'") + zone + "'";
+  }
+  description.predicates = {
+      {"hand_still", 1, "hand_still('hand_1'): the hand has not moved more than 1.5 cm since it came to rest"},
+      {"palm_up", 1, "palm_up('hand_1'): an open palm turned up is seen"},
+      {"gesture", 2, "gesture('hand_1', 'offer'): the open palm up held still"},
+      {"in_zone", 2,
+       "in_zone('hand_1', " + (zones.empty() ? std::string("zone") : zones) +
+           "): the hand's centre lies in the named zone"}};
   declare(std::move(description), {});  // no operations
 }
 

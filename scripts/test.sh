@@ -103,7 +103,7 @@ if [[ "${EDITOR_E2E:-1}" != "0" ]]; then
   fi
   echo
   echo "test: the editor end to end in Chromium (artifacts in $BUILD_DIR/test-artifacts)"
-  for e2e in assemble_by_clicks paper_tasks control_panel cells polishing_by_clicks wire_bending_by_clicks teach_by_demonstration; do
+  for e2e in assemble_by_clicks paper_tasks control_panel cells polishing_by_clicks wire_bending_by_clicks teach_by_demonstration collaborative_assembly; do
     node "web/e2e/$e2e.mjs" --costar "$BUILD_DIR/cli/costar" --artifacts "$BUILD_DIR/test-artifacts"
   done
 fi

@@ -70,6 +70,23 @@ json cellState(workcell::Workcell& cell, std::int64_t active, bool paused) {
         {"held", world.holds("tool_held", kNoArgs)},    {"docked", world.holds("tool_docked", kNoArgs)}};
   }
 
+  // The speed and separation monitor (the safety component, docs/PERSON.md), when the scene has
+  // a person: the page shows the separation and the speed override live over the 3D view.
+  const auto number = [&world](const char* name) -> const world::NumberValue* {
+    const world::Symbol* symbol = world.symbol(name);
+    return symbol == nullptr ? nullptr : symbol->number();
+  };
+  if (const world::NumberValue* separation = number("person_separation")) {
+    const world::NumberValue* protective = number("protective_distance");
+    const world::NumberValue* scale = number("arm_speed_scale");
+    state["safety"] = {{"separation", rounded(separation->value, 1e3)},
+                       {"protective_distance", protective != nullptr ? rounded(protective->value, 1e3) : 0.0},
+                       {"speed_scale", scale != nullptr ? rounded(scale->value, 1e3) : 0.0},
+                       {"slowed", world.holds("arm_slowed_for_person", kNoArgs)},
+                       {"stopped", world.holds("arm_stopped_for_person", kNoArgs)},
+                       {"collaborative", world.holds("arm_collaborative", kNoArgs)}};
+  }
+
   json gripper = {{"open", world.holds("gripper_open", kNoArgs)},
                   {"closed", world.holds("gripper_closed", kNoArgs)},
                   {"holding", world.holds("gripper_holding", kNoArgs)}};

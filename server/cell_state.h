@@ -29,7 +29,10 @@ class WaypointFinder {
 };
 
 /// {type: "state", t (clock s), run (the active run's id, 0: none), mode (idle, running,
-/// paused), arm {endpoint, joints, moving}, gripper {open, closed, holding, mode, reading},
+/// paused), arm {endpoint, joints, moving, wrench, in_contact}, tool (a cell with a power tool),
+/// safety {separation, protective_distance (m), speed_scale (0-1), slowed, stopped, collaborative}
+/// (a scene with a person: the speed and separation monitor's reading), gripper {open, closed,
+/// holding, mode, reading},
 /// objects [{name, class, source, p, q, color}], waypoints [{name, kind, frame, p, q}] (the
 /// arm's; a joint waypoint drawn where the cell's motion service puts the tool), frames, and up
 /// to 2,000 predicates that hold}. Engine thread only (it reads the cell).

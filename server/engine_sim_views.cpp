@@ -44,6 +44,13 @@ std::optional<json> Engine::groundTruth() {
       }
       truth["power_tool"] = std::move(power_tool);
     }
+    // With a person in the scene: what the speed and separation judge recorded (docs/PERSON.md).
+    if (const std::optional<sim::SeparationRecord> record = simulation->separationRecord()) {
+      truth["separation"] = {
+          {"violation_steps", record->violation_steps},       {"contact_steps", record->contact_steps},
+          {"hand_contact_steps", record->hand_contact_steps}, {"min_separation_fast", record->min_separation_fast},
+          {"collaborative_s", record->collaborative_seconds}, {"stops", record->stops}};
+    }
     if (const std::optional<sim::JigState> jig = simulation->jig(); jig && jig->has_wire) {
       json bends = json::array();
       for (const sim::MeasuredBend& bend : jig->bends) {

@@ -817,6 +817,40 @@ TEST(PolishingCell, TheStateCarriesTheWrenchAndTheTool) {
   EXPECT_EQ(truth["power_tool"]["arm_workpiece_steps"].get<int>(), 0);
 }
 
+// The state the page shows over the 3D view when a person is in the cell: the speed and
+// separation monitor's reading (docs/PERSON.md). Without a person there is none to show.
+TEST(PersonCell, TheStateCarriesTheSeparationAndTheSpeedScale) {
+  workcell::WorkcellOptions away;
+  away.name = "iiwa-3f-sim";
+  away.scene = dataRoot() / "sim/scenes/person_away.json";
+  Harness h(away);
+  h.waitTicks(5);
+  const json state = h.get("/api/state");
+  ASSERT_TRUE(state.contains("safety")) << state.dump().substr(0, 400);
+  const json& safety = state["safety"];
+  EXPECT_GT(safety["separation"].get<double>(), 1.0) << safety.dump();                     // walked away from the table
+  EXPECT_NEAR(safety["protective_distance"].get<double>(), 0.501, 0.01) << safety.dump();  // the arm at rest
+  EXPECT_DOUBLE_EQ(safety["speed_scale"].get<double>(), 1.0);
+  EXPECT_FALSE(safety["stopped"].get<bool>());
+  EXPECT_FALSE(safety["slowed"].get<bool>());
+  EXPECT_FALSE(safety["collaborative"].get<bool>());
+  // The test endpoint has what the separation judge recorded (nothing near the person here).
+  ApiOptions test_endpoints;
+  test_endpoints.test_endpoints = true;
+  Harness truth_of(away, 0.0, test_endpoints);
+  truth_of.waitTicks(5);
+  const json truth = truth_of.get("/api/test/ground_truth");
+  ASSERT_TRUE(truth.contains("separation")) << truth.dump().substr(0, 400);
+  EXPECT_EQ(truth["separation"]["violation_steps"].get<int>(), 0);
+  EXPECT_EQ(truth["separation"]["contact_steps"].get<int>(), 0);
+  workcell::WorkcellOptions none;
+  none.name = "iiwa-3f-sim";
+  none.scene = dataRoot() / "sim/scenes/one_node.json";
+  Harness without(none);
+  without.waitTicks(5);
+  EXPECT_FALSE(without.get("/api/state").contains("safety"));
+}
+
 // GET /api/robot on a cell with a power tool: its shape in the tool frame and where it sits in
 // the hand (the tool frame in the tool centre point's, from the grasp SmartGrasp takes it by:
 // the knob's, the pad 10.7 cm beyond the tool centre point, the tool pointing along its z), so

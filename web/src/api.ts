@@ -82,6 +82,9 @@ export interface CellState {
   };
   /** The power tool, on cells that have one: speed in `unit` (opm: per minute). */
   tool?: { speed: number; unit: string; on: boolean; at_speed: boolean; held: boolean; docked: boolean };
+  /** The speed and separation monitor, when the scene has a person (docs/PERSON.md): the sensed
+   * separation and the protective distance (m), the speed override (0 held .. 1 full speed). */
+  safety?: { separation: number; protective_distance: number; speed_scale: number; slowed: boolean; stopped: boolean; collaborative: boolean };
   /** reading: the gripper_fingers symbol (2 fingers: their opening, m; 3 fingers: each one's position, 0 open .. 1 closed). */
   gripper: { open: boolean; closed: boolean; holding: boolean; mode?: string; reading?: FingerReading };
   /** color: the mean RGB ([0, 1]) DetectObjects saw on the part, when it reported one. */

@@ -1,7 +1,7 @@
 import { describe, expect, it } from 'vitest';
 import type { NodeInfo, PortInfo } from '../src/api';
 import { boundProblem, boundText, rangeProblem, rangeProblems, rangeText, toPlan, toShown, unitOf } from '../src/model/units';
-import { argumentKinds, waypointPaths } from '../src/model/paths';
+import { argumentKinds, argumentWords, waypointPaths } from '../src/model/paths';
 import { forceReadout } from '../src/model/forceReadout';
 import type { CellState } from '../src/api';
 
@@ -95,6 +95,11 @@ describe('paths taught as one', () => {
     expect(argumentKinds('pressed_at(w): a PressAndFollow pressed the tool through waypoint w', 1)).toEqual(['waypoint']);
     expect(argumentKinds('left_of(a, b): see docs/PREDICATES.md', 2)).toEqual(['reference', 'reference']);
     expect(argumentKinds('the tool is on', 0)).toEqual([]);
+    // The hand's predicates quote the words they take: the editor offers them to choose.
+    expect(argumentWords("gesture('hand_1', 'offer'): the open palm up held still", 2)).toEqual([['hand_1'], ['offer']]);
+    expect(argumentWords("in_zone('hand_1', 'handover'|'bench'): the hand's centre lies in the named zone", 2)).toEqual([['hand_1'], ['handover', 'bench']]);
+    expect(argumentWords('left_of(a, b): see docs/PREDICATES.md', 2)).toEqual([null, null]);
+    expect(argumentWords("in_zone('hand_1', zone|'x'): mixed", 2)).toEqual([['hand_1'], null]);
   });
 });
 

@@ -5,7 +5,7 @@ import type { Choices, NodeInfo, PortInfo } from '../api';
 import type { EditorNode } from '../model/tree';
 import { formatPredicates, parsePredicates, PredicateTerm, referenceChoices } from '../model/predicates';
 import { formatPoseText, parsePoseText, POSE_FIELDS, PoseFields } from '../model/poseText';
-import { argumentKinds, waypointPaths } from '../model/paths';
+import { argumentKinds, argumentWords, waypointPaths } from '../model/paths';
 import { boundProblem, boundText, rangeProblem, rangeText, toPlan, toShown, unitOf } from '../model/units';
 
 interface Props {
@@ -334,6 +334,7 @@ export function NodeEditor({ node, info, choices, objects, trees, readOnly, onCh
       const predicate = choices?.predicate.find((p) => p.name === value(node, 'predicate'));
       const arity = predicate?.arity ?? 0;
       const kinds = argumentKinds(predicate?.description ?? '', arity);
+      const words = argumentWords(predicate?.description ?? '', arity);
       const args = (current ?? '').split(';').filter((a) => a !== '');
       while (args.length < arity) args.push('');
       const setArg = (i: number, v: string | undefined) => {
@@ -364,7 +365,7 @@ export function NodeEditor({ node, info, choices, objects, trees, readOnly, onCh
                 key={i}
                 id={`${id}-${i}`}
                 current={arg || undefined}
-                options={kinds[i] === 'waypoint' ? choices?.waypoint ?? [] : ['?', ...references]}
+                options={words[i] ?? (kinds[i] === 'waypoint' ? choices?.waypoint ?? [] : ['?', ...references])}
                 placeholder="choose…"
                 disabled={readOnly}
                 onChange={(v) => setArg(i, v)}

@@ -1,11 +1,13 @@
 // Pane 2: the cell in 3D (three.js): the robot the cell has, drawn from the URDF its planner
 // reads (GET /api/robot, model/drawnRobot.ts) with the joint angles the stream carries and
-// the fingers from the gripper's reading, the table, the parts the system believes are there
+// the fingers from the gripper's reading, the table, the parts the system believes are there,
+// the person's hand and forearm where the camera sees the hand
 // (object symbols; a held part moves with the tool), each drawn as its class's boxes in its
 // class's colour, the waypoints, SmartMove's candidates, and on request the RGB-D camera's
 // point cloud, the trajectories recorded by hand guiding as lines, and a grasp (the one taught
 // last, or chosen under the waypoints) as the open gripper on every part of its class, with its
-// name and the gripper mode it needs. During a replay it shows
+// name and the gripper mode it needs; over it, with a person in the cell, the speed and separation
+// monitor's reading (SafetyStrip). During a replay it shows
 // the run's logged snapshots, not the cell now. Drag to orbit, wheel to zoom; grab the tool's
 // handle (the sphere at the tool) and drag to guide the arm by hand (free-drive, model/handGuide.ts:
 // the arm moves while the pointer is held and stops when it is let go).
@@ -20,6 +22,7 @@ import { DrawnRobot } from '../model/drawnRobot';
 import type { RobotDescription } from '../model/robot';
 import type { Candidate } from './ObjectsPane';
 import { ForceStrip } from './ForceStrip';
+import { SafetyStrip } from './SafetyStrip';
 import { handForce, HAND_PERIOD_MS, type Vec3 } from '../model/handGuide';
 import { graspCaption, graspOnParts, type GraspPose, type PlacedGrasp } from '../model/graspDrawing';
 
@@ -127,6 +130,8 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
   const [drawn, setDrawn] = useState<DrawnRobot | null>(null);
   const [drawnTool, setDrawnTool] = useState('');
   const [drawnToolQ, setDrawnToolQ] = useState('');
+  // Where the person's hand is drawn (x,y,z, m), '' when the camera does not see it.
+  const [handDrawn, setHandDrawn] = useState('');
   const framed = useRef(false);
   const [error, setError] = useState<string | null>(null);
   const [cloudInfo, setCloudInfo] = useState<string>('');
@@ -366,6 +371,23 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
     } else {
       setGraspText('');
     }
+    // The person's hand as the camera sees it (the frame hand_1), drawn as the boxes SmartMove
+    // plans around: the hand on its frame, the forearm behind it (docs/PERSON.md).
+    const hand = state.frames.find((f) => f.name === 'hand_1');
+    if (hand) {
+      const skin = new THREE.MeshLambertMaterial({ color: 0xd9a27e, transparent: true, opacity: 0.8 });
+      const person = new THREE.Group();
+      person.name = 'hand_1';
+      for (const [size, x] of [[[0.26, 0.12, 0.08], 0], [[0.3, 0.1, 0.1], -0.28]] as const) {
+        const box = new THREE.Mesh(new THREE.BoxGeometry(...size), skin);
+        box.position.set(x, 0, 0);
+        person.add(box);
+      }
+      person.position.set(...hand.p);
+      person.quaternion.set(...hand.q);
+      s.parts.add(person);
+    }
+    setHandDrawn(hand ? hand.p.map((v) => v.toFixed(3)).join(',') : '');
     clear(s.waypoints);
     for (const waypoint of state.waypoints) {
       if (!waypoint.p) continue;
@@ -512,6 +534,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
           {graspText}
         </div>
       )}
+      <SafetyStrip state={state} />
       <ForceStrip state={state} />
       {error ? (
         <p className="empty">{error}</p>
@@ -523,7 +546,7 @@ export function View3D({ state, candidates, selectedWaypoint, api, pointCloudAva
           data-part-screens={partScreens}
           data-trajectories={Object.keys(trajectoryLines ?? {}).length}
           data-grasp-screens={graspScreens}
-          data-drawn-tool={drawnTool} data-drawn-tool-q={drawnToolQ} data-robot={robot?.name ?? ''} data-finger-boxes={drawn?.fingerBoxes() ?? 0} />
+          data-drawn-tool={drawnTool} data-drawn-tool-q={drawnToolQ} data-robot={robot?.name ?? ''} data-hand={handDrawn} data-finger-boxes={drawn?.fingerBoxes() ?? 0} />
       )}
     </section>
   );

@@ -54,3 +54,15 @@ export function argumentKinds(description: string, arity: number): ArgumentKind[
     return 'reference';
   });
 }
+
+/**
+ * The words each argument takes when the description's signature quotes them ('a'|'b'):
+ * gesture('hand_1', 'offer'), in_zone('hand_1', 'handover'). null: any reference.
+ */
+export function argumentWords(description: string, arity: number): (string[] | null)[] {
+  const names = /^\s*\w+\(([^)]*)\)/.exec(description)?.[1].split(',').map((a) => a.trim()) ?? [];
+  return Array.from({ length: arity }, (_, i) => {
+    const words = (names[i] ?? '').split('|').map((w) => /^'([^']+)'$/.exec(w.trim())?.[1]);
+    return words.length > 0 && words.every((w) => w !== undefined) ? (words as string[]) : null;
+  });
+}
