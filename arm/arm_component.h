@@ -144,6 +144,11 @@ class ArmComponent final : public component::TableComponent {
   /// The force-controlled operations' ranges (also their parameters' min and max).
   static constexpr double kMaxContactForce = 60.0;  // N: the most MoveUntilContact or PressAndFollow presses with
   static constexpr double kMaxForceLimit = 150.0;   // N: the highest max_force
+  /// m/s: the fastest MoveUntilContact approaches. A rigid tool meeting a rigid surface stops in a
+  /// few milliseconds, before any controller can act: the arm's momentum alone pushes with about
+  /// 1.1 to 1.3 N per mm/s on the simulated cells (docs/FORCE.md "Contact at speed"), so faster
+  /// than this the touch itself overshoots 10 N by more than a few newtons.
+  static constexpr double kMaxApproachSpeed = 0.01;
 
  private:
   /// Declares the operations, each with its handler.

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <set>
 #include <stdexcept>
@@ -183,6 +184,17 @@ std::string forceBelowLimit(const ParamMap& params) {
   return {};
 }
 
+/// Why MoveUntilContact refuses a speed above ArmComponent::kMaxApproachSpeed (empty: it does not).
+std::string approachSpeedProblem(double speed) {
+  if (speed <= ArmComponent::kMaxApproachSpeed) {
+    return {};
+  }
+  return formatNumber("%g m/s", speed) + " is faster than a guarded approach may touch at (" +
+         formatNumber("%g m/s", ArmComponent::kMaxApproachSpeed) +
+         "): the arm's momentum alone would push past the force on a hard surface; move close first (MoveToPose), "
+         "then approach";
+}
+
 /// A force the operation keeps: below the limit that stops the motion (a constraint kept in the
 /// stored descriptions, so that `costar validate` without the robot checks it too).
 ParamSpec keptForce(const std::string& description, double value) {
@@ -239,11 +251,19 @@ void ArmComponent::declareForceOperations(component::ComponentDescription& descr
   path.validate = [](std::string_view text) -> std::string {
     return text.find_first_not_of("; ") == std::string_view::npos ? "name at least one waypoint" : "";
   };
+  ParamSpec approach_speed =
+      number("speed", "how fast the tool approaches (m/s); faster, the touch itself would push past the force", 0.01,
+             0.002, kMaxApproachSpeed);
+  approach_speed.validate = [](std::string_view text) {
+    char* end = nullptr;
+    const std::string written(text);
+    const double speed = std::strtod(written.c_str(), &end);
+    return end != written.c_str() ? approachSpeedProblem(speed) : std::string();
+  };
   component::OperationSpec until_contact{
       "MoveUntilContact",
       "Moves the tool in a direction until it pushes with the force, then keeps pushing with it (a guarded approach).",
-      {direction, keptForce("the force (N) that stops the approach and is kept", 5.0),
-       number("speed", "how fast the tool approaches (m/s)", 0.01, 0.002, 0.1),
+      {direction, keptForce("the force (N) that stops the approach and is kept", 5.0), approach_speed,
        number("distance", "the farthest it goes looking for contact (m)", 0.15, 0.005, 0.5), max_force}};
   operations.add(std::move(until_contact), [this](const ParamMap& params) { return moveUntilContact(params); });
   component::OperationSpec press{
@@ -330,6 +350,12 @@ class StillWait {
   std::optional<TimePoint> still_since_;
 };
 
+/// Fails with `failure` once the arm is at rest (or with why it does not come to rest).
+Step failOnceStill(StillWait& still, const std::string& failure) {
+  const Step settled = still.poll(failure);
+  return settled.kind == Step::Kind::kNext ? Step::failed(failure) : settled;
+}
+
 }  // namespace
 
 std::unique_ptr<component::RunningOperation> ArmComponent::tare() {
@@ -381,6 +407,11 @@ std::unique_ptr<component::RunningOperation> ArmComponent::moveUntilContact(cons
     std::uint64_t arm_motion = 0;
     std::uint64_t controller_motion = 0;
     double peak = 0.0;
+    /// The approach ended (in contact, or stopped by the force limit): the operation ends once
+    /// the arm is at rest, so that its end and arm_moving agree.
+    std::shared_ptr<StillWait> settling;
+    std::optional<std::string> failure;
+    nlohmann::json contact;
   };
   auto state = std::make_shared<State>();
   state->direction = directionNamed(params.at("direction").asString(), endpoint());
@@ -390,6 +421,9 @@ std::unique_ptr<component::RunningOperation> ArmComponent::moveUntilContact(cons
   state->max_force = params.at("max_force").asDouble();
   if (const std::string problem = forceBelowLimit(params); !problem.empty()) {
     return finishedWith(OperationResult::failure("MoveUntilContact: " + problem));
+  }
+  if (const std::string problem = approachSpeedProblem(state->speed); !problem.empty()) {
+    return finishedWith(OperationResult::failure("MoveUntilContact: speed " + problem));
   }
   const CartesianState current = force_.controller->state();
   const bool pressing = pressing_->motion != 0 && current.following && current.motion == pressing_->motion;
@@ -417,6 +451,10 @@ std::unique_ptr<component::RunningOperation> ArmComponent::moveUntilContact(cons
   });
   steps.push_back([this, state] {
     const CartesianState now = force_.controller->state();
+    if (state->failure) {
+      // Stopped by the force limit: the controller holds the tool where it stopped.
+      return failOnceStill(*state->settling, *state->failure);
+    }
     if (motion_->counter != state->arm_motion) {
       return Step::failed("MoveUntilContact: the arm was stopped, or another motion took over");
     }
@@ -424,18 +462,38 @@ std::unique_ptr<component::RunningOperation> ArmComponent::moveUntilContact(cons
     if (const std::string problem =
             cartesianProblem(driver_, clock_, config_, now, state->controller_motion, state->max_force);
         !problem.empty()) {
+      const bool held = now.force_limit_stop && now.motion == state->controller_motion;
       stop();
+      if (held) {
+        state->failure = "MoveUntilContact: " + problem;
+        state->settling = std::make_shared<StillWait>(driver_, clock_);
+        return Step::running();
+      }
       return Step::failed("MoveUntilContact: " + problem);
     }
-    if (now.offset > state->distance) {
+    if (!state->settling && now.offset > state->distance) {
       stop();
       return Step::failed("MoveUntilContact: no contact within " + formatNumber("%.3f m", state->distance) +
                           " (the force along the direction stayed below " + newtons(state->force) + ")");
     }
-    if (now.axis_force >= 0.95 * state->force) {
+    if (!state->settling && now.axis_force >= 0.95 * state->force) {
       pressing_->motion = now.motion;
       pressing_->axis = state->direction;
-      return Step::done({{"travel_m", now.offset}, {"force_n", now.axis_force}});
+      state->contact = {{"travel_m", now.offset}, {"force_n", now.axis_force}};
+      state->settling = std::make_shared<StillWait>(driver_, clock_);
+    }
+    if (state->settling) {
+      // In contact: done once the arm is at rest, pressing with the force.
+      const Step settled = state->settling->poll("MoveUntilContact");
+      if (settled.kind == Step::Kind::kFailed) {
+        pressing_->motion = 0;  // the operation's end stops the arm
+      }
+      if (settled.kind != Step::Kind::kNext) {
+        return settled;
+      }
+      state->contact["force_n"] = now.axis_force;
+      state->contact["peak_force_n"] = state->peak;
+      return Step::done(state->contact);
     }
     return Step::running();
   });
@@ -477,8 +535,23 @@ std::unique_ptr<component::RunningOperation> ArmComponent::pressAndFollow(const 
     double squared_error = 0.0;
     int samples = 0;
     double peak = 0.0;
+    /// Stopped by the force limit: the operation fails once the arm is at rest (arm_moving agrees).
+    std::optional<std::string> failure;
+    std::shared_ptr<StillWait> settling;
   };
   auto state = std::make_shared<State>();
+  // A problem while the controller presses: the arm stops; a force-limit stop leaves the tool
+  // held where it stopped, and the operation fails once it is at rest.
+  const auto stopOnProblem = [this](State& pressing, const CartesianState& now, std::string failure) {
+    const bool held = now.force_limit_stop && now.motion == pressing.controller_motion;
+    stop();
+    if (!held) {
+      return Step::failed(std::move(failure));
+    }
+    pressing.failure = std::move(failure);
+    pressing.settling = std::make_shared<StillWait>(driver_, clock_);
+    return Step::running();
+  };
   state->names = params.at("path").asList();
   state->force = params.at("force").asDouble();
   state->speed = params.at("speed").asDouble();
@@ -632,16 +705,18 @@ std::unique_ptr<component::RunningOperation> ArmComponent::pressAndFollow(const 
       state->controller_motion = force_.controller->state().motion;
       return Step::next();
     });
-    steps.push_back([this, state, who] {
+    steps.push_back([this, state, who, stopOnProblem] {
       const CartesianState now = force_.controller->state();
+      if (state->failure) {
+        return failOnceStill(*state->settling, *state->failure);
+      }
       if (motion_->counter != state->arm_motion) {
         return Step::failed(who + ": the arm was stopped, or another motion took over");
       }
       if (const std::string problem =
               cartesianProblem(driver_, clock_, config_, now, state->controller_motion, state->max_force);
           !problem.empty()) {
-        stop();
-        return Step::failed(who + ": " + problem);
+        return stopOnProblem(*state, now, who + ": " + problem);
       }
       if (now.offset > state->approach + kMaxPathOffset) {
         stop();
@@ -688,8 +763,11 @@ std::unique_ptr<component::RunningOperation> ArmComponent::pressAndFollow(const 
     pressing_->axis = state->axis;
     return Step::next();
   });
-  steps.push_back([this, state, who] {
+  steps.push_back([this, state, who, stopOnProblem] {
     const CartesianState now = force_.controller->state();
+    if (state->failure) {
+      return failOnceStill(*state->settling, *state->failure);
+    }
     if (motion_->counter != state->arm_motion) {
       return Step::failed(who + ": the arm was stopped, or another motion took over");
     }
@@ -700,8 +778,7 @@ std::unique_ptr<component::RunningOperation> ArmComponent::pressAndFollow(const 
     if (const std::string problem =
             cartesianProblem(driver_, clock_, config_, now, state->controller_motion, state->max_force);
         !problem.empty()) {
-      stop();
-      return Step::failed(who + ": " + problem);
+      return stopOnProblem(*state, now, who + ": " + problem);
     }
     state->peak = std::max(state->peak, now.axis_force);
     state->squared_error += (now.axis_force - state->force) * (now.axis_force - state->force);

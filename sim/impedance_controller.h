@@ -7,11 +7,12 @@
 // tool axis, D = 2 zeta sqrt(K Lambda) per tool axis with Lambda the arm's Cartesian inertia,
 // and f the target force along the force axis once the tool touches. The offset moves toward
 // the force: at the approach speed until the tool first touches (half the target force), then
-// at (target - measured) / (k tau) (tau 0.1 s), within the approach speed. The measured force
-// is the simulated wrist sensor's (noise and tare included), as a real controller would have it.
-// The commanded force is limited to the motion's force limit; a measured force above it stops
-// the motion (state().force_limit_stop): no more pressing, the reference frozen where the tool
-// gives way to what it pushes (back by the force limit over the stiffness), so the force goes. The
+// at (target - measured) / (k tau) (tau 0.1 s), within the approach speed; at that touch it
+// steps back by the measured force over k, as f is added, so the command steps to the target and
+// not past it. The measured force is the simulated wrist sensor's (noise and tare included), as a
+// real controller would have it. The commanded force is limited to the motion's force limit; a
+// measured force above it stops the motion (state().force_limit_stop): no more pressing, the
+// reference frozen where the tool is, so the force goes and the tool does not jump back. The
 // motors' torque limits clamp the rest (MuJoCo's actuator ctrlrange). No MuJoCo type appears here.
 
 #include <cstdint>
