@@ -189,8 +189,8 @@ std::filesystem::path generatedModel(const std::string& name, const std::string&
 /// business and are checked there; here the keys are checked against the format's.
 RobotDescription parseGenerated(const json& root_object) {
   onlyKnown(root_object, "",
-            {"format", "name", "model", "type", "label", "notes", "sources", "published_lengths", "base_link", "links",
-             "joints", "tool", "home_deg", "kinematics", "gripper_links"});
+            {"format", "name", "model", "type", "label", "notes", "sources", "published_lengths", "rgba", "base_link",
+             "links", "joints", "tool", "home_deg", "kinematics", "gripper_links"});
   RobotDescription robot;
   robot.name = text(root_object, "", "name");
   robot.type = text(root_object, "", "type");

@@ -12,11 +12,13 @@ Conventions:
 - The base link is fixed to the world at the origin (the workcell places it: "robot_base"); every
   link frame sits on its joint.
 - MJCF: arm geoms contype 2, conaffinity 0 (they touch the table and parts, not each other);
-  a collision shape's optional rgba colours it (default the arm's orange);
+  a collision shape's optional rgba colours it (default: the description's top-level "rgba", else
+  orange);
   one motor actuator per joint named after it, ctrlrange the joint's torque limit (the
   simulation runs computed-torque control); joint damping 0.5, armature 0.1; a keyframe "home";
   the tool frame is a body with a site of the same name.
-- URDF: capsules become a cylinder and two spheres (the same solid); the tool frame is a link
+- URDF: capsules become a cylinder and two spheres (the same solid), each a <collision> and a
+  <visual> of the same solid in its colour (RViz and the editor's 3D view draw it); the tool frame is a link
   on a fixed joint; the base link carries no inertia (KDL does not accept one on the root).
 Bad input stops with a message naming the file, the field and the problem (exit status 1)."""
 import math
@@ -53,9 +55,22 @@ def mat_mat(a, b):
     return [[sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
 
 
+# The colour of a shape that names none, when the description gives no "rgba" of its own.
+DEFAULT_RGBA = [0.93, 0.55, 0.13, 1]
+
 # The largest length (m) and mass (kg) a description may give: an arm is a few metres long.
 MAX_M = 10.0
 MAX_KG = 1000.0
+
+
+def read_rgba(reader, parent, field):
+    """An optional colour: 4 numbers from 0 to 1, or None."""
+    rgba = reader.get(parent, "rgba", field, "list", optional=True)
+    if rgba is not None and (len(rgba) != 4 or not all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) and 0 <= x <= 1 for x in rgba)):
+        name = f"{field}.rgba" if field else "rgba"
+        reader.fail(name, f"must be 4 numbers from 0 to 1 (red, green, blue, alpha), not {rgba}")
+    return rgba
 
 
 def read_description(path):
@@ -63,7 +78,8 @@ def read_description(path):
     root = reader.root
     if root.get("format") != FORMAT:
         reader.fail("format", f'must be "{FORMAT}"')
-    robot = {"name": reader.get(root, "name", "", "string"), "base_link": reader.get(root, "base_link", "", "string")}
+    robot = {"name": reader.get(root, "name", "", "string"), "base_link": reader.get(root, "base_link", "", "string"),
+             "rgba": read_rgba(reader, root, "") or DEFAULT_RGBA}
     links = {}
     for i, link in enumerate(reader.get(root, "links", "", "list")):
         field = f"links[{i}]"
@@ -88,10 +104,7 @@ def read_description(path):
             radius = reader.get(shape, "radius", shape_field, "number", at_most=MAX_M)
             if radius <= 0 or math.dist(start, end) <= 0:
                 reader.fail(shape_field, "needs a positive radius and distinct from/to")
-            rgba = reader.get(shape, "rgba", shape_field, "list", optional=True)
-            if rgba is not None and (len(rgba) != 4 or not all(
-                    isinstance(x, (int, float)) and not isinstance(x, bool) and 0 <= x <= 1 for x in rgba)):
-                reader.fail(f"{shape_field}.rgba", f"must be 4 numbers from 0 to 1 (red, green, blue, alpha), not {rgba}")
+            rgba = read_rgba(reader, shape, shape_field)
             shapes.append({"type": kind, "from": start, "to": end, "radius": radius, "rgba": rgba})
         links[name] = {"name": name, "mass": mass, "com": reader.get(link, "com", field, "vec3", at_most=MAX_M),
                        "inertia": inertia, "collision": shapes}
@@ -201,7 +214,7 @@ def write_mjcf(robot, path, source):
              '  <default>',
              f'    <default class="{robot["name"]}">',
              '      <joint damping="0.5" armature="0.1"/>',
-             '      <geom contype="2" conaffinity="0" rgba="0.93 0.55 0.13 1" group="1"/>',
+             f'      <geom contype="2" conaffinity="0" rgba="{fmt(robot["rgba"])}" group="1"/>',
              '    </default>',
              '  </default>',
              '  <worldbody>',
@@ -264,9 +277,13 @@ def write_urdf(robot, path, source):
         if link is not robot["links"][0]:
             lines.append(f'    <inertial><origin xyz="{fmt(link["com"])}" rpy="0 0 0"/><mass value="{link["mass"]:.12g}"/>'
                          f'<inertia ixx="{ixx:.12g}" ixy="0" ixz="0" iyy="{iyy:.12g}" iyz="0" izz="{izz:.12g}"/></inertial>')
-        for shape in link["collision"]:
+        for k, shape in enumerate(link["collision"]):
+            colour = fmt(shape["rgba"] or robot["rgba"])
             for xyz, rpy, geometry in urdf_shapes(shape):
-                lines.append(f'    <collision><origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/><geometry>{geometry}</geometry></collision>')
+                origin = f'<origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>'
+                lines.append(f'    <collision>{origin}<geometry>{geometry}</geometry></collision>')
+                lines.append(f'    <visual>{origin}<geometry>{geometry}</geometry>'
+                             f'<material name="{link["name"]}_{k}"><color rgba="{colour}"/></material></visual>')
         lines.append('  </link>')
     tool = robot["tool"]
     lines.append(f'  <link name="{tool["name"]}"/>')

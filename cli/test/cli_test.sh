@@ -132,7 +132,9 @@ check "trials: bad shard"   2 "needs 0 <= I < N" -- "$costar" trials examples/ur
 check "calibrate: bad move"   2 "'5cm' should be DISTANCE_M,ANGLE_DEG" -- "$costar" calibrate --camera-move 5cm
 check "calibrate: bad method" 2 "--method: nope not in" -- "$costar" calibrate marker --method nope
 check "calibrate eval: 0"     2 "--setups: Value 0 not in range" -- "$costar" calibrate eval --setups 0
-check "calibrate eval: bad cell" 2 "unknown workcell 'nosuch' for calibrate eval \(simulated cells: iiwa-3f-sim, iiwa-sim, panda-sim, ur5-sim\)" \
+# The simulated cells are the files of workcells/, in name order.
+sim_cells=$(for f in workcells/*.json; do basename "$f" .json; done | LC_ALL=C sort | paste -sd, | sed 's/,/, /g')
+check "calibrate eval: bad cell" 2 "unknown workcell 'nosuch' for calibrate eval \(simulated cells: $sim_cells\)" \
   -- "$costar" calibrate eval -w nosuch --setups 1
 check "calibrate eval: no sim"  2 "unknown workcell 'test' for calibrate eval" -- "$costar" calibrate eval -w test --setups 1
 check "trials: bad move"      2 "--camera-move: '1,1' should be DISTANCE_M,ANGLE_DEG, numbers from 0 to 0.5 m and 45 degrees" \

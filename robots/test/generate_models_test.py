@@ -28,7 +28,7 @@ class GenerateModels(GeneratorCase):
         self.assertAlmostEqual(limits[6], 175 * 3.141592653589793 / 180, places=9)
         # Capsules: a cylinder and two spheres in the URDF.
         link1 = next(l for l in urdf.iter("link") if l.get("name") == "iiwa_link_1")
-        self.assertEqual(sorted(g[0].tag for g in link1.iter("geometry")), ["cylinder", "sphere", "sphere"])
+        self.assertEqual(sorted(c.find("geometry")[0].tag for c in link1.findall("collision")), ["cylinder", "sphere", "sphere"])
 
     def test_bad_descriptions_name_the_field(self):
         self.expect_error(lambda d: d["joints"][3].update(axis=[0, -1, 1]), "joints[3].axis", "unit vector")
@@ -67,6 +67,28 @@ class GenerateModels(GeneratorCase):
         colours = [g.get("rgba") for g in ET.parse(self.tmp / "iiwa" / "iiwa14.xml").getroot().iter("geom")
                    if g.get("name", "").endswith("_collision_0")]
         self.assertTrue(colours and all(c is None for c in colours))  # the class's colour
+        default = next(d for d in ET.parse(self.tmp / "iiwa" / "iiwa14.xml").getroot().iter("default") if d.get("class"))
+        self.assertEqual(default.find("geom").get("rgba"), "0.93 0.55 0.13 1")  # orange when the description names none
+        # The URDF draws every collision solid as a visual of the same solid in its colour (RViz, the editor).
+        urdf = ET.parse(self.tmp / "ur5.urdf").getroot()
+        for link in urdf.iter("link"):
+            collisions, visuals = link.findall("collision"), link.findall("visual")
+            self.assertEqual(len(visuals), len(collisions), link.get("name"))
+            for c, v in zip(collisions, visuals):
+                self.assertEqual(ET.tostring(c.find("geometry")), ET.tostring(v.find("geometry")))
+                self.assertEqual(c.find("origin").attrib, v.find("origin").attrib)
+        base = next(l for l in urdf.iter("link") if l.get("name") == "base_link")
+        self.assertEqual(base.find("visual/material/color").get("rgba"), "0.2 0.25 0.33 1")
+
+    def test_the_description_colours_every_shape_that_names_none(self):
+        variant = self.variant(lambda d: d.update(rgba=[0.9, 0.9, 0.9, 1]))
+        result = self.run_generator(variant, self.tmp)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        default = next(d for d in ET.parse(self.tmp / "iiwa14.xml").getroot().iter("default") if d.get("class"))
+        self.assertEqual(default.find("geom").get("rgba"), "0.9 0.9 0.9 1")
+        urdf = ET.parse(self.tmp / "iiwa14.urdf").getroot()
+        self.assertEqual({c.get("rgba") for c in urdf.iter("color")}, {"0.9 0.9 0.9 1"})
+        self.expect_error(lambda d: d.update(rgba=[1, 1, 1]), "rgba", "4 numbers from 0 to 1")
 
     def test_the_models_carry_the_fingerprint_of_their_description(self):
         result = self.run_generator(IIWA, self.tmp)

@@ -15,7 +15,19 @@ import path from 'node:path';
 import { api, args, artifacts, launchBrowser, makeLog, openPage, runScript, startServer } from './lib.mjs';
 
 const { log, check } = makeLog('cells');
-const CELLS = { 'ur5-sim': 6, 'iiwa-sim': 7, 'iiwa-3f-sim': 7, 'panda-sim': 7 };
+// Every simulated cell (workcells/*.json) with its arm's joint count (robots/ROBOT/ROBOT.json): a new cell is tried here
+// with no list to edit.
+const CELLS = Object.fromEntries(
+  fs
+    .readdirSync('workcells')
+    .filter((file) => file.endsWith('.json'))
+    .sort()
+    .map((file) => {
+      const robot = JSON.parse(fs.readFileSync(path.join('workcells', file), 'utf8')).robot;
+      const joints = JSON.parse(fs.readFileSync(path.join('robots', robot, `${robot}.json`), 'utf8')).joints.length;
+      return [file.replace(/\.json$/, ''), joints];
+    }),
+);
 const MAX_ERROR_MM = 5;
 const MAX_ERROR_DEG = 1;
 let server;

@@ -2,7 +2,7 @@
 // urdf-loader reads the URDF with the browser's DOMParser: happy-dom stands in for the browser.
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
-import { Quaternion, Vector3 } from 'three';
+import { Color, Mesh, MeshLambertMaterial, MeshPhongMaterial, Quaternion, Vector3 } from 'three';
 import { describe, expect, it } from 'vitest';
 import { DrawnRobot } from '../src/model/drawnRobot';
 import type { FingerReading, RobotDescription } from '../src/model/robot';
@@ -86,5 +86,44 @@ describe("the robot drawn from the planner's URDF", () => {
     plain.update(samples[0].joints, samples[0].gripper.reading, samples[0].gripper.mode, true);
     expect(plain.heldToolPose()).toBeNull();
     plain.dispose();
+  });
+
+  it("draws each arm in its description's colours (robots/ROBOT/ROBOT.json's rgba), once, and the gripper in grey", () => {
+    const colours = (cell: string) => {
+      const drawn = new DrawnRobot(fixture(cell).robot);
+      drawn.update(fixture(cell).samples[0].joints, undefined, undefined);
+      const seen = new Set<string>();
+      let drawnTwice = 0;
+      drawn.object.traverse((o) => {
+        const shape = o as typeof o & { isURDFVisual?: boolean; isURDFCollider?: boolean };
+        const besideVisuals = shape.parent?.children.some((c) => (c as { isURDFVisual?: boolean }).isURDFVisual);
+        if (shape.isURDFCollider && shape.visible && besideVisuals) drawnTwice++;
+        if (!shape.isURDFVisual || !shape.visible) return;
+        shape.traverse((m) => {
+          const mesh = m as Mesh;
+          if (mesh.isMesh) seen.add((mesh.material as MeshPhongMaterial).color.getHexString());
+        });
+      });
+      const grey = new Set<string>();
+      drawn.object.traverse((o) => {
+        const mesh = o as Mesh;
+        if (mesh.isMesh && mesh.visible && mesh.parent?.visible && !(mesh.parent as { isURDFVisual?: boolean }).isURDFVisual) {
+          grey.add((mesh.material as MeshLambertMaterial).color.getHexString());
+        }
+      });
+      drawn.dispose();
+      return { seen, drawnTwice, grey };
+    };
+    const hex = (r: number, g: number, b: number) => new Color(r, g, b).getHexString();
+    const ur5 = colours('ur5-sim');
+    // UR's light grey links and dark blue joint covers.
+    expect([...ur5.seen].sort()).toEqual([hex(0.2, 0.25, 0.33), hex(0.7, 0.72, 0.75)].sort());
+    const iiwa = colours('iiwa-3f-sim');
+    expect([...iiwa.seen]).toEqual([hex(0.93, 0.55, 0.13)]); // KUKA orange
+    for (const cell of [ur5, iiwa]) {
+      // The arm's collision solids are not drawn over its visuals; the gripper (no visuals) is drawn in grey.
+      expect(cell.drawnTwice).toBe(0);
+      expect(cell.grey.has(new Color(0x55595f).getHexString())).toBe(true);
+    }
   });
 });

@@ -27,7 +27,10 @@ export class DrawnRobot {
 
   constructor(readonly description: RobotDescription) {
     const loader = new URDFLoader();
-    loader.parseVisual = false;
+    // The arm's shapes are drawn from the URDF's visuals, in the colours its description gives
+    // (robots/generate_models.py writes each collision solid again as a coloured visual); a link
+    // with no visual (the gripper's) is drawn from its collision shapes in the gripper's grey.
+    loader.parseVisual = true;
     loader.parseCollision = true;
     this.robot = loader.parse(description.urdf);
     const base = baseMatrix(description);
@@ -46,11 +49,19 @@ export class DrawnRobot {
     this.materials.push(armMaterial, gripperMaterial, this.fingerMaterial);
     for (const [name, link] of Object.entries(this.robot.links)) {
       const hidden = description.gripper.finger_links.includes(name);
-      for (const child of link.children) {
-        const collider = child as THREE.Object3D & { isURDFCollider?: boolean };
-        if (!collider.isURDFCollider) continue;
-        collider.visible = !hidden;
-        collider.traverse((o) => {
+      const shapes = link.children as (THREE.Object3D & { isURDFCollider?: boolean; isURDFVisual?: boolean })[];
+      const coloured = shapes.some((child) => child.isURDFVisual);
+      for (const child of shapes) {
+        if (!child.isURDFCollider && !child.isURDFVisual) continue;
+        child.visible = !hidden && (coloured ? !!child.isURDFVisual : true);
+        if (child.isURDFVisual) {
+          child.traverse((o) => {
+            const mesh = o as THREE.Mesh;
+            if (mesh.isMesh) this.materials.push(mesh.material as THREE.Material);
+          });
+          continue;
+        }
+        child.traverse((o) => {
           const mesh = o as THREE.Mesh;
           if (!mesh.isMesh) return;
           (mesh.material as THREE.Material).dispose();
