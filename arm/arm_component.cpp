@@ -272,9 +272,32 @@ std::unique_ptr<component::RunningOperation> ArmComponent::jogJoint(const compon
   return execute(planToJoints(goal, speedOf(params)), "JogJoint");
 }
 
+std::string ArmComponent::nameTaken(const std::string& name) const {
+  if (waypoints_.find(name)) {
+    return {};  // taught again, or renamed to itself
+  }
+  if (name == "world") {
+    return "'world' is the frame every pose is given in";
+  }
+  for (const auto& symbol : description().symbols) {
+    if (symbol.name == name) {
+      return "'" + name + "' is the arm's own symbol (" + symbol.description + ")";
+    }
+  }
+  // Another component's frame ("camera", "table_center", a part): a waypoint of that name would
+  // hide it, and the editor could reach neither.
+  if (frameInWorld(name)) {
+    return "'" + name + "' names a frame the cell knows already (a calibrated frame or a part)";
+  }
+  return {};
+}
+
 std::unique_ptr<component::RunningOperation> ArmComponent::teach(const component::ParamMap& params) {
   Waypoint waypoint;
   waypoint.name = params.at("waypoint").asString();
+  if (const std::string taken = nameTaken(waypoint.name); !taken.empty()) {
+    return finished(OperationResult::failure("cannot save the waypoint: " + taken + "; choose another name"));
+  }
   if (params.at("kind").asString() == "joints") {
     waypoint.kind = Waypoint::Kind::kJoints;
     waypoint.joints = checkedRead().position;
@@ -300,7 +323,11 @@ std::unique_ptr<component::RunningOperation> ArmComponent::renameOrDelete(bool r
   const std::string name = params.at("waypoint").asString();
   try {
     if (rename) {
-      waypoints_.rename(name, params.at("new_name").asString());
+      const std::string new_name = params.at("new_name").asString();
+      if (const std::string taken = nameTaken(new_name); !taken.empty() && new_name != name) {
+        return finished(OperationResult::failure("cannot rename '" + name + "': " + taken + "; choose another name"));
+      }
+      waypoints_.rename(name, new_name);
     } else if (!waypoints_.remove(name)) {
       return finished(OperationResult::failure("unknown waypoint '" + name + "'"));
     }

@@ -156,6 +156,9 @@ class ArmComponent final : public component::TableComponent {
   double speedOf(const component::ParamMap& params) const;
   std::optional<world::Pose> waypointPose(const Waypoint& waypoint) const;
   std::optional<world::Pose> frameInWorld(const std::string& frame) const;
+  /// Why `name` cannot be a new waypoint's (empty when it can): "world", the arm's own symbols
+  /// ("endpoint"), or a frame another component publishes ("camera", "table_center", a part).
+  std::string nameTaken(const std::string& name) const;
   // The operations' handlers.
   std::unique_ptr<component::RunningOperation> move(const component::ParamMap& params);
   std::unique_ptr<component::RunningOperation> straightLine(const std::string& operation,

@@ -233,6 +233,37 @@ RecordedTrajectory trajectoryFromJson(const json& item, const std::string& field
 
 /// The waypoint file's advisory lock, FILE.lock beside it (flock: released when the process
 /// dies, so a crashed writer never blocks the others). Held around every read-modify-write.
+/// The loop of frames that `start` begins, as "a -> b -> a" (empty when its frames end in the
+/// world or another component's frame): a waypoint relative to itself, or to one relative to it,
+/// has no pose at all.
+std::string frameLoop(const std::map<std::string, Waypoint>& waypoints, const std::string& start) {
+  std::string path = start;
+  std::string at = start;
+  for (std::size_t step = 0; step <= waypoints.size(); ++step) {
+    const auto it = waypoints.find(at);
+    if (it == waypoints.end() || it->second.kind != Waypoint::Kind::kPose) {
+      return {};
+    }
+    at = it->second.frame;
+    path += " -> " + at;
+    if (at == start) {
+      return path;
+    }
+  }
+  return {};  // a loop further on, not through `start`: found from its own waypoints
+}
+
+/// The waypoints whose poses are given relative to waypoint `name`, as "'a', 'b'".
+std::string relativeTo(const std::map<std::string, Waypoint>& waypoints, const std::string& name) {
+  std::string names;
+  for (const auto& [other, waypoint] : waypoints) {
+    if (waypoint.kind == Waypoint::Kind::kPose && waypoint.frame == name && other != name) {
+      names += (names.empty() ? "'" : ", '") + other + "'";
+    }
+  }
+  return names;
+}
+
 class FileLock {
  public:
   explicit FileLock(const std::filesystem::path& file) {
@@ -334,6 +365,12 @@ WaypointStore::Map WaypointStore::read() const {
                                   std::to_string(previous->second) + "]); names must differ");
       }
       waypoints.waypoints[waypoint.name] = std::move(waypoint);
+    }
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string name = list[i].at("name").get<std::string>();
+      if (const std::string loop = frameLoop(waypoints.waypoints, name); !loop.empty()) {
+        fail("waypoints[" + std::to_string(i) + "].frame", "a loop of frames (" + loop + "): no pose can be found");
+      }
     }
   } catch (const std::exception& e) {
     throw std::runtime_error(label + ": " + e.what());
@@ -446,12 +483,22 @@ void WaypointStore::put(const Waypoint& waypoint) {
   }
   update([&waypoint](Map& contents) {
     contents.waypoints[waypoint.name] = waypoint;
+    if (const std::string loop = frameLoop(contents.waypoints, waypoint.name); !loop.empty()) {
+      throw std::invalid_argument("waypoint '" + waypoint.name + "' would be relative to itself (" + loop +
+                                  "); teach it relative to another frame");
+    }
     return true;
   });
 }
 
 bool WaypointStore::remove(const std::string& name) {
-  return update([&name](Map& contents) { return contents.waypoints.erase(name) > 0; });
+  return update([&name](Map& contents) {
+    if (const std::string users = relativeTo(contents.waypoints, name); !users.empty()) {
+      throw std::invalid_argument("waypoint '" + name + "' is the frame of " + users +
+                                  ": delete or teach those again first");
+    }
+    return contents.waypoints.erase(name) > 0;
+  });
 }
 
 void WaypointStore::rename(const std::string& from, const std::string& to) {
@@ -471,6 +518,12 @@ void WaypointStore::rename(const std::string& from, const std::string& to) {
     waypoints.erase(it);
     waypoint.name = to;
     waypoints[to] = std::move(waypoint);
+    // The waypoints taught relative to it follow it to its new name.
+    for (auto& [name, other] : waypoints) {
+      if (other.kind == Waypoint::Kind::kPose && other.frame == from) {
+        other.frame = to;
+      }
+    }
     return true;
   });
 }

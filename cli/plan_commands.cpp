@@ -18,6 +18,7 @@
 #include "bt/trace.h"
 #include "cli/inject_option.h"
 #include "cli/number_options.h"
+#include "cli/output_options.h"
 #include "cli/stop_signals.h"
 #include "cli/workcell_access.h"
 #include "core/files.h"
@@ -130,6 +131,20 @@ int runPlan(RunOptions options) {
     }
   } catch (const std::invalid_argument& e) {
     std::cerr << "error: " << e.what() << "\n";
+    return kExitInvalid;
+  }
+  try {
+    // Before the cell is built: the trace must not replace the plan or the taught waypoints.
+    const std::filesystem::path waypoints = options.workcell.waypoints.empty()
+                                                ? workcell::defaultWaypointFile(options.workcell.name)
+                                                : std::filesystem::path(options.workcell.waypoints);
+    refuseWritingAnInput(options.trace, "--trace",
+                         {{options.plan, "the plan"},
+                          {waypoints, "the waypoint file"},
+                          {options.workcell.scene, "the --scene file"},
+                          {options.workcell.remote, "the --remote file"}});
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: " << e.what() << "; nothing was run\n";
     return kExitInvalid;
   }
   if (!options.inject.empty()) {

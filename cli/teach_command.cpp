@@ -9,6 +9,7 @@
 
 #include "arm/arm_component.h"
 #include "arm/free_drive.h"
+#include "arm/hand_guiding_limits.h"
 #include "bt/builder.h"
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
@@ -249,6 +250,16 @@ void drag(workcell::Workcell& cell, const std::vector<std::string>& w) {
   if (seconds = number(w[4]); !seconds) {
     return;
   }
+  // A person's hand, as in the editor: a firm push and twist at most.
+  const auto tooHard = [](const Eigen::Vector3d& value, double limit, const char* verb, const char* what,
+                          const char* unit) {
+    if (value.norm() <= limit) {
+      return false;
+    }
+    std::printf("error: a hand %s the tool with at most %g %s; the %s asked is %g %s (nothing was done)\n", verb, limit,
+                unit, what, value.norm(), unit);
+    return true;
+  };
   std::string mode = "free";
   std::string locked;
   std::string axes = "world";
@@ -274,6 +285,10 @@ void drag(workcell::Workcell& cell, const std::vector<std::string>& w) {
     } else {
       mode = w[i];
     }
+  }
+  if (tooHard(hand.force, arm::kMaxHandForce, "pushes", "force", "N") ||
+      tooHard(hand.torque, arm::kMaxHandTorque, "turns", "torque", "N m")) {
+    return;
   }
   const world::Pose before = simulation->tcpPose();
   const TimePoint start = cell.clock().now();

@@ -13,6 +13,7 @@
 #include "bt/plan.h"
 #include "cli/inject_option.h"
 #include "cli/number_options.h"
+#include "cli/output_options.h"
 #include "cli/stop_signals.h"
 #include "core/files.h"
 #include "core/json_file.h"
@@ -86,13 +87,25 @@ int report(const trials::Summary& summary, const Options& options, int code = 0)
   return code;
 }
 
-/// Checks that the outputs can be written at the end, before anything runs.
+/// Checks that the outputs can be written at the end, before anything runs, and that none of
+/// them is a file the trials read.
 void checkOutputs(const Options& options) {
+  NamedFiles inputs{{options.trials.plan, "the plan"},
+                    {options.trials.scene, "the --scene file"},
+                    {options.trials.waypoints, "the --waypoints file"}};
+  for (const std::string& file : options.merge_inputs) {
+    inputs.emplace_back(file, "a result file to merge");
+  }
   if (!options.json.empty()) {
     checkOutputFile(options.json, "--json");
+    refuseWritingAnInput(options.json, "--json", inputs);
   }
   if (!options.plot.empty()) {
     checkOutputFile(options.plot, "--plot");
+    refuseWritingAnInput(options.plot, "--plot", inputs);
+  }
+  if (!options.json.empty() && !options.plot.empty() && sameFile(options.json, options.plot)) {
+    throw std::invalid_argument("--json and --plot name the same file '" + options.json + "'");
   }
   if (!options.trials.trace_dir.empty()) {  // the first trial's file in it: each trial writes one
     const std::uint64_t first = options.trials.seed + static_cast<std::uint64_t>(options.trials.shard_index);

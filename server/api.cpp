@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 
+#include "arm/hand_guiding_limits.h"
 #include "bt/plan_xml.h"
 #include "server/auth.h"
 #include "server/plan_json.h"
@@ -546,10 +547,6 @@ HttpResponse startOperation(const Call& call) {
   return startRun(call.backend, std::move(run));
 }
 
-/// The most a page's hand pushes with: a firm push (N), a firm twist (N m).
-constexpr double kMaxHandForce = 60.0;
-constexpr double kMaxHandTorque = 3.0;
-
 /// POST /api/drag: free-drive's hand and dead-man (Backend::Drag): {"force": [x, y, z], "torque":
 /// [x, y, z]} (N, N m, world, at the tool), a push for 0.25 s and the dead-man for 2 s, answered
 /// with why free-drive's last step was not wholly taken ("blocked", empty when it was) and its
@@ -567,7 +564,7 @@ HttpResponse dragTool(const Call& call) {
       }
       drag.release = value.get<bool>();
     } else if (key == "force" || key == "torque") {
-      const double limit = key == "force" ? kMaxHandForce : kMaxHandTorque;
+      const double limit = key == "force" ? arm::kMaxHandForce : arm::kMaxHandTorque;
       if (!value.is_array() || value.size() != 3) {
         throw RequestError(400, "'" + key + "' must be [x, y, z]");
       }

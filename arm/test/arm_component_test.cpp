@@ -262,6 +262,28 @@ TEST_F(ArmTest, TeachSavesWhereTheArmIsAndJoggingMovesIt) {
             "cannot save the waypoint: waypoint name 'bad name!' may contain only letters, digits, '_' and '-'");
 }
 
+// A waypoint named "endpoint" hid the arm's tool pose from the editor (it showed the taught pose
+// while the arm moved) and could be neither moved to nor deleted there; "camera" and
+// "table_center" were listed twice.
+TEST_F(ArmTest, AWaypointCannotTakeTheNameOfASymbolOrFrameTheCellKnows) {
+  EXPECT_EQ(run("Teach", {{"waypoint", "endpoint"}, {"kind", "pose"}, {"frame", "world"}}).reason,
+            "cannot save the waypoint: 'endpoint' is the arm's own symbol (the tool centre point, in the world); "
+            "choose another name");
+  EXPECT_EQ(run("Teach", {{"waypoint", "table_center"}, {"kind", "joints"}, {"frame", "world"}}).reason,
+            "cannot save the waypoint: 'table_center' names a frame the cell knows already (a calibrated frame or a "
+            "part); choose another name");
+  EXPECT_EQ(run("Teach", {{"waypoint", "world"}, {"kind", "pose"}, {"frame", "world"}}).reason,
+            "cannot save the waypoint: 'world' is the frame every pose is given in; choose another name");
+  EXPECT_FALSE(waypoints.find("endpoint") || waypoints.find("table_center") || waypoints.find("world"));
+  ASSERT_EQ(run("Teach", {{"waypoint", "here"}, {"kind", "pose"}, {"frame", "world"}}).state, OperationState::kSuccess);
+  EXPECT_EQ(run("RenameWaypoint", {{"waypoint", "here"}, {"new_name", "endpoint"}}).reason,
+            "cannot rename 'here': 'endpoint' is the arm's own symbol (the tool centre point, in the world); choose "
+            "another name");
+  EXPECT_TRUE(waypoints.find("here").has_value());
+  // Taught again under its own name: an update, not a clash.
+  EXPECT_EQ(run("Teach", {{"waypoint", "here"}, {"kind", "pose"}, {"frame", "world"}}).state, OperationState::kSuccess);
+}
+
 // How another component moves the arm: it plans with a motion service of its own (the cell's,
 // here one on the same driver and collision world) and hands the plan's waypoints to the arm's
 // FollowJointPath, with the contacts the plan allowed passed to the query alone.

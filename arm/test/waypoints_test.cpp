@@ -77,6 +77,48 @@ TEST_F(WaypointFile, AZeroOrNonUnitQuaternionIsAnErrorNamingTheField) {
             "waypoints[0].orientation: must be a unit quaternion [w, x, y, z], not [1,0,0]");
 }
 
+// A hostile tester taught cyc_b relative to cyc_a, then cyc_a relative to cyc_b: both were saved and
+// neither could be reached; deleting or renaming a waypoint another was taught relative to
+// orphaned it.
+TEST_F(WaypointFile, FramesNeverLoopAndAWaypointUsedAsAFrameIsNotLost) {
+  EXPECT_EQ(problem(R"({"waypoints": [
+      {"name": "a", "frame": "b", "position": [0, 0, 0.1], "orientation": [1, 0, 0, 0]},
+      {"name": "b", "frame": "a", "position": [0, 0, 0.1], "orientation": [1, 0, 0, 0]}]})"),
+            "waypoints[0].frame: a loop of frames (a -> b -> a): no pose can be found");
+  EXPECT_EQ(problem(R"({"waypoints": [
+      {"name": "self", "frame": "self", "position": [0, 0, 0.1], "orientation": [1, 0, 0, 0]}]})"),
+            "waypoints[0].frame: a loop of frames (self -> self): no pose can be found");
+  WaypointStore store(folder_ / "taught.json", /*persist=*/true, 6);
+  Waypoint a;
+  a.name = "a";
+  a.frame = "table_center";
+  store.put(a);
+  Waypoint b = a;
+  b.name = "b";
+  b.frame = "a";
+  store.put(b);
+  a.frame = "b";
+  try {
+    store.put(a);
+    ADD_FAILURE() << "a loop was saved";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(),
+                 "waypoint 'a' would be relative to itself (a -> b -> a); teach it relative to another frame");
+  }
+  EXPECT_EQ(store.find("a")->frame, "table_center");  // the refused change left the file as it was
+  try {
+    store.remove("a");
+    ADD_FAILURE() << "the frame of b was deleted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "waypoint 'a' is the frame of 'b': delete or teach those again first");
+  }
+  store.rename("a", "base");
+  EXPECT_EQ(store.find("b")->frame, "base");  // b follows its frame to the new name
+  EXPECT_EQ(WaypointStore(folder_ / "taught.json", true, 6).find("b")->frame, "base");
+  EXPECT_TRUE(store.remove("b"));
+  EXPECT_TRUE(store.remove("base"));
+}
+
 TEST_F(WaypointFile, TheJointCountComesFromTheArmOrIsAnyUpToTheCapacity) {
   const std::string seven = R"({"waypoints": [{"name": "j", "joints": [0, 0, 0, 0, 0, 0, 0]}]})";
   EXPECT_EQ(problem(seven, 7), "no error");

@@ -128,6 +128,24 @@ check "trials merge: missing" 2 '1 of 3 trials are missing \(a shard not merged\
 check "trials merge: twice" 2 'trial 1 appears twice' -- "$costar" trials merge "$tmp/s0.json" "$tmp/s1.json" "$tmp/s1.json"
 check "trials: bad shard"   2 "needs 0 <= I < N" -- "$costar" trials examples/ur5/pick_up_node.xml --judge lift --shard 4/4
 
+# An output never replaces what the command reads (a hostile tester's --trace P.xml replaced the plan,
+# --trace W.json every taught waypoint, trials --json P.xml the plan).
+cp examples/test_workcell/demo.xml "$tmp/own.xml"
+printf '{"waypoints": [{"name": "kept", "joints": [0, 0, 0, 0, 0, 0]}]}' >"$tmp/kept.json"
+check "run: --trace is the plan" 2 "cannot write --trace '$tmp/own.xml': it is the plan, which this command reads" \
+  -- "$costar" run "$tmp/own.xml" -w test --trace "$tmp/own.xml"
+check "run: --trace is the waypoints" 2 "cannot write --trace '$tmp/./kept.json': it is the waypoint file, which this command reads" \
+  -- "$costar" run "$tmp/own.xml" -w test --waypoints "$tmp/kept.json" --trace "$tmp/./kept.json"
+check "trials: --json is the plan" 2 "cannot write --json '$tmp/own.xml': it is the plan, which this command reads" \
+  -- "$costar" trials "$tmp/own.xml" --judge lift --json "$tmp/own.xml"
+check "trials: --json is --plot" 2 "--json and --plot name the same file" \
+  -- "$costar" trials "$tmp/own.xml" --judge lift --json "$tmp/r.png" --plot "$tmp/r.png"
+if cmp -s examples/test_workcell/demo.xml "$tmp/own.xml" && grep -q '"kept"' "$tmp/kept.json"; then
+  echo "ok   outputs: the plan and the waypoints are as they were"
+else
+  echo "FAIL outputs: an input was written"; failures=$((failures + 1))
+fi
+
 # Calibration (issue 14): bad options are refused before any cell is built.
 check "calibrate: bad move"   2 "'5cm' should be DISTANCE_M,ANGLE_DEG" -- "$costar" calibrate --camera-move 5cm
 check "calibrate: bad method" 2 "--method: nope not in" -- "$costar" calibrate marker --method nope
@@ -228,6 +246,18 @@ if grep -Eq "^the tool moved [-0-9.]* 0\.(09[5-9]|1[0-9])[0-9]* " "$tmp/drag.out
   echo "ok   teach: drag, record, replay"
 else
   echo "FAIL teach: drag, record, replay"; cat "$tmp/drag.out"; failures=$((failures + 1))
+fi
+
+# A hand pushes with at most 60 N and turns with 3 N m, as in the editor (200 N moved the tool 0.8 m
+# in 1.1 s, 1e308 made MuJoCo unstable).
+printf 'drag 200 0 0 1\ndrag 0 0 0 1 turn 0 0 5\nquit\n' |
+  "$costar" teach --scene sim/scenes/one_node.json --waypoints "$tmp/waypoints.json" >"$tmp/hard.out" 2>&1
+if grep -q "^error: a hand pushes the tool with at most 60 N; the force asked is 200 N (nothing was done)" "$tmp/hard.out" &&
+   grep -q "^error: a hand turns the tool with at most 3 N m; the torque asked is 5 N m (nothing was done)" "$tmp/hard.out" &&
+   ! grep -q "the tool moved" "$tmp/hard.out"; then
+  echo "ok   teach: a drag harder than a hand is refused"
+else
+  echo "FAIL teach: a drag harder than a hand is refused"; cat "$tmp/hard.out"; failures=$((failures + 1))
 fi
 
 # Issue 27: a name that is not UTF-8 is refused where it is typed, the waypoint file untouched.
