@@ -5,7 +5,7 @@
 import type { CellState, Pose } from '../api';
 
 type Vec3 = [number, number, number];
-type Quat = [number, number, number, number];
+type Quat = [number, number, number, number]; // x, y, z, w
 
 function qmul(a: Quat, b: Quat): Quat {
   const [ax, ay, az, aw] = a;
@@ -18,7 +18,8 @@ function qmul(a: Quat, b: Quat): Quat {
   ];
 }
 const qinv = (q: Quat): Quat => [-q[0], -q[1], -q[2], q[3]];
-function rotate(q: Quat, v: Vec3): Vec3 {
+/** `v` turned by the unit quaternion `q`. */
+export function rotate(q: Quat, v: Vec3): Vec3 {
   const r = qmul(qmul(q, [v[0], v[1], v[2], 0]), qinv(q));
   return [r[0], r[1], r[2]];
 }

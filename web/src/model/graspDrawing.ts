@@ -3,6 +3,8 @@
 // /api/choices: grasp_pose), so the view draws the open gripper there on every part of that class
 // the system believes in. Poses are {p: [x, y, z], q: [x, y, z, w]} as the server sends them.
 
+import { compose, rotate } from './belief';
+
 export type Vec3 = [number, number, number];
 export type Quat = [number, number, number, number]; // x, y, z, w
 
@@ -27,23 +29,7 @@ export interface PlacedGrasp {
   q: Quat;
 }
 
-function multiply(a: Quat, b: Quat): Quat {
-  const [ax, ay, az, aw] = a;
-  const [bx, by, bz, bw] = b;
-  return [
-    aw * bx + ax * bw + ay * bz - az * by,
-    aw * by - ax * bz + ay * bw + az * bx,
-    aw * bz + ax * by - ay * bx + az * bw,
-    aw * bw - ax * bx - ay * by - az * bz,
-  ];
-}
-
-/** `v` turned by the unit quaternion `q`. */
-export function rotate(q: Quat, v: Vec3): Vec3 {
-  const [x, y, z, w] = multiply(multiply(q, [v[0], v[1], v[2], 0]), [-q[0], -q[1], -q[2], q[3]]);
-  void w;
-  return [x, y, z];
-}
+export { rotate };
 
 /** Where the tool centre point is when `grasp` holds each part of `objectClass` (a part's pose
  *  times the grasp's), in the order of `parts`. */
@@ -51,12 +37,8 @@ export function graspOnParts(parts: PartPose[], objectClass: string, grasp: Gras
   return parts
     .filter((part) => part.class === objectClass)
     .map((part) => {
-      const offset = rotate(part.q, grasp.p);
-      return {
-        part: part.name,
-        p: [part.p[0] + offset[0], part.p[1] + offset[1], part.p[2] + offset[2]] as Vec3,
-        q: multiply(part.q, grasp.q),
-      };
+      const { p, q } = compose(part, grasp);
+      return { part: part.name, p: p as Vec3, q: q as Quat };
     });
 }
 
