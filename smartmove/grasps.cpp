@@ -1,6 +1,7 @@
 #include "smartmove/grasps.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -134,6 +135,14 @@ std::vector<std::string> GraspLibrary::names() const {
 }
 
 void GraspLibrary::teach(const Grasp& taught) {
+  // A name people type and plans quote (grasp="..."); "" is SmartGrasp's "any grasp".
+  const bool plain = std::all_of(taught.name.begin(), taught.name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-';
+  });
+  if (taught.name.empty() || taught.name.size() > 64 || !plain) {
+    throw std::invalid_argument("grasp name '" + taught.name +
+                                "': 1 to 64 letters, digits, '_' and '-' (an empty grasp means any grasp in a plan)");
+  }
   Grasp grasp = taught;
   if (grasp.gripper.empty()) {
     grasp.gripper = gripper_;

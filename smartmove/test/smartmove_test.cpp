@@ -57,6 +57,12 @@ TEST(Grasps, TaughtGraspsOverrideDefaultsAndPersist) {
   }
   GraspLibrary reloaded(dataRoot() / "data/grasps.json", file);
   EXPECT_NEAR(reloaded.find("node", "top")->tcp_in_object.translation().z(), 0.01, 1e-12);
+  // A hostile tester taught '', '../x', 'a b' and 100 characters: each was saved.
+  for (const std::string& bad : std::vector<std::string>{"", "../x", "/tmp/abs", "a b", std::string(100, 'g')}) {
+    EXPECT_THROW(reloaded.teach({"node", bad, world::poseFromXyzRpy(0, 0, 0.02, M_PI, 0, 0)}), std::invalid_argument)
+        << bad;
+    EXPECT_TRUE(bad.empty() || !reloaded.find("node", bad).has_value()) << bad;
+  }
   EXPECT_TRUE(reloaded.find("node", "side").has_value());
   EXPECT_EQ(reloaded.forClass("node").size(), 2u);
   std::filesystem::remove(file);
