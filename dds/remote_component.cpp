@@ -1,5 +1,6 @@
 #include "dds/remote_component.h"
 
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <condition_variable>
@@ -40,6 +41,7 @@ struct RemoteClient::State {
   struct Host {
     std::int32_t pid = 0;
     std::string hostname;
+    std::vector<std::string> components;  // what it serves, from its heartbeat
     SteadyClock::time_point heard;
   };
   struct Served {
@@ -116,7 +118,13 @@ struct RemoteClient::State {
           message.bytes._buffer = reply.bytes.data();
           message.bytes._length = message.bytes._maximum = static_cast<std::uint32_t>(reply.bytes.size());
           message.bytes._release = false;
-          Bus::write(driver_reply_writer, &message);
+          // A reply that cannot be sent is the asking host's loss (its call times out and its
+          // heartbeat tells whether it lives), never a failure of the component this executor
+          // is calling now, which may be another host's.
+          if (const dds_return_t rc = dds_write(driver_reply_writer, &message); rc != DDS_RETCODE_OK) {
+            spdlog::warn("the reply to {} {} of host {:x} could not be sent: {}", request.target, request.method,
+                         request.host_id, dds_strretcode(rc));
+          }
         });
   }
 
@@ -184,8 +192,17 @@ struct RemoteClient::State {
              std::to_string(config.domain) + ", partition '" + config.partition + "'";
     }
     if (now - host->second.heard > kHostTimeout) {
+      // The host's other components went with it: named too, so that a reason given by the
+      // first of them the executor calls still names the one whose operation was running.
+      std::string others;
+      for (const std::string& name : host->second.components) {
+        if (name != component) {
+          others += (others.empty() ? "" : ", ") + ("'" + name + "'");
+        }
+      }
       return "component '" + component + "' stopped answering: its host (pid " + std::to_string(host->second.pid) +
-             " on " + host->second.hostname + ") has sent nothing for " + seconds(now - host->second.heard) + " s";
+             " on " + host->second.hostname + (others.empty() ? "" : ", which also served " + others) +
+             ") has sent nothing for " + seconds(now - host->second.heard) + " s";
     }
     return {};
   }
@@ -296,6 +313,7 @@ struct RemoteClient::State {
     Host& host = hosts[heartbeat.host_id];
     host.pid = heartbeat.pid;
     host.hostname = heartbeat.hostname;
+    host.components.assign(heartbeat.components._buffer, heartbeat.components._buffer + heartbeat.components._length);
     host.heard = SteadyClock::now();
     heard.notify_all();
   }

@@ -6,6 +6,8 @@
 #include "dds/lockstep.h"
 
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -13,6 +15,7 @@
 #include <optional>
 #include <thread>
 
+#include "component/registry.h"
 #include "dds/bus.h"
 #include "dds/host.h"
 #include "dds/remote_component.h"
@@ -146,6 +149,83 @@ TEST(Lockstep, EachNewExecutorGetsTheComponentsAfresh) {
     EXPECT_EQ(std::get<world::NumberValue>(report.symbols[0].value).value, 1.0) << "run " << run;
     EXPECT_EQ(host.runs(), run);
   }
+}
+
+/// A lockstep host of a probe named `name` in a child process (dds_test_host --lockstep): its
+/// operation (ReadNear for "near") and its report each ask the executor's "sensor" driver; SIGKILLed when destroyed.
+class ProbeProcess {
+ public:
+  ProbeProcess(const RemoteConfig& config, const std::string& name) {
+    std::vector<std::string> args = {COSTAR_DDS_TEST_HOST, "--lockstep", std::to_string(config.domain),
+                                     config.partition, name};
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      std::vector<char*> argv;
+      for (auto& arg : args) {
+        argv.push_back(arg.data());
+      }
+      argv.push_back(nullptr);
+      ::execv(argv[0], argv.data());
+      ::_exit(127);
+    }
+  }
+  ProbeProcess(const ProbeProcess&) = delete;
+  ProbeProcess& operator=(const ProbeProcess&) = delete;
+  ~ProbeProcess() { kill(); }
+  void kill() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGKILL);
+      ::waitpid(pid_, nullptr, 0);
+      pid_ = -1;
+    }
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+// Two hosts, one component each; the host of 'far' dies while the executor answers its driver
+// call with a camera frame's worth of data (640 x 480 points and colours), which it never takes.
+// The other host's component keeps answering (its driver calls answered at once, not held up
+// behind the frame the dead host left unread), and only 'far' is named: before, the next driver
+// reply to 'near' waited 1 s behind the frame and failed ("DDS: write failed: Timeout"), and that
+// failure was reported as component 'near''s.
+TEST(Lockstep, AHostThatDiesIsNamedAloneAndTheOtherHostsComponentsKeepAnswering) {
+  RemoteConfig config = lockstepConfig("two-hosts");
+  config.components = {"near", "far"};
+  ProbeProcess near_host(config, "near");
+  ProbeProcess far_host(config, "far");
+  const auto client = RemoteClient::create(config);
+  client->setDriverServer([&](const std::string&, const std::string&, const nlohmann::json& args) {
+    DriverReply reply{{{"value", 1.0}}, {}, {}};
+    if (args.at("who") == "far") {
+      far_host.kill();
+      reply.floats.assign(640 * 480 * 3, 0.5F);
+      reply.bytes.assign(640 * 480 * 3, 7);
+    }
+    return reply;
+  });
+  const auto near = client->connect("near", seconds(20));
+  const auto far = client->connect("far", seconds(20));
+  client->publishClock(TimePoint(milliseconds(10)));
+  ASSERT_EQ(near->report().symbols.size(), 1U);
+  try {
+    far->start("ReadFar", {});
+    ADD_FAILURE() << "far started on a host that was killed";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("component 'far' stopped answering"), std::string::npos) << error.what();
+  }
+
+  client->publishClock(TimePoint(milliseconds(20)));
+  component::ComponentRegistry registry;
+  registry.add(near);
+  registry.add(far);
+  registry.refreshWorld();
+  EXPECT_NE(registry.stopReason().find("component 'far' stopped answering"), std::string::npos)
+      << registry.stopReason();
+  EXPECT_EQ(registry.stopReason().find("near"), std::string::npos) << registry.stopReason();
+  const component::OperationResult read = near->poll(near->start("ReadNear", {}));
+  EXPECT_EQ(read.state, component::OperationState::kSuccess) << read.reason;
 }
 
 /// A reader of its own on `topic_name`, as a ROS 2 node would read it (no costar code): checks

@@ -196,6 +196,27 @@ TEST_F(RemoteComponentTest, AKilledHostFailsItsRunningOperationNamingTheComponen
   EXPECT_EQ(again.state, OperationState::kSuccess) << again.reason;
 }
 
+// A host that serves two components takes both with it: the reason the first of them gives (the
+// registry asks each in turn) names the other too, whose operation may have been the one running.
+TEST_F(RemoteComponentTest, AKilledHostsReasonNamesEveryComponentItServed) {
+  HostProcess host(config_.partition, {"test_counter", "test_actions"});
+  const auto counter = connect("test_counter");
+  const auto actions = connect("test_actions");
+  host.kill(SIGKILL);
+  const auto deadline = std::chrono::steady_clock::now() + kHangGuard;
+  std::string reason;
+  while (reason.empty() && std::chrono::steady_clock::now() < deadline) {
+    try {
+      counter->report();
+      std::this_thread::sleep_for(milliseconds(10));
+    } catch (const std::runtime_error& error) {
+      reason = error.what();
+    }
+  }
+  EXPECT_NE(reason.find("component 'test_counter' stopped answering"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("which also served 'test_actions'"), std::string::npos) << reason;
+}
+
 TEST_F(RemoteComponentTest, NoHostIsAnErrorNamingTheComponentAndWhereItWasLookedFor) {
   client_ = RemoteClient::create(config_);
   try {
