@@ -135,6 +135,7 @@ class ArmComponent final : public component::TableComponent {
     std::string blocked;    // why the last step was not (wholly) taken: a limit, a contact ahead
     Wrench hand;            // the push it measures (world, at the tool centre point)
     double speed = 0.0;     // m/s of its reference
+    double tracking = 0.0;  // m: the tool from its reference, measured (the protective stop's, arm/free_drive.h)
     JointVector checked{};  // the joints its reference was checked at (for collisions, limits, speed)
   };
   FreeDriveStatus freeDriveStatus() const;

@@ -188,6 +188,32 @@ world::Pose advance(const world::Pose& pose, const Twist& twist, double dt) {
   return moved;
 }
 
+std::string ProtectiveStop::check(double tool_speed, double tracking, double turn, double dt) {
+  if (tracking > limits_.tracking) {
+    return "the tool was " + formatNumber("%.1f mm", 1000.0 * tracking) + " from where free-drive held it (at most " +
+           formatNumber("%.0f mm", 1000.0 * limits_.tracking) + ": a push harder than a hand's, or a collision)";
+  }
+  if (turn > limits_.rotation_tracking) {
+    return "the tool was turned " + formatNumber("%.1f deg", turn * 180.0 / M_PI) +
+           " from where free-drive held it (at most " +
+           formatNumber("%.1f deg", limits_.rotation_tracking * 180.0 / M_PI) +
+           ": a twist harder than a hand's, or a collision)";
+  }
+  if (tool_speed <= limits_.tool_speed) {
+    over_for_ = 0.0;
+    fastest_ = 0.0;
+    return {};
+  }
+  over_for_ += dt;
+  fastest_ = std::max(fastest_, tool_speed);
+  if (over_for_ < limits_.over_speed_window) {
+    return {};
+  }
+  return "the tool moved faster than " + formatNumber("%.2f m/s", limits_.tool_speed) + " for " +
+         formatNumber("%.0f ms", 1000.0 * over_for_) + " (" + formatNumber("%.2f m/s", fastest_) +
+         " at most), the teaching speed limit";
+}
+
 FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joints, const Twist& twist, double dt,
                             const JointVector& max_joint_step, const AdmittanceGains& gains, const StepChecks& check) {
   FreeDriveStep held{reference, joints, Twist{}, {}};

@@ -101,6 +101,37 @@ Twist admittance(const Wrench& hand, const Twist& before, double dt, const Guidi
 /// The pose a twist moves `pose` to in `dt`.
 world::Pose advance(const world::Pose& pose, const Twist& twist, double dt);
 
+/// Free-drive's protective stop: the hand's push is turned into a reference the arm follows
+/// compliantly, so a push harder than a hand's, or a collision, does not show as a force on the
+/// wrist (the arm yields instead of pushing back) but as speed and as the tool running away from
+/// the reference. Either stops the arm, as a cobot's protective stop does in hand guiding.
+struct ProtectiveLimits {
+  /// m/s of the tool centre point (measured, not the reference's): the reduced speed of
+  /// collaborative teaching; a transient above it shorter than `over_speed_window` (s) is let be.
+  double tool_speed = 0.25;
+  double over_speed_window = 0.05;
+  /// m and rad the tool may be from the reference it is held to: a hand's largest push (60 N,
+  /// arm/hand_guiding_limits.h) holds it 10 to 13 mm away on the simulated arms, its largest turn
+  /// (3 N m) 1 degree.
+  double tracking = 0.025;
+  double rotation_tracking = 0.15;
+};
+
+class ProtectiveStop {
+ public:
+  explicit ProtectiveStop(ProtectiveLimits limits = {}) : limits_(limits) {}
+  /// One tick `dt` (s) after the last: the tool's measured speed (m/s) and its distance (m) and
+  /// turn (rad) from the reference. Returns why the arm must stop, naming the limit and the
+  /// value measured, or empty.
+  std::string check(double tool_speed, double tracking, double turn, double dt);
+  const ProtectiveLimits& limits() const { return limits_; }
+
+ private:
+  ProtectiveLimits limits_;
+  double over_for_ = 0.0;  // s the tool has been faster than the limit, up to now
+  double fastest_ = 0.0;   // m/s: the most it measured in that time
+};
+
 /// What a step of the reference is checked against: the Arm's planner (its kinematics and the
 /// collision world the planner uses), or a test's toy arm.
 struct StepChecks {

@@ -31,6 +31,8 @@ constexpr double kForceLimit = ArmComponent::kMaxForceLimit;
 constexpr double kShortestRecording = 0.005;
 /// The arm must be this still (rad/s, any joint) for free-drive to begin.
 constexpr double kStillSpeed = 0.05;
+/// The tool's speed is measured over this (s) of the joints' measured velocity.
+constexpr double kSpeedProbe = 1e-3;
 
 }  // namespace
 
@@ -177,6 +179,8 @@ std::unique_ptr<component::RunningOperation> ArmComponent::freeDrive(const compo
     TimePoint began{};
     RecordedTrajectory recording;  // the tool in the recording's frame, every tick
     world::Pose frame_inverse = world::Pose::Identity();
+    ProtectiveStop protective;
+    std::uint64_t control_motion = 0;  // the controller's motion count for the last reference given
   };
   auto run = std::make_shared<Run>();
   run->mode = mode;
@@ -275,6 +279,35 @@ std::unique_ptr<component::RunningOperation> ArmComponent::freeDrive(const compo
     }
     const double dt = toSeconds(now - run->last);
     run->last = now;
+    // The controller latches a force above the limit on the wrist until it is given the next
+    // reference: read it before that (read after, it was never seen).
+    if (const CartesianState control = force_.controller->state();
+        !first && control.motion == run->control_motion && control.force_limit_stop) {
+      stopMotion(*motion_, driver_, clock_, kinematics_->limits());
+      return OperationResult::failure("FreeDrive: protective stop: the force on the wrist was " +
+                                      formatNumber("%.0f N", control.stop_force) + " (at most " +
+                                      formatNumber("%.0f N", kForceLimit) + "); the arm was stopped and holds");
+    }
+    // The tool's own speed and its distance from the reference, measured: a push the compliant
+    // arm yields to shows there, not on the wrist.
+    JointVector probe = state.position;
+    for (int j = 0; j < probe.size() && j < state.velocity.size(); ++j) {
+      probe[j] += state.velocity[j] * kSpeedProbe;
+    }
+    const world::Pose ahead = toolAt(probe);
+    const double tool_speed = (ahead.translation() - tcp.translation()).norm() / kSpeedProbe;
+    const double tracking = (tcp.translation() - run->reference.translation()).norm();
+    const double turn = world::rotationAngle(run->reference, tcp);
+    driving.status.tracking = tracking;
+    if (const std::string why = run->protective.check(tool_speed, tracking, turn, dt); !why.empty()) {
+      stopMotion(*motion_, driver_, clock_, kinematics_->limits());
+      return OperationResult::failure("FreeDrive: protective stop: " + why + "; the arm was stopped and holds",
+                                      {{"reason", "protective stop"},
+                                       {"tool_speed_m_s", tool_speed},
+                                       {"tracking_m", tracking},
+                                       {"turn_rad", turn},
+                                       {"travelled_m", run->travelled}});
+    }
     const Wrench hand =
         handWrench(reading.wrench, run->start_reading, sensor, run->sensor_at_start, tcp_in_sensor, force_.payload);
     driving.status.hand = hand;
@@ -306,11 +339,7 @@ std::unique_ptr<component::RunningOperation> ArmComponent::freeDrive(const compo
     motion_->trajectory.reset();
     motion_->cartesian = true;
     force_.controller->follow(std::move(motion), now);
-    if (force_.controller->state().force_limit_stop) {
-      stopMotion(*motion_, driver_, clock_, kinematics_->limits());
-      return OperationResult::failure("FreeDrive: the force on the tool exceeded " +
-                                      formatNumber("%.0f N", kForceLimit) + "; the arm was stopped");
-    }
+    run->control_motion = force_.controller->state().motion;
     run->travelled += (step.reference.translation() - run->reference.translation()).norm();
     run->reference = step.reference;
     run->joints = step.joints;

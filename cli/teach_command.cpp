@@ -195,6 +195,8 @@ void dragRandom(workcell::Workcell& cell, const std::vector<std::string>& w) {
                 (r.first_part_contact + (r.first_part_contact.empty() ? "" : ")")).c_str(), r.lowest_tool);
     std::printf("tool speed: at most %.3f m/s (at %.2f s, %s); at rest %.2f s after letting go at most\n",
                 r.max_tool_speed, r.max_speed_at, r.max_speed_held ? "free-driving" : "let go", r.max_stop_time);
+    std::printf("the tool at most %.1f mm from its reference (the protective stop's limit: %.0f mm)\n",
+                1000.0 * r.max_tracking, 1000.0 * arm::ProtectiveLimits{}.tracking);
     for (const auto& [why, ticks] : r.blocked) {
       std::printf("  refused steps: %-40s %d ticks\n", why.c_str(), ticks);
     }
@@ -293,11 +295,21 @@ void drag(workcell::Workcell& cell, const std::vector<std::string>& w) {
   const world::Pose before = simulation->tcpPose();
   const TimePoint start = cell.clock().now();
   std::string blocked;
+  // The tool's fastest, measured on the simulator's true pose between ticks.
+  double fastest = 0.0;
+  world::Pose last = before;
+  TimePoint last_time = start;
   const bool ok =
       runNode(cell,
               "<FreeDrive mode=\"" + escape(mode) + "\" locked=\"" + escape(locked) + "\" axes=\"" + axes +
                   "\" hold=\"0.2\" record=\"" + escape(record) + "\" record_frame=\"" + escape(record_frame) + "\"/>",
               [&] {
+                const world::Pose now = simulation->tcpPose();
+                if (const double dt = toSeconds(cell.clock().now() - last_time); dt > 0.0) {
+                  fastest = std::max(fastest, (now.translation() - last.translation()).norm() / dt);
+                }
+                last = now;
+                last_time = cell.clock().now();
                 if (toSeconds(cell.clock().now() - start) < *seconds) {
                   simulation->setHandWrench(hand);
                   arm->holdFreeDrive(std::chrono::milliseconds(100));
@@ -309,13 +321,11 @@ void drag(workcell::Workcell& cell, const std::vector<std::string>& w) {
                 }
               });
   simulation->setHandWrench({});
-  if (ok) {
-    const world::Pose after = simulation->tcpPose();
-    const Eigen::Vector3d moved = after.translation() - before.translation();
-    std::printf("the tool moved %.4f %.4f %.4f m and turned %.1f deg%s%s\n", moved.x(), moved.y(), moved.z(),
-                world::rotationAngle(before, after) * 180.0 / M_PI,
-                blocked.empty() ? "" : "; held back: ", blocked.c_str());
-  }
+  const world::Pose after = simulation->tcpPose();
+  const Eigen::Vector3d moved = after.translation() - before.translation();
+  std::printf("the tool moved %.4f %.4f %.4f m and turned %.1f deg, at %.3f m/s at most%s%s\n", moved.x(), moved.y(),
+              moved.z(), world::rotationAngle(before, after) * 180.0 / M_PI, fastest,
+              ok && !blocked.empty() ? "; held back: " : "", ok ? blocked.c_str() : "");
 }
 
 /// One command line; returns false to end the session.

@@ -96,6 +96,9 @@ FreeDriveTrialResult runFreeDriveTrial(workcell::Workcell& cell, const FreeDrive
     }
     result.joint_limit_violations += violated ? 1 : 0;
     const arm::ArmComponent::FreeDriveStatus checked = arm->freeDriveStatus();
+    if (checked.active) {
+      result.max_tracking = std::max(result.max_tracking, checked.tracking);
+    }
     if (checked.active && checked.checked.size() == q.size()) {
       for (int j = 0; j < q.size(); ++j) {
         result.max_departure = std::max(result.max_departure, std::abs(q[j] - checked.checked[j]));

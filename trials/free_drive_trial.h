@@ -37,6 +37,7 @@ struct FreeDriveTrialResult {
   std::uint64_t part_contact_ticks = 0;      // ticks with the arm or gripper touching a part
   std::string first_part_contact;            // the first: which bodies, when
   double max_tool_speed = 0.0;               // m/s of the tool centre point (10 ms differences)
+  double max_tracking = 0.0;                 // m: the tool's farthest from its reference (the protective stop's)
   double max_speed_at = 0.0;                 // s into the drag when it was reached
   bool max_speed_held = false;               // while the dead-man was held (else: after letting go)
   double lowest_tool = 0.0;                  // m: the tool centre point's lowest height above the table

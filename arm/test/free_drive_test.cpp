@@ -91,6 +91,32 @@ TEST(FreeDrive, TheAdmittanceAnswersBeyondItsDeadBandWithinItsSpeedAndMasksLocke
               0.015, 1e-12);
 }
 
+TEST(FreeDrive, TheProtectiveStopTripsOnSpeedHeldPastItsWindowOrOnTrackingNamingTheLimitAndTheValue) {
+  // A hard push the compliant arm yields to: the wrist reads little, the tool runs fast and away
+  // from its reference (the 150 N stop never fired: 200 N moved the UR5's tool 0.8 m at 3.9 m/s).
+  ProtectiveStop stop;
+  const double dt = 0.01;
+  // A transient above the speed shorter than the window is let be, and the window starts over.
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(stop.check(0.30, 0.010, 0.0, dt), "") << i;
+  }
+  EXPECT_EQ(stop.check(0.20, 0.010, 0.0, dt), "");
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(stop.check(0.40, 0.010, 0.0, dt), "") << i;
+  }
+  EXPECT_EQ(stop.check(0.31, 0.010, 0.0, dt),
+            "the tool moved faster than 0.25 m/s for 50 ms (0.40 m/s at most), the teaching speed limit");
+  // The tool held away from its reference trips at once, speed or not.
+  ProtectiveStop tracking;
+  EXPECT_EQ(tracking.check(0.0, 0.024, 0.0, dt), "");
+  EXPECT_EQ(tracking.check(0.0, 0.0312, 0.0, dt),
+            "the tool was 31.2 mm from where free-drive held it (at most 25 mm: a push harder than a hand's, or a "
+            "collision)");
+  EXPECT_EQ(tracking.check(0.0, 0.0, 0.2, dt),
+            "the tool was turned 11.5 deg from where free-drive held it (at most 8.6 deg: a twist harder than a "
+            "hand's, or a collision)");
+}
+
 TEST(FreeDrive, AStepTowardAWallStopsTheLookAheadShortOfItAndAnAslantPushSlidesAlongIt) {
   // A one-joint-per-axis "arm": the joints are the tool's x, y, z; a wall at z = 0.1.
   AdmittanceGains gains;

@@ -82,6 +82,74 @@ TEST_P(FreeDrive, APushMovesTheToolAlongItAndLettingGoStopsAndHoldsIt) {
   EXPECT_FALSE(arm_->freeDriveStatus().active);
 }
 
+TEST_P(FreeDrive, APushHarderThanAHandTripsTheProtectiveStopNamingTheLimitAndTheArmComesToRest) {
+  // The compliant arm yields to a push instead of pushing back, so the wrist's 150 N stop never
+  // fired: 200 N moved the UR5's tool 0.8 m at 3.9 m/s, 140 N 0.13 m at 0.6 m/s, and free-drive
+  // went on. Now the tool's measured speed and its distance from the reference stop it too.
+  double fastest = 0.0;
+  world::Pose last = simulation_->tcpPose();
+  double last_t = 0.0;
+  const auto watch = [&](double t) {
+    const world::Pose now = simulation_->tcpPose();
+    if (t > last_t) {
+      fastest = std::max(fastest, (now.translation() - last.translation()).norm() / (t - last_t));
+    }
+    last = now;
+    last_t = t;
+  };
+  // Pushes with `force` along y until the operation ends and `after` s more (a person's reaction),
+  // then lets go; the tool's fastest speed (10 ms differences of the true pose) in `fastest`.
+  const auto shove = [&](double force, double seconds, double after) {
+    fastest = 0.0;
+    last = simulation_->tcpPose();
+    last_t = 0.0;
+    arm::Wrench hand;
+    hand.force = Eigen::Vector3d(0.0, force, 0.0);
+    const bt::RunResult result = run("<FreeDrive hold=\"0.2\"/>", [&](double t) {
+      watch(t);
+      if (t < seconds) {
+        simulation_->setHandWrench(hand);
+        arm_->holdFreeDrive(std::chrono::milliseconds(100));
+      } else {
+        simulation_->setHandWrench({});
+      }
+    });
+    if (after > 0.0) {
+      run("<Sleep msec=\"" + std::to_string(static_cast<int>(after * 1000.0)) + "\"/>",
+          [&](double t) { simulation_->setHandWrench(t < after ? hand : arm::Wrench{}); });
+    }
+    simulation_->setHandWrench({});
+    return result;
+  };
+  // The largest push a hand may make (60 N) guides it, within the teaching speed.
+  const world::Pose start = simulation_->tcpPose();
+  const bt::RunResult firm = shove(60.0, 0.8, 0.0);
+  ASSERT_EQ(firm.status, bt::Status::kSuccess) << firm.failure_reason;
+  EXPECT_GT((simulation_->tcpPose().translation() - start.translation()).norm(), 0.04);
+  EXPECT_LE(fastest, 0.25);
+  run("<Sleep msec=\"300\"/>", {});
+  // 140 N, below the wrist's limit: stopped by the tool's speed or its distance from the reference.
+  const world::Pose before = simulation_->tcpPose();
+  const bt::RunResult hard = shove(140.0, 5.0, 0.2);
+  ASSERT_EQ(hard.status, bt::Status::kFailure);
+  EXPECT_TRUE(hard.failure_reason.starts_with("FreeDrive: protective stop: the tool ")) << hard.failure_reason;
+  EXPECT_TRUE(hard.failure_reason.ends_with("; the arm was stopped and holds")) << hard.failure_reason;
+  EXPECT_LT(toSeconds(hard.elapsed), 1.0);  // of the 5 s push
+  // Let go, it is at rest and stays there.
+  run("<Sleep msec=\"500\"/>", {});
+  const world::Pose stopped = simulation_->tcpPose();
+  EXPECT_LT(arm::maxAbs(simulation_->armVelocities()), 0.02);
+  EXPECT_LT((stopped.translation() - before.translation()).norm(), 0.15);
+  run("<Sleep msec=\"500\"/>", {});
+  EXPECT_LT((simulation_->tcpPose().translation() - stopped.translation()).norm(), 0.002);
+  EXPECT_FALSE(arm_->freeDriveStatus().active);
+  // 200 N: the wrist's own limit, read before the next reference clears it.
+  const bt::RunResult harder = shove(200.0, 5.0, 0.0);
+  ASSERT_EQ(harder.status, bt::Status::kFailure);
+  EXPECT_TRUE(harder.failure_reason.starts_with("FreeDrive: protective stop: ")) << harder.failure_reason;
+  EXPECT_LT(toSeconds(harder.elapsed), 0.1);
+}
+
 TEST_P(FreeDrive, RotationModeTurnsTheToolAboutItsCentrePointAndKeepsItThere) {
   const world::Pose before = simulation_->tcpPose();
   arm::Wrench hand;
