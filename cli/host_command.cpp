@@ -38,6 +38,8 @@ int hostSimulated(const HostOptions& options) {
     return components.make();
   };
   lockstep.reach_time = [&](std::int64_t stamp_ns) { link.reachTime(stamp_ns); };
+  lockstep.prepare = [&](const std::string& prepared_json) { link.prepare(prepared_json); };
+  lockstep.prepared_used = [&] { return link.preparedUsed(); };
   dds::ComponentHost component_host(remote, components.make(), lockstep);
   link.setHost(component_host.id());
   std::cerr << "costar host: serving";

@@ -200,6 +200,15 @@ struct ComponentHost::State {
     }
   }
 
+  /// A component's report as JSON, or {"error": why} when it throws.
+  static nlohmann::json reportOf(const std::string& name, const component::Component& component) {
+    try {
+      return toJson(component.report());
+    } catch (const std::exception& failure) {
+      return {{"error", name + ": " + failure.what()}};
+    }
+  }
+
   /// Answers a lockstep call of an executor.
   void answerCall(const costar_msgs_srv_dds__Call_Request_& request) {
     if (!components.contains(std::string_view(request.target)) || (request.host_id != 0 && request.host_id != id)) {
@@ -224,6 +233,9 @@ struct ComponentHost::State {
         executor = request.client;
       }
       lockstep->reach_time(request.stamp_ns);
+      if (lockstep->prepare) {
+        lockstep->prepare(request.prepared_json);
+      }
       component::Component& component = *components.find(std::string_view(request.target))->second;
       const std::string method = request.method;
       const nlohmann::json args = nlohmann::json::parse(request.args_json);
@@ -246,10 +258,14 @@ struct ComponentHost::State {
         component.cancel(args.at("id").get<component::OperationId>());
         result = nlohmann::json::object();
       } else if (method == "report") {
-        try {
-          result = toJson(component.report());
-        } catch (const std::exception& failure) {
-          result = {{"error", std::string(request.target) + ": " + failure.what()}};
+        result = reportOf(request.target, component);
+      } else if (method == "reports") {
+        // Every component's of this host, the one asked first: one call a tick for all of them.
+        result = {{request.target, reportOf(request.target, component)}};
+        for (const std::string& name : names) {
+          if (name != request.target) {
+            result[name] = reportOf(name, *components.find(name)->second);
+          }
         }
       } else {
         throw std::invalid_argument("unknown call '" + method + "'");
@@ -262,6 +278,7 @@ struct ComponentHost::State {
     message.client = request.client;
     message.host_id = id;
     message.number = request.number;
+    message.prepared_used = lockstep && lockstep->prepared_used ? lockstep->prepared_used() : 0;
     message.ok = error.empty();
     message.error = wire(error);
     message.result_json = wire(result_json);

@@ -11,6 +11,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "component/component.h"
@@ -29,6 +30,10 @@ class ComponentHost {
     std::function<std::vector<std::shared_ptr<component::Component>>(std::uint64_t executor)> new_run;
     /// Brings the host's clock to a call's simulated time (SimulatorLink::reachTime).
     std::function<void(std::int64_t stamp_ns)> reach_time;
+    /// The driver readings the executor answered ahead for the call about to be served
+    /// (SimulatorLink::prepare), and after it how many were used (SimulatorLink::preparedUsed).
+    std::function<void(const std::string& prepared_json)> prepare;
+    std::function<std::uint32_t()> prepared_used;
   };
 
   /// Joins the DDS domain and partition of `config` and publishes the components'

@@ -15,6 +15,7 @@
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,19 @@ struct WrenchSample {
 using DriverServer =
     std::function<DriverReply(const std::string& driver, const std::string& method, const nlohmann::json& args)>;
 
+/// A driver's calls whose answer depends on the simulated time alone (a reading: it changes
+/// nothing, and asked twice at one time answers the same). The executor answers them ahead with
+/// a component call whose last one asked them first (a gripper's report reads its fingers), which
+/// saves the host a round trip each; the host uses them while its component asks the same calls
+/// in the same order, and asks for the rest.
+struct DriverReading {
+  std::string driver;
+  std::string method;
+  bool operator<(const DriverReading& other) const {
+    return driver != other.driver ? driver < other.driver : method < other.method;
+  }
+};
+
 /// A host's side: the simulated time on rt/clock and calls to the executor's drivers.
 class SimulatorLink {
  public:
@@ -73,6 +87,14 @@ class SimulatorLink {
   /// Calls `method` of `driver`. @throws std::runtime_error naming them when the executor
   /// answers with an error or not within kAnswerTimeout.
   DriverReply call(const std::string& driver, const std::string& method, const nlohmann::json& args);
+
+  /// The readings the executor answered ahead for the call about to be served (its
+  /// prepared_json; empty: none), used by call() in order while they match.
+  void prepare(const std::string& prepared_json);
+  /// How many of them call() used since prepare(); forgets the rest.
+  std::uint32_t preparedUsed();
+  /// How many driver calls went to the executor (those answered ahead did not).
+  std::uint64_t callsSent() const;
 
   /// Waits until rt/clock has reached `stamp_ns` and sets the clock to it.
   /// @throws std::runtime_error when it does not within kAnswerTimeout.

@@ -84,8 +84,48 @@ struct RemoteClient::State {
   dds_entity_t call_writer = 0, call_reply_reader = 0, driver_request_reader = 0, driver_reply_writer = 0;
   dds_entity_t clock_writer = 0, joint_state_writer = 0, wrench_writer = 0, waitset = 0;
   DriverServer driver_server;
+  std::set<DriverReading> readings;  // answered ahead (dds/lockstep.h)
   std::int64_t clock_ns = 0;
   std::uint64_t calls = 0;
+  /// A driver call a host made: driver, method, its arguments as the host wrote them.
+  struct DriverCall {
+    std::string driver, method, args_json;
+  };
+  /// The driver calls the last call of each component's method made, in order ("gripper/report").
+  std::map<std::string, std::vector<DriverCall>, std::less<>> asked;
+  std::vector<DriverCall>* recording = nullptr;  // the present call's, while it waits
+  /// The reports of a host's components, asked together by the first of them asked at a time:
+  /// the others' are used while the clock and the calls stand where they were.
+  struct Reports {
+    std::int64_t clock_ns = -1;
+    std::uint64_t after_call = 0;
+    nlohmann::json by_component;
+  };
+  std::map<std::uint64_t, Reports> reports;  // by host
+
+  /// The leading readings of `last`, answered now (at the call's simulated time), as the
+  /// call's prepared_json; what was answered is appended to `answered`.
+  std::string answerAhead(const std::vector<DriverCall>& last, std::vector<DriverCall>& answered) {
+    nlohmann::json prepared = nlohmann::json::array();
+    for (const DriverCall& call : last) {
+      if (!driver_server || !readings.contains({call.driver, call.method})) {
+        break;
+      }
+      nlohmann::json answer = {{"driver", call.driver}, {"method", call.method}, {"args", call.args_json}};
+      try {
+        DriverReply reply = driver_server(call.driver, call.method, nlohmann::json::parse(call.args_json));
+        if (!reply.floats.empty() || !reply.bytes.empty()) {
+          break;  // a frame travels as the answer to its own call
+        }
+        answer["result"] = std::move(reply.result);
+      } catch (const std::exception& failure) {
+        answer["error"] = failure.what();
+      }
+      prepared.push_back(std::move(answer));
+      answered.push_back(call);
+    }
+    return prepared.empty() ? std::string() : prepared.dump();
+  }
 
   /// Answers the driver calls of hosts to this executor.
   void serveDrivers() {
@@ -93,6 +133,9 @@ struct RemoteClient::State {
         driver_request_reader, [this](const costar_msgs_srv_dds__Call_Request_& request) {
           if (request.client != client_id) {
             return;
+          }
+          if (recording != nullptr) {
+            recording->push_back({request.target, request.method, request.args_json});
           }
           DriverReply reply;
           std::string error;
@@ -143,6 +186,9 @@ struct RemoteClient::State {
     }
     const std::uint64_t number = ++calls;
     const std::string args_json = args.dump();
+    const std::string key = component + "/" + method;
+    std::vector<DriverCall> answered;
+    const std::string prepared_json = answerAhead(asked[key], answered);
     costar_msgs_srv_dds__Call_Request_ request{};
     request.client = client_id;
     request.host_id = host_id;
@@ -151,15 +197,24 @@ struct RemoteClient::State {
     request.method = wire(method);
     request.args_json = wire(args_json);
     request.stamp_ns = clock_ns;
+    request.prepared_json = wire(prepared_json);
     Bus::write(call_writer, &request);
+    std::vector<DriverCall> made;  // the host's driver calls during this one, after those it used
+    recording = &made;
+    struct StopRecording {
+      std::vector<DriverCall>*& recording;
+      ~StopRecording() { recording = nullptr; }
+    } stop_recording{recording};
     for (;;) {
       std::optional<nlohmann::json> result;
       std::string error;
+      std::uint32_t used = 0;
       Bus::takeAll<costar_msgs_srv_dds__Call_Response_>(call_reply_reader,
                                                         [&](const costar_msgs_srv_dds__Call_Response_& reply) {
                                                           if (reply.client != client_id || reply.number != number) {
                                                             return;  // another executor's, or one given up on
                                                           }
+                                                          used = reply.prepared_used;
                                                           if (reply.ok) {
                                                             result = nlohmann::json::parse(reply.result_json);
                                                           } else {
@@ -168,6 +223,10 @@ struct RemoteClient::State {
                                                           }
                                                         });
       if (result) {
+        // What this call asked, for the next one: the readings it used, then the calls it made.
+        answered.resize(std::min<std::size_t>(used, answered.size()));
+        answered.insert(answered.end(), made.begin(), made.end());
+        asked[key] = std::move(answered);
         if (!error.empty()) {
           throw std::runtime_error(error);
         }
@@ -407,7 +466,10 @@ void RemoteClient::publishWrench(const WrenchSample& wrench) {
   Bus::write(state.wrench_writer, &message);
 }
 
-void RemoteClient::setDriverServer(DriverServer server) { state_->driver_server = std::move(server); }
+void RemoteClient::setDriverServer(DriverServer server, std::vector<DriverReading> readings) {
+  state_->driver_server = std::move(server);
+  state_->readings = {readings.begin(), readings.end()};
+}
 
 void RemoteClient::publishClock(TimePoint now) {
   State& state = *state_;
@@ -581,7 +643,23 @@ bool RemoteComponent::cancelConfirmed(component::OperationId id) const {
 world::Report RemoteComponent::report() const {
   RemoteClient::State& state = *client_->state_;
   if (state.config.lockstep) {
-    const nlohmann::json answer = state.call(description_.name, "report", nlohmann::json::object());
+    // One call a tick for all of a host's components: the registry asks each component's report
+    // in turn, with nothing between them that reaches the host (a report changes nothing).
+    std::uint64_t host_id = 0;
+    {
+      std::lock_guard lock(state.mutex);
+      const auto served = state.served.find(description_.name);
+      host_id = served == state.served.end() ? 0 : served->second.host_id;
+    }
+    RemoteClient::State::Reports& held = state.reports[host_id];
+    if (held.clock_ns != state.clock_ns || held.after_call != state.calls ||
+        !held.by_component.contains(description_.name)) {
+      held.by_component = state.call(description_.name, "reports", nlohmann::json::object());
+      held.clock_ns = state.clock_ns;
+      held.after_call = state.calls;
+    }
+    const nlohmann::json answer = std::move(held.by_component.at(description_.name));
+    held.by_component.erase(description_.name);
     if (answer.contains("error")) {
       throw std::runtime_error(answer["error"].get<std::string>());
     }

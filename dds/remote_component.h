@@ -11,6 +11,7 @@
 #include <chrono>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "component/component.h"
 #include "dds/lockstep.h"
@@ -54,8 +55,9 @@ class RemoteClient : public std::enable_shared_from_this<RemoteClient> {
   /// host serves it within `timeout`.
   std::shared_ptr<RemoteComponent> connect(const std::string& component, std::chrono::milliseconds timeout);
 
-  /// Lockstep: answers the hosts' driver calls with `server` while a call waits for its host.
-  void setDriverServer(DriverServer server);
+  /// Lockstep: answers the hosts' driver calls with `server` while a call waits for its host;
+  /// `readings` are answered ahead with a call whose last one asked them first (DriverReading).
+  void setDriverServer(DriverServer server, std::vector<DriverReading> readings = {});
   /// Lockstep: publishes the simulated time on rt/clock; the calls after it carry it.
   void publishClock(TimePoint now);
   /// Lockstep: publishes the arm's joints on rt/joint_states (sensor_msgs/msg/JointState) and the

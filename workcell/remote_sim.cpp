@@ -152,6 +152,12 @@ const std::vector<std::string>& remotableSimComponents() {
   return kNames;
 }
 
+const std::vector<dds::DriverReading>& simDriverReadings() {
+  static const std::vector<dds::DriverReading> kReadings = {
+      {"gripper", "read"}, {"gripper", "max_opening"}, {"camera", "info"}, {"camera", "stream_status"}};
+  return kReadings;
+}
+
 dds::DriverServer simDriverServer(gripper::GripperDriver* gripper, camera::RgbdCamera& camera,
                                   std::function<world::Pose()> camera_pose) {
   return [gripper, &camera, camera_pose = std::move(camera_pose)](const std::string& driver, const std::string& method,

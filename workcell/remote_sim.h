@@ -26,6 +26,10 @@ const std::vector<std::string>& remotableSimComponents();
 dds::DriverServer simDriverServer(gripper::GripperDriver* gripper, camera::RgbdCamera& camera,
                                   std::function<world::Pose()> camera_pose);
 
+/// The calls of simDriverServer that are readings (dds::DriverReading): the fingers' reading and
+/// opening, the camera's description and stream status.
+const std::vector<dds::DriverReading>& simDriverReadings();
+
 /// A host's components of simulated cell `cell` on drivers that call the executor through
 /// `link`, and what they need kept alive.
 class RemoteSimComponents {

@@ -384,8 +384,12 @@ class SimWorkcell final : public Workcell {
     calibration_ = makeCalibration(options, *arm, arm_config.tcp_in_flange, camera);
     add(calibration_);
     if (remote_) {
-      remote_->setDriverServer(simDriverServer(
-          gripper_drivers.parallel, camera, [calibration = calibration_.get()] { return calibration->cameraPose(); }));
+      // Readings are answered ahead with the calls that ask them (dds::DriverReading), except
+      // under an injected fault: a faulty driver's reading records when the fault took effect.
+      remote_->setDriverServer(
+          simDriverServer(gripper_drivers.parallel, camera,
+                          [calibration = calibration_.get()] { return calibration->cameraPose(); }),
+          faults_ ? std::vector<dds::DriverReading>{} : simDriverReadings());
     }
     add(std::make_shared<FixedFrames>(std::vector<std::pair<std::string, world::Pose>>{
         {"table_center", tableCenter()}, {"robot_base", cell_.robot_base}}));

@@ -12,6 +12,7 @@
 
 #include <atomic>
 #include <functional>
+#include <map>
 #include <optional>
 #include <thread>
 
@@ -148,6 +149,131 @@ TEST(Lockstep, EachNewExecutorGetsTheComponentsAfresh) {
     ASSERT_EQ(report.symbols.size(), 1U);
     EXPECT_EQ(std::get<world::NumberValue>(report.symbols[0].value).value, 1.0) << "run " << run;
     EXPECT_EQ(host.runs(), run);
+  }
+}
+
+/// A component whose report is a gauge's level, read from the executor's "gauge" driver.
+class Gauge final : public component::Component {
+ public:
+  Gauge(std::string name, SimulatorLink& link) : link_(link) {
+    description_.name = std::move(name);
+    description_.type = "Gauge";
+    description_.symbols = {{"level", world::SymbolKind::kNumber, "the gauge's level"}};
+  }
+  const component::ComponentDescription& description() const override { return description_; }
+  component::OperationId start(const std::string&, const component::ParamMap&) override { return 1; }
+  component::OperationResult poll(component::OperationId) override { return component::OperationResult::success(); }
+  void cancel(component::OperationId) override {}
+  world::Report report() const override {
+    const double level = link_.call("gauge", "read", {{"who", description_.name}}).result.get<double>();
+    world::Report report;
+    report.symbols.push_back({description_.name, "", {}, world::NumberValue{level, ""}});
+    return report;
+  }
+
+ private:
+  SimulatorLink& link_;
+  component::ComponentDescription description_;
+};
+
+/// Gauges "left" and "right" in one lockstep host on a thread of its own; counts the calls it
+/// answers.
+class GaugeHost {
+ public:
+  explicit GaugeHost(const RemoteConfig& config) : link_(config) {
+    const auto gauges = [this] {
+      return std::vector<std::shared_ptr<component::Component>>{std::make_shared<Gauge>("left", link_),
+                                                                std::make_shared<Gauge>("right", link_)};
+    };
+    ComponentHost::Lockstep lockstep;
+    lockstep.new_run = [this, gauges](std::uint64_t executor) {
+      link_.setExecutor(executor);
+      return gauges();
+    };
+    lockstep.reach_time = [this](std::int64_t stamp_ns) {
+      ++calls_;
+      link_.reachTime(stamp_ns);
+    };
+    lockstep.prepare = [this](const std::string& prepared_json) { link_.prepare(prepared_json); };
+    lockstep.prepared_used = [this] { return link_.preparedUsed(); };
+    host_ = std::make_unique<ComponentHost>(config, gauges(), lockstep);
+    link_.setHost(host_->id());
+    thread_ = std::thread([this] { host_->serve(stop_); });
+  }
+  ~GaugeHost() {
+    stop_ = true;
+    thread_.join();
+  }
+  /// The executor's calls answered, and the driver calls sent to the executor.
+  int calls() const { return calls_; }
+  std::uint64_t driverCallsSent() const { return link_.callsSent(); }
+
+ private:
+  SimulatorLink link_;
+  std::unique_ptr<ComponentHost> host_;
+  std::atomic<bool> stop_{false};
+  std::atomic<int> calls_{0};
+  std::thread thread_;
+};
+
+/// The executor of the gauges: their levels are `levels` (by name) when read.
+struct GaugeExecutor {
+  GaugeExecutor(const RemoteConfig& config, bool readings_ahead) : client(RemoteClient::create(config)) {
+    client->setDriverServer(
+        [this](const std::string&, const std::string&, const nlohmann::json& args) {
+          return DriverReply{levels.at(args.at("who").get<std::string>()), {}, {}};
+        },
+        readings_ahead ? std::vector<DriverReading>{{"gauge", "read"}} : std::vector<DriverReading>{});
+    left = client->connect("left", seconds(10));
+    right = client->connect("right", seconds(10));
+  }
+  static double level(const component::Component& gauge) {
+    return std::get<world::NumberValue>(gauge.report().symbols.at(0).value).value;
+  }
+  std::map<std::string, double> levels = {{"left", 1.0}, {"right", 2.0}};
+  std::shared_ptr<RemoteClient> client;
+  std::shared_ptr<RemoteComponent> left, right;
+};
+
+RemoteConfig gaugeConfig(const std::string& name) {
+  RemoteConfig config = lockstepConfig(name);
+  config.components = {"left", "right"};
+  return config;
+}
+
+// The registry asks each component's report in turn every tick: a host's components answer in
+// one call a tick (the first asked brings the others'), each at that tick's time.
+TEST(Lockstep, AHostsReportsComeInOneCallATick) {
+  const RemoteConfig config = gaugeConfig("reports");
+  GaugeHost host(config);
+  GaugeExecutor executor(config, false);
+  for (int tick = 1; tick <= 3; ++tick) {
+    executor.levels = {{"left", 10.0 * tick}, {"right", 10.0 * tick + 1}};
+    executor.client->publishClock(TimePoint(milliseconds(10 * tick)));
+    EXPECT_EQ(GaugeExecutor::level(*executor.left), 10.0 * tick);
+    EXPECT_EQ(GaugeExecutor::level(*executor.right), 10.0 * tick + 1);
+    EXPECT_EQ(host.calls(), tick);
+  }
+  // Asked again at the same time, a report is asked again (the one brought along was used).
+  EXPECT_EQ(GaugeExecutor::level(*executor.right), 31.0);
+  EXPECT_EQ(host.calls(), 4);
+}
+
+// The readings a host's report asked for at the last tick are read by the executor and sent with
+// the next tick's call: the host asks nothing more, and reads the levels of the new tick.
+TEST(Lockstep, TheReadingsTheLastCallAskedAreAnsweredAheadWithTheNext) {
+  for (const bool ahead : {true, false}) {
+    const RemoteConfig config = gaugeConfig(ahead ? "ahead" : "asked");
+    GaugeHost host(config);
+    GaugeExecutor executor(config, ahead);
+    for (int tick = 1; tick <= 3; ++tick) {
+      executor.levels = {{"left", 5.0 * tick}, {"right", -5.0 * tick}};
+      executor.client->publishClock(TimePoint(milliseconds(10 * tick)));
+      EXPECT_EQ(GaugeExecutor::level(*executor.left), 5.0 * tick);
+      EXPECT_EQ(GaugeExecutor::level(*executor.right), -5.0 * tick);
+    }
+    // The first tick's two readings were asked by the host; then none (ahead) or two a tick.
+    EXPECT_EQ(host.driverCallsSent(), ahead ? 2U : 6U) << (ahead ? "answered ahead" : "no readings declared");
   }
 }
 
