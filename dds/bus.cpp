@@ -33,6 +33,8 @@ const TopicInfo& info(Topic topic) {
       {"rt/clock", &rosgraph_msgs_msg_dds__Clock__desc, false, true},
       {"rt/joint_states", &sensor_msgs_msg_dds__JointState__desc, false, true},
       {"rt/wrench", &geometry_msgs_msg_dds__WrenchStamped__desc, false, true},
+      {"rt/camera/color/image_raw", &sensor_msgs_msg_dds__Image__desc, false, true},
+      {"rt/camera/depth/image_raw", &sensor_msgs_msg_dds__Image__desc, false, true},
   };
   static_assert(std::size(kTopics) == kTopicCount);
   return kTopics[static_cast<int>(topic)];

@@ -35,8 +35,10 @@ enum class Topic {
   kClock,              // rt/clock (rosgraph_msgs/msg/Clock: the simulated time)
   kJointStates,        // rt/joint_states (sensor_msgs/msg/JointState)
   kWrench,             // rt/wrench (geometry_msgs/msg/WrenchStamped)
+  kColorImage,         // rt/camera/color/image_raw (sensor_msgs/msg/Image, rgb8)
+  kDepthImage,         // rt/camera/depth/image_raw (sensor_msgs/msg/Image, 32FC1 in metres)
 };
-inline constexpr int kTopicCount = 15;
+inline constexpr int kTopicCount = 17;
 const char* topicName(Topic topic);
 
 /// Owns the participant and everything made from it. Not copyable.

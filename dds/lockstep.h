@@ -48,6 +48,18 @@ struct WrenchSample {
   std::array<double, 3> torque{};
 };
 
+/// A camera image as ROS 2's sensor_msgs/msg/Image carries it: `encoding` "rgb8" (3 bytes a
+/// pixel) or "32FC1" (a float a pixel, little-endian), rows of `step` bytes.
+struct ImageSample {
+  TimePoint stamp{};
+  std::string frame_id;
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  std::string encoding;
+  std::uint32_t step = 0;
+  std::vector<std::uint8_t> data;
+};
+
 /// The executor's side: answers `method` of `driver` with `args` (dds::RemoteClient calls it
 /// while it waits for a host). Throws to answer with an error.
 using DriverServer =

@@ -83,6 +83,7 @@ struct RemoteClient::State {
   // Lockstep (config.lockstep), used from the executor's thread only.
   dds_entity_t call_writer = 0, call_reply_reader = 0, driver_request_reader = 0, driver_reply_writer = 0;
   dds_entity_t clock_writer = 0, joint_state_writer = 0, wrench_writer = 0, waitset = 0;
+  dds_entity_t color_image_writer = 0, depth_image_writer = 0;
   DriverServer driver_server;
   std::set<DriverReading> readings;  // answered ahead (dds/lockstep.h)
   std::int64_t clock_ns = 0;
@@ -410,6 +411,8 @@ RemoteClient::RemoteClient(const RemoteConfig& config) : state_(std::make_unique
     state.clock_writer = state.bus.writer(Topic::kClock);
     state.joint_state_writer = state.bus.writer(Topic::kJointStates);
     state.wrench_writer = state.bus.writer(Topic::kWrench);
+    state.color_image_writer = state.bus.writer(Topic::kColorImage);
+    state.depth_image_writer = state.bus.writer(Topic::kDepthImage);
     state.waitset = dds_create_waitset(state.bus.participant());
     dds_waitset_attach(state.waitset, dds_create_readcondition(state.call_reply_reader, DDS_ANY_STATE), 0);
     dds_waitset_attach(state.waitset, dds_create_readcondition(state.driver_request_reader, DDS_ANY_STATE), 0);
@@ -464,6 +467,31 @@ void RemoteClient::publishWrench(const WrenchSample& wrench) {
   message.wrench.force = {wrench.force[0], wrench.force[1], wrench.force[2]};
   message.wrench.torque = {wrench.torque[0], wrench.torque[1], wrench.torque[2]};
   Bus::write(state.wrench_writer, &message);
+}
+
+void RemoteClient::publishImages(const ImageSample& color, const ImageSample& depth) {
+  State& state = *state_;
+  if (!state.config.lockstep) {
+    throw std::logic_error("RemoteClient::publishImages: only in lockstep");
+  }
+  const auto publish = [](dds_entity_t writer, const ImageSample& image) {
+    if (image.data.empty()) {
+      return;
+    }
+    std::vector<std::uint8_t> data = image.data;
+    sensor_msgs_msg_dds__Image_ message{};
+    message.header.stamp = rosTime(image.stamp);
+    message.header.frame_id = wire(image.frame_id);
+    message.height = image.height;
+    message.width = image.width;
+    message.encoding = wire(image.encoding);
+    message.is_bigendian = 0;
+    message.step = image.step;
+    view(message.data, data);
+    Bus::write(writer, &message);
+  };
+  publish(state.color_image_writer, color);
+  publish(state.depth_image_writer, depth);
 }
 
 void RemoteClient::setDriverServer(DriverServer server, std::vector<DriverReading> readings) {

@@ -64,6 +64,9 @@ class RemoteClient : public std::enable_shared_from_this<RemoteClient> {
   /// wrist's wrench on rt/wrench (geometry_msgs/msg/WrenchStamped), for ROS 2 tools on the domain.
   void publishJointState(const JointStateSample& joints);
   void publishWrench(const WrenchSample& wrench);
+  /// Lockstep: publishes a camera frame's colour image on rt/camera/color/image_raw and its depth
+  /// on rt/camera/depth/image_raw (sensor_msgs/msg/Image; either may be empty: not sent).
+  void publishImages(const ImageSample& color, const ImageSample& depth);
 
  private:
   friend class RemoteComponent;

@@ -13,6 +13,7 @@
 #include <map>
 #include <optional>
 #include <random>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -51,7 +52,12 @@ double percentile(std::vector<double> values, double p) {
   return values[std::min(at, values.size() - 1)];
 }
 
-bool isMotion(const std::string& id) { return id == "Home" || id == "Move" || id == "SmartMove"; }
+/// An operation that moves the arm: the arm's own, and SmartMove's (its motions run as the arm's).
+bool isMotion(const std::string& id) {
+  static const std::set<std::string, std::less<>> kMotions = {"Home",       "Move",         "MoveRelative", "SmartMove",
+                                                              "SmartGrasp", "SmartRelease", "SmartPush"};
+  return kMotions.contains(id);
+}
 
 /// An operation of the plan as a run in one process had it: its node's id and its span.
 struct Span {

@@ -2,12 +2,13 @@
 // The liveness campaign of remote components (issue 34): a simulated cell's gripper and
 // perception served by a host in another process (`costar host`, in lockstep with the run's
 // simulation), the host killed with SIGKILL at a moment drawn from the seed — during a
-// DetectObjects, during an arm motion (Home, Move, SmartMove) or at the boundary between two
-// operations — and every run judged from outside: it must end as FAILURE with a reason naming
-// the host's component within a deadline (wall time from the kill), the arm must come to rest
-// (the simulator's true joint velocities), nothing may hang, and the plan and waypoint files
-// must be unchanged. The moment is found in a run of the same seed in one process (lockstep
-// makes the two the same up to the kill) and taken in simulated time.
+// DetectObjects, during an arm motion (Home, Move, MoveRelative, SmartGrasp, SmartRelease,
+// SmartPush) or at the boundary between two operations — and every run judged from outside: it
+// must end as FAILURE with a reason naming the host's component within a deadline (wall time
+// from the kill), the arm must come to rest (the simulator's true joint velocities), nothing may
+// hang, and the plan and waypoint files must be unchanged. The moment is found in a run of the
+// same seed in one process (lockstep makes the two the same up to the kill) and taken in
+// simulated time.
 
 #include <cstdint>
 #include <filesystem>

@@ -1,9 +1,11 @@
 #include "workcell/remote_sim.h"
 
 #include <algorithm>
+#include <cstring>
 #include <optional>
 #include <stdexcept>
 
+#include "dds/remote_component.h"
 #include "perception/perception_component.h"
 #include "perception/pipeline.h"
 #include "perception/workspace.h"
@@ -145,7 +147,53 @@ class RemoteCamera final : public camera::RgbdCamera {
   mutable std::optional<Info> info_;
 };
 
+/// The camera, publishing each frame taken as ROS 2 images.
+class ImagePublishingCamera final : public camera::RgbdCamera {
+ public:
+  ImagePublishingCamera(camera::RgbdCamera& inner, dds::RemoteClient& client, std::string frame_id)
+      : inner_(inner), client_(client), frame_id_(std::move(frame_id)) {}
+  std::string name() const override { return inner_.name(); }
+  const camera::Intrinsics& intrinsics() const override { return inner_.intrinsics(); }
+  Duration framePeriod() const override { return inner_.framePeriod(); }
+  camera::RgbdFrame capture() override { return published(inner_.capture()); }
+  camera::RgbdFrame captureDepth() override { return published(inner_.captureDepth()); }
+  std::optional<camera::StreamStatus> streamStatus() override { return inner_.streamStatus(); }
+
+ private:
+  camera::RgbdFrame published(camera::RgbdFrame frame) {
+    const auto width = static_cast<std::uint32_t>(frame.intrinsics.width);
+    const auto height = static_cast<std::uint32_t>(frame.intrinsics.height);
+    dds::ImageSample color;
+    if (!frame.rgb.pixels.empty()) {
+      color = {frame.stamp,
+               frame_id_,
+               static_cast<std::uint32_t>(frame.rgb.width),
+               static_cast<std::uint32_t>(frame.rgb.height),
+               "rgb8",
+               static_cast<std::uint32_t>(frame.rgb.width) * 3,
+               frame.rgb.pixels};
+    }
+    dds::ImageSample depth{frame.stamp, frame_id_, width, height, "32FC1", width * 4, {}};
+    depth.data.resize(frame.points.size() * sizeof(float));
+    for (std::size_t i = 0; i < frame.points.size(); ++i) {
+      const float z = frame.points[i].z();
+      std::memcpy(depth.data.data() + i * sizeof(float), &z, sizeof(float));
+    }
+    client_.publishImages(color, depth);
+    return frame;
+  }
+
+  camera::RgbdCamera& inner_;
+  dds::RemoteClient& client_;
+  std::string frame_id_;
+};
+
 }  // namespace
+
+std::unique_ptr<camera::RgbdCamera> imagePublishingCamera(camera::RgbdCamera& camera, dds::RemoteClient& client,
+                                                          std::string frame_id) {
+  return std::make_unique<ImagePublishingCamera>(camera, client, std::move(frame_id));
+}
 
 const std::vector<std::string>& remotableSimComponents() {
   static const std::vector<std::string> kNames = {"gripper", "perception"};

@@ -14,6 +14,10 @@
 #include "dds/lockstep.h"
 #include "gripper/gripper_driver.h"
 
+namespace costar::dds {
+class RemoteClient;
+}  // namespace costar::dds
+
 namespace costar::workcell {
 
 /// The components of a simulated cell that a host may serve.
@@ -29,6 +33,12 @@ dds::DriverServer simDriverServer(gripper::GripperDriver* gripper, camera::RgbdC
 /// The calls of simDriverServer that are readings (dds::DriverReading): the fingers' reading and
 /// opening, the camera's description and stream status.
 const std::vector<dds::DriverReading>& simDriverReadings();
+
+/// `camera`, whose frames, as they are taken, are also published for ROS 2 tools on the domain:
+/// the colour image on rt/camera/color/image_raw (rgb8) and the depth on rt/camera/depth/image_raw
+/// (32FC1, metres along the optical axis, NaN where there is none), in frame `frame_id`.
+std::unique_ptr<camera::RgbdCamera> imagePublishingCamera(camera::RgbdCamera& camera, dds::RemoteClient& client,
+                                                          std::string frame_id);
 
 /// A host's components of simulated cell `cell` on drivers that call the executor through
 /// `link`, and what they need kept alive.

@@ -336,7 +336,13 @@ class SimWorkcell final : public Workcell {
     // The fingers as the cell reads them: the 2-finger's through the fault injector, the
     // adaptive gripper's from the simulation.
     finger_drivers_ = {gripper_drivers.parallel, simulation_->adaptiveGripper()};
-    camera::RgbdCamera& camera = faults_ ? faults_->wrap(camera_) : camera_;
+    camera::RgbdCamera* taken = faults_ ? &faults_->wrap(camera_) : &camera_;
+    if (remote_) {
+      // With components on the domain, its frames go there as ROS 2 images too.
+      published_camera_ = imagePublishingCamera(*taken, *remote_, "camera_optical_frame");
+      taken = published_camera_.get();
+    }
+    camera::RgbdCamera& camera = *taken;
     const auto add = [this](std::shared_ptr<component::Component> component) {
       components().add(faults_ ? faults_->wrap(std::move(component)) : std::move(component));
     };
@@ -733,7 +739,8 @@ class SimWorkcell final : public Workcell {
   std::shared_ptr<smartmove::SmartMoveComponent> smartmove_;
   std::shared_ptr<calibration::CalibrationComponent> calibration_;
   std::shared_ptr<faults::Injector> faults_;
-  std::shared_ptr<dds::RemoteClient> remote_;  // the hosts of remote components, or null
+  std::shared_ptr<dds::RemoteClient> remote_;             // the hosts of remote components, or null
+  std::unique_ptr<camera::RgbdCamera> published_camera_;  // with remote_: the camera, its frames published
 };
 
 }  // namespace

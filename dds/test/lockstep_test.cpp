@@ -11,7 +11,10 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cmath>
+#include <cstring>
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <thread>
@@ -444,6 +447,54 @@ TEST(Lockstep, JointStatesAndTheWrenchAreRos2sOnTheWire) {
         EXPECT_EQ(stamped.wrench.torque.z, -0.125);
       });
   EXPECT_TRUE(got_wrench);
+}
+
+TEST(Lockstep, CameraImagesAreRos2sOnTheWire) {
+  const RemoteConfig config = lockstepConfig("images");
+  const auto client = RemoteClient::create(config);
+  ImageSample color;
+  color.stamp = TimePoint(milliseconds(3040));
+  color.frame_id = "camera_optical_frame";
+  color.width = 2;
+  color.height = 1;
+  color.encoding = "rgb8";
+  color.step = 6;
+  color.data = {255, 0, 0, 10, 20, 30};
+  ImageSample depth = color;
+  depth.encoding = "32FC1";
+  depth.step = 8;
+  const float metres[2] = {0.75F, std::numeric_limits<float>::quiet_NaN()};
+  depth.data.resize(sizeof(metres));
+  std::memcpy(depth.data.data(), metres, sizeof(metres));
+  const auto got_color = readAsRos2<sensor_msgs_msg_dds__Image_>(
+      config, &sensor_msgs_msg_dds__Image__desc, "rt/camera/color/image_raw", "sensor_msgs::msg::dds_::Image_",
+      [&] { client->publishImages(color, depth); },
+      [](const sensor_msgs_msg_dds__Image_& image) {
+        EXPECT_EQ(image.header.stamp.sec, 3);
+        EXPECT_EQ(image.header.stamp.nanosec, 40'000'000U);
+        EXPECT_STREQ(image.header.frame_id, "camera_optical_frame");
+        EXPECT_EQ(image.width, 2U);
+        EXPECT_EQ(image.height, 1U);
+        EXPECT_STREQ(image.encoding, "rgb8");
+        EXPECT_EQ(image.step, 6U);
+        ASSERT_EQ(image.data._length, 6U);
+        EXPECT_EQ(image.data._buffer[3], 10);
+        EXPECT_EQ(image.data._buffer[5], 30);
+      });
+  EXPECT_TRUE(got_color);
+  const auto got_depth = readAsRos2<sensor_msgs_msg_dds__Image_>(
+      config, &sensor_msgs_msg_dds__Image__desc, "rt/camera/depth/image_raw", "sensor_msgs::msg::dds_::Image_",
+      [&] { client->publishImages(color, depth); },
+      [](const sensor_msgs_msg_dds__Image_& image) {
+        EXPECT_STREQ(image.encoding, "32FC1");
+        EXPECT_EQ(image.is_bigendian, 0);
+        ASSERT_EQ(image.data._length, 8U);
+        float read[2] = {};
+        std::memcpy(read, image.data._buffer, sizeof(read));
+        EXPECT_EQ(read[0], 0.75F);
+        EXPECT_TRUE(std::isnan(read[1]));
+      });
+  EXPECT_TRUE(got_depth);
 }
 
 }  // namespace
