@@ -82,6 +82,39 @@ class RemoteGripperDriver final : public gripper::GripperDriver {
   double stroke_;
 };
 
+/// A 3-finger adaptive gripper's fingers and scissor axis in the executor's simulator.
+class RemoteAdaptiveGripperDriver final : public gripper::AdaptiveGripperDriver {
+ public:
+  explicit RemoteAdaptiveGripperDriver(dds::SimulatorLink& link) : link_(link) {}
+  gripper::AdaptiveGripperReading read() const override {
+    const nlohmann::json json = link_.call("adaptive_gripper", "read", nlohmann::json::object()).result;
+    gripper::AdaptiveGripperReading reading;
+    for (std::size_t i = 0; i < reading.fingers.size(); ++i) {
+      const nlohmann::json& finger = json.at("fingers").at(i);
+      reading.fingers[i] = {finger.at("position").get<double>(), finger.at("speed").get<double>(),
+                            finger.at("force").get<double>(), finger.at("contact").get<bool>()};
+    }
+    const std::string mode = json.at("mode").get<std::string>();
+    const std::optional<gripper::GripperMode> known = gripper::modeFromString(mode);
+    if (!known) {
+      throw std::runtime_error("adaptive_gripper read: unknown mode '" + mode + "'");
+    }
+    reading.mode = *known;
+    reading.mode_reached = json.at("mode_reached").get<bool>();
+    reading.stamp = timePoint(json.at("stamp_ns"));
+    return reading;
+  }
+  void commandFingers(const std::array<double, gripper::kFingerCount>& positions, double speed, double force) override {
+    link_.call("adaptive_gripper", "command_fingers", {{"positions", positions}, {"speed", speed}, {"force", force}});
+  }
+  void commandMode(gripper::GripperMode mode) override {
+    link_.call("adaptive_gripper", "command_mode", {{"mode", gripper::toString(mode)}});
+  }
+
+ private:
+  dds::SimulatorLink& link_;
+};
+
 /// The executor's simulated camera; each frame carries the pose the executor's calibration
 /// gives the camera.
 class RemoteCamera final : public camera::RgbdCamera {
@@ -201,15 +234,48 @@ const std::vector<std::string>& remotableSimComponents() {
 }
 
 const std::vector<dds::DriverReading>& simDriverReadings() {
-  static const std::vector<dds::DriverReading> kReadings = {
-      {"gripper", "read"}, {"gripper", "max_opening"}, {"camera", "info"}, {"camera", "stream_status"}};
+  static const std::vector<dds::DriverReading> kReadings = {{"gripper", "read"},
+                                                            {"gripper", "max_opening"},
+                                                            {"adaptive_gripper", "read"},
+                                                            {"camera", "info"},
+                                                            {"camera", "stream_status"}};
   return kReadings;
 }
 
-dds::DriverServer simDriverServer(gripper::GripperDriver* gripper, camera::RgbdCamera& camera,
-                                  std::function<world::Pose()> camera_pose) {
-  return [gripper, &camera, camera_pose = std::move(camera_pose)](const std::string& driver, const std::string& method,
-                                                                  const nlohmann::json& args) -> dds::DriverReply {
+dds::DriverServer simDriverServer(gripper::GripperDriver* gripper, gripper::AdaptiveGripperDriver* adaptive,
+                                  camera::RgbdCamera& camera, std::function<world::Pose()> camera_pose) {
+  return [gripper, adaptive, &camera, camera_pose = std::move(camera_pose)](
+             const std::string& driver, const std::string& method, const nlohmann::json& args) -> dds::DriverReply {
+    if (driver == "adaptive_gripper" && adaptive != nullptr) {
+      if (method == "read") {
+        const gripper::AdaptiveGripperReading reading = adaptive->read();
+        nlohmann::json fingers = nlohmann::json::array();
+        for (const gripper::AdaptiveFingerReading& finger : reading.fingers) {
+          fingers.push_back({{"position", finger.position},
+                             {"speed", finger.speed},
+                             {"force", finger.force},
+                             {"contact", finger.contact}});
+        }
+        return {{{"fingers", fingers},
+                 {"mode", gripper::toString(reading.mode)},
+                 {"mode_reached", reading.mode_reached},
+                 {"stamp_ns", nanoseconds(reading.stamp)}}};
+      }
+      if (method == "command_fingers") {
+        adaptive->commandFingers(args.at("positions").get<std::array<double, gripper::kFingerCount>>(),
+                                 args.at("speed").get<double>(), args.at("force").get<double>());
+        return {nlohmann::json::object()};
+      }
+      if (method == "command_mode") {
+        const std::string mode = args.at("mode").get<std::string>();
+        const std::optional<gripper::GripperMode> known = gripper::modeFromString(mode);
+        if (!known) {
+          throw std::invalid_argument("adaptive_gripper command_mode: unknown mode '" + mode + "'");
+        }
+        adaptive->commandMode(*known);
+        return {nlohmann::json::object()};
+      }
+    }
     if (driver == "gripper" && gripper != nullptr) {
       if (method == "read") {
         const gripper::FingerReading reading = gripper->read();
@@ -263,6 +329,7 @@ struct RemoteSimComponents::State {
   std::vector<std::string> names;
   const GripperModel* gripper_model = nullptr;
   std::optional<RemoteGripperDriver> gripper;
+  std::optional<RemoteAdaptiveGripperDriver> adaptive;
   RemoteCamera camera;
   perception::PerceptionConfig perception_config;
   std::shared_ptr<perception::Pipeline> pipeline;
@@ -282,14 +349,14 @@ RemoteSimComponents::RemoteSimComponents(const std::string& cell_name, const std
     if (name == "gripper") {
       state_->gripper_model = &gripperModel(cell.gripper);
       if (!state_->gripper_model->adaptive.empty()) {
-        throw std::invalid_argument("the gripper of " + cell_name + " ('" + cell.gripper +
-                                    "') cannot run in a host yet: only a 2-finger gripper can");
+        state_->adaptive.emplace(link);
+      } else {
+        const std::optional<double> stroke = state_->gripper_model->geometry->stroke();
+        if (!stroke) {
+          throw std::invalid_argument("the gripper of " + cell_name + " ('" + cell.gripper + "') has no stroke");
+        }
+        state_->gripper.emplace(link, *stroke);
       }
-      const std::optional<double> stroke = state_->gripper_model->geometry->stroke();
-      if (!stroke) {
-        throw std::invalid_argument("the gripper of " + cell_name + " ('" + cell.gripper + "') has no stroke");
-      }
-      state_->gripper.emplace(link, *stroke);
     }
     if (name == "perception") {
       perception::PerceptionConfig& config = state_->perception_config;
@@ -311,7 +378,10 @@ std::vector<std::shared_ptr<component::Component>> RemoteSimComponents::make() {
   std::vector<std::shared_ptr<component::Component>> made;
   for (const std::string& name : state.names) {
     if (name == "gripper") {
-      made.push_back(state.gripper_model->make_component({.parallel = &*state.gripper}, state.link.clock()));
+      GripperDrivers drivers;
+      drivers.parallel = state.gripper ? &*state.gripper : nullptr;
+      drivers.adaptive = state.adaptive ? &*state.adaptive : nullptr;
+      made.push_back(state.gripper_model->make_component(drivers, state.link.clock()));
     } else {
       made.push_back(std::make_shared<perception::PerceptionComponent>(state.camera, state.link.clock(), state.pipeline,
                                                                        state.perception_config));

@@ -372,10 +372,6 @@ class SimWorkcell final : public Workcell {
     // fault-injected) component the registry holds.
     std::shared_ptr<component::Component> gripper;
     if (served("gripper")) {
-      if (gripper_drivers.parallel == nullptr) {
-        throw std::invalid_argument("the gripper of " + cell_.name + " ('" + cell_.gripper +
-                                    "') cannot run in a host: only a 2-finger gripper can");
-      }
       gripper = remote_->connect("gripper", kHostWait);
     } else {
       gripper = gripper_model_.make_component(gripper_drivers, clock());
@@ -393,7 +389,7 @@ class SimWorkcell final : public Workcell {
       // Readings are answered ahead with the calls that ask them (dds::DriverReading), except
       // under an injected fault: a faulty driver's reading records when the fault took effect.
       remote_->setDriverServer(
-          simDriverServer(gripper_drivers.parallel, camera,
+          simDriverServer(gripper_drivers.parallel, gripper_drivers.adaptive, camera,
                           [calibration = calibration_.get()] { return calibration->cameraPose(); }),
           faults_ ? std::vector<dds::DriverReading>{} : simDriverReadings());
     }

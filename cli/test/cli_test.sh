@@ -105,6 +105,21 @@ check "remote sim: -j 2"        2 'a host serves one run at a time' \
   -- "$costar" trials examples/ur5/pick_up_node.xml --judge lift -n 2 --seed 41 -j 2 --remote "$tmp/sim_remote.json"
 kill "$sim_host_pid"; wait "$sim_host_pid"
 check "remote sim: host ended"  0 'serving gripper perception of ur5-sim in lockstep' -- cat "$tmp/sim_host.log"
+# The 3-finger adaptive gripper in a host (its fingers and modes through the executor's simulator).
+printf '{"domain": 71, "partition": "%s-3f", "components": ["gripper"]}' "$partition" >"$tmp/sim_remote_3f.json"
+"$costar" host gripper -w iiwa-3f-sim --domain 71 --partition "$partition-3f" 2>"$tmp/sim_host_3f.log" &
+sim_host_pid=$!
+trial_args=(trials examples/ur5/pick_up_node.xml -w iiwa-3f-sim --judge lift -n 1 --seed 41 -j 1)
+check "remote 3f: one process" 0 '^1 of 1 trials succeeded' -- "$costar" "${trial_args[@]}" --json "$tmp/local_3f.json"
+check "remote 3f: trials"      0 '^1 of 1 trials succeeded' -- "$costar" "${trial_args[@]}" --remote "$tmp/sim_remote_3f.json" \
+  --json "$tmp/remote_3f.json"
+check "remote 3f: the same"    0 '^same: 1 trials$' -- python3 -c '
+import json, sys
+def trials(file):
+    return [(t["seed"], t["success"], t["cycle_time_s"], t["judged"]) for t in json.load(open(file))["results"]]
+a, b = trials(sys.argv[1]), trials(sys.argv[2])
+print(f"same: {len(a)} trials" if a == b and a else f"differ: {a} vs {b}")' "$tmp/local_3f.json" "$tmp/remote_3f.json"
+kill "$sim_host_pid"; wait "$sim_host_pid"
 check "help"                0 'Exit code: 0 SUCCESS' -- "$costar" run --help
 check "time limit"          1 'exceeded its time limit' -- "$costar" run examples/test_workcell/demo.xml -w test --time-limit 0.1
 check "inject: bad spec"    2 "fault 'melt:arm@t=1': unknown kind 'melt'" \
