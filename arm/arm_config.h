@@ -21,6 +21,12 @@ struct ArmConfig {
   world::Pose base_in_world = world::Pose::Identity();
   /// The tool centre point in the flange frame (between the gripper's finger pads).
   world::Pose tcp_in_flange = world::Pose::Identity();
+  /// The gripper's own links in the collision model: the flange link its body is mounted on (the
+  /// robot description's tool.name) and the gripper's links (its description's fingers), not the
+  /// arm's wrist that carries them. Free-drive brings them as near a part or the table as the
+  /// tool's stopping distance and the hand's push need, where the arm's links keep the whole
+  /// look-ahead (arm/free_drive.h). Empty: every link keeps the whole look-ahead.
+  std::vector<std::string> gripper_links;
   /// The joints' names (in arm_joints and joint waypoints) and labels for people ("wrist 3"),
   /// base first; empty: "joint_1", "joint_2"... and no labels.
   std::vector<std::string> joint_names;

@@ -178,6 +178,16 @@ Twist admittance(const Wrench& hand, const Twist& before, double dt, const Guidi
   return twist;
 }
 
+Eigen::Vector3d gripperLookAhead(const Eigen::Vector3d& velocity, const Eigen::Vector3d& hand_force,
+                                 const AdmittanceGains& gains) {
+  const double speed = velocity.norm();
+  Eigen::Vector3d ahead = hand_force / gains.stiffness;
+  if (speed > 0.0) {
+    ahead += velocity / speed * (speed * speed / (2.0 * gains.acceleration) + gains.clearance);
+  }
+  return ahead.norm() > gains.look_ahead ? Eigen::Vector3d(ahead.normalized() * gains.look_ahead) : ahead;
+}
+
 world::Pose advance(const world::Pose& pose, const Twist& twist, double dt) {
   world::Pose moved = pose;
   moved.translation() += twist.velocity * dt;
@@ -215,7 +225,8 @@ std::string ProtectiveStop::check(double tool_speed, double tracking, double tur
 }
 
 FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joints, const Twist& twist, double dt,
-                            const JointVector& max_joint_step, const AdmittanceGains& gains, const StepChecks& check) {
+                            const JointVector& max_joint_step, const AdmittanceGains& gains, const StepChecks& check,
+                            const Eigen::Vector3d& hand_force) {
   FreeDriveStep held{reference, joints, Twist{}, {}};
   const bool moving = twist.velocity.norm() > 0.0;
   const bool turning = twist.angular_velocity.norm() > 0.0;
@@ -231,11 +242,14 @@ FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joi
     tries.push_back(translation_only);
     tries.push_back(rotation_only);
   }
-  // Against a wall the hand slides along it: the translation less one world axis's part.
+  // Against a wall the hand slides along it: the translation less one world axis's part, where
+  // the push along the wall is beyond the dead band (the wall takes the rest).
   for (int axis = 0; moving && axis < 3; ++axis) {
     Twist slide = translation_only;
     slide.velocity[axis] = 0.0;
-    if (slide.velocity.norm() > 0.0 && slide.velocity != twist.velocity) {
+    Eigen::Vector3d along_wall = hand_force;
+    along_wall[axis] = 0.0;
+    if (slide.velocity.norm() > 0.0 && slide.velocity != twist.velocity && along_wall.norm() > gains.dead_band) {
       tries.push_back(slide);
     }
   }
@@ -296,16 +310,29 @@ FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joi
         refuse("a link would move faster than " + formatNumber("%.2f m/s", gains.max_point_speed));
         continue;
       }
-      // The stopping distance ahead must be clear too, for the tool and for every link.
-      Twist ahead;
-      if (attempt.velocity.norm() > 0.0) {
-        ahead.velocity = attempt.velocity.normalized() * gains.look_ahead;
-      }
+      // What lies ahead must be clear too. The gripper (every link, in check.sweep): where the
+      // reference stops from its speed with the clearance, the tool pushed on by the hand's give.
+      // The arm's other links (check.sweep_arm): the whole look-ahead along the motion, and the
+      // fastest point carried as far (an elbow moving faster than the tool looks as far ahead as
+      // it moves).
+      const auto sweep_arm = check.sweep_arm ? check.sweep_arm : check.sweep;
+      Twist turn_ahead;
       if (attempt.angular_velocity.norm() > 0.0) {
-        ahead.angular_velocity = attempt.angular_velocity.normalized() * (gains.look_ahead / kMetresPerRadian);
+        turn_ahead.angular_velocity = attempt.angular_velocity.normalized() * (gains.look_ahead / kMetresPerRadian);
       }
-      const std::optional<JointVector> tool_ahead = check.reach(advance(next, ahead, 1.0), *q, why);
-      if (!tool_ahead || !check.sweep(*q, *tool_ahead, why)) {
+      Twist near = turn_ahead;
+      near.velocity = gripperLookAhead(attempt.velocity, hand_force, gains);
+      const std::optional<JointVector> gripper_ahead = check.reach(advance(next, near, 1.0), *q, why);
+      if (!gripper_ahead || !check.sweep(*q, *gripper_ahead, why)) {
+        refuse(why);
+        break;
+      }
+      Twist far = turn_ahead;
+      if (attempt.velocity.norm() > 0.0) {
+        far.velocity = attempt.velocity.normalized() * gains.look_ahead;
+      }
+      const std::optional<JointVector> tool_ahead = check.reach(advance(next, far, 1.0), *q, why);
+      if (!tool_ahead || !sweep_arm(*q, *tool_ahead, why)) {
         refuse(why);
         break;
       }
@@ -314,7 +341,7 @@ FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joi
         for (int j = 0; j < joints.size(); ++j) {
           links_ahead[j] += ((*q)[j] - joints[j]) * gains.look_ahead / moved;
         }
-        if (!check.sweep(*q, links_ahead, why)) {
+        if (!sweep_arm(*q, links_ahead, why)) {
           refuse(why);
           break;
         }

@@ -52,9 +52,22 @@ struct AdmittanceGains {
   double max_speed = 0.15;            // m/s of the reference: the tool stays within 0.25 m/s
   double max_rotation_speed = 0.6;    // rad/s
   double acceleration = 1.5;          // m/s^2 (and rad/s^2 x 4) of the reference
-  /// How far ahead along the motion (m) the configuration must be free too: the tool stops this
-  /// far before a contact at most (the collision world pads the arm by another centimetre).
+  /// How far ahead along the motion (m) the arm's links must be free too: the tool stops this far
+  /// before a contact of the arm's links at most (the collision world pads the arm besides: 5 mm
+  /// in the simulated cells). The gripper's links look less far ahead: the distance the
+  /// reference needs to stop from its speed (speed^2 / 2 acceleration) and `clearance` along the
+  /// motion, plus how far the hand's push moves the tool past the reference (push / stiffness),
+  /// within look_ahead (gripperLookAhead()). The whole 4 cm for the gripper too kept its body
+  /// 4.5 cm above a part it was guided down onto, and a grasp taught there 3.2 cm higher than
+  /// one that holds the part.
   double look_ahead = 0.04;
+  /// How stiffly the controller holds the tool to the reference (N/m): a hand that pushes on past
+  /// a wall moves the tool push / stiffness beyond the reference (the joints' hold makes it
+  /// stiffer still: 40 N moved the UR5's tool 7.5 mm).
+  double stiffness = 4000.0;
+  double rotational_stiffness = 200.0;  // N m/rad
+  /// Kept beyond the stopping distance and the push's give (m).
+  double clearance = 0.002;
   /// m/s any point of the arm (an elbow swinging, not only the tool) moves at most: the tool
   /// stays within 0.25 m/s with the controller's lag, and so does every link.
   double max_point_speed = 0.2;
@@ -97,6 +110,11 @@ struct Twist {
 };
 Twist admittance(const Wrench& hand, const Twist& before, double dt, const GuidingMode& mode,
                  const Eigen::Matrix3d& tool_rotation, const AdmittanceGains& gains);
+
+/// How far ahead of a step moving at `velocity` (m/s, world) the gripper must be free, with the
+/// hand pushing `hand_force` (N, world): AdmittanceGains::look_ahead.
+Eigen::Vector3d gripperLookAhead(const Eigen::Vector3d& velocity, const Eigen::Vector3d& hand_force,
+                                 const AdmittanceGains& gains);
 
 /// The pose a twist moves `pose` to in `dt`.
 world::Pose advance(const world::Pose& pose, const Twist& twist, double dt);
@@ -142,6 +160,9 @@ struct StepChecks {
   /// collisions (each link, the gripper and the tool against the table, the known parts and the
   /// arm itself), else false with the contact in `why`.
   std::function<bool(const JointVector& from, const JointVector& to, std::string& why)> sweep;
+  /// The same for the arm's links other than the gripper's (the gripper's may touch anything in
+  /// it: they look less far ahead, in `sweep`); empty: `sweep`.
+  std::function<bool(const JointVector& from, const JointVector& to, std::string& why)> sweep_arm;
   /// How far (m) the point of the arm that moves most (a link's, not only the tool's) moves from
   /// `from` to `to`.
   std::function<double(const JointVector& from, const JointVector& to)> displacement;
@@ -157,16 +178,20 @@ struct FreeDriveStep {
   std::string blocked;
 };
 
-/// The step the reference takes from (`reference`, `joints`) with `twist` over `dt`: the whole
-/// twist when the joints there turn within `max_joint_step`, no point of the arm moves faster
-/// than `gains.max_point_speed`, and the arm's sweep from there to the look-ahead is free: to
-/// where the tool is `look_ahead` further along its motion (0.4 rad along a turn), and to where
-/// the joints' motion carries the arm's fastest point `look_ahead` further (an elbow moving
-/// faster than the tool looks as far ahead as it moves); otherwise its translation alone, or its
-/// rotation alone, or the translation less its part along one world axis (sliding along a
-/// wall), or none (the reference holds and the twist is zero). A step too fast is slowed, and so is
-/// one toward a singularity (`gains.singular_slow`, `singular_floor`).
+/// The step the reference takes from (`reference`, `joints`) with `twist` over `dt`, the hand
+/// pushing the tool with `hand_force` (world, N): the whole twist when the joints there turn
+/// within `max_joint_step`, no point of the arm moves faster than `gains.max_point_speed`, and
+/// the arm's sweep from there to the look-ahead is free: the gripper's to gripperLookAhead()
+/// (0.4 rad along a turn), the other links' to where the tool is `look_ahead` further along its
+/// motion and to where the joints' motion carries the arm's fastest point `look_ahead` further
+/// (an elbow moving faster than the tool looks as far ahead as it moves); otherwise its
+/// translation alone, or
+/// its rotation alone, or the translation less its part along one world axis (sliding along a wall, where the hand's
+/// push less its part along that axis is beyond the dead band: a hand pushing into a wall a degree aslant does not
+/// creep along it), or none (the reference holds and the twist is zero). A step too fast is slowed, and so is one
+/// toward a singularity (`gains.singular_slow`, `singular_floor`).
 FreeDriveStep stepReference(const world::Pose& reference, const JointVector& joints, const Twist& twist, double dt,
-                            const JointVector& max_joint_step, const AdmittanceGains& gains, const StepChecks& check);
+                            const JointVector& max_joint_step, const AdmittanceGains& gains, const StepChecks& check,
+                            const Eigen::Vector3d& hand_force);
 
 }  // namespace costar::arm

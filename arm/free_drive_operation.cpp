@@ -19,10 +19,6 @@ using component::ValueType;
 
 namespace {
 
-/// The stiffness the controller holds the tool to the reference with: stiff enough that a hand's
-/// 40 N moves it 1 cm from the reference at most (the collision world's padding), compliant.
-constexpr double kStiffness = 4000.0;           // N/m
-constexpr double kRotationalStiffness = 200.0;  // N m/rad
 /// How stiffly every joint is held to the configuration checked for collisions (N m/rad).
 constexpr double kJointStiffness = 100.0;
 /// Above this (N) on the wrist, whatever pushes, free-drive stops.
@@ -223,6 +219,17 @@ std::unique_ptr<component::RunningOperation> ArmComponent::freeDrive(const compo
     }
     return true;
   };
+  // The arm's links but the gripper's keep the whole look-ahead: the gripper's may touch anything
+  // in that sweep (its own, shorter, is check.sweep's).
+  check.sweep_arm = [this](const JointVector& from, const JointVector& to, std::string& why) {
+    QueryScene scene(AllowedContacts::between(config_.gripper_links, planner_->obstacleNames()));
+    scene.workspace = false;  // the tool's own look-ahead (check.sweep) keeps it in the workspace
+    if (const auto contact = planner_->collisionAlong(from, to, scene)) {
+      why = contact->str();
+      return false;
+    }
+    return true;
+  };
   check.displacement = [this](const JointVector& from, const JointVector& to) {
     return planner_->largestDisplacement(from, to);
   };
@@ -318,12 +325,19 @@ std::unique_ptr<component::RunningOperation> ArmComponent::freeDrive(const compo
       for (int j = 0; j < max_step.size(); ++j) {
         max_step[j] *= run->gains.joint_speed_fraction * dt;
       }
-      step = stepReference(run->reference, run->joints, wanted, dt, max_step, run->gains, check);
+      // The gripper's short look-ahead keeps besides how far the arm truly is from the configuration
+      // its steps were checked at (its links' largest displacement), beyond the push's give it
+      // counts already: the joints' give under the hand, up to 1 cm of the gripper's body on the
+      // UR5 turned sideways, which touched a node with the clearance alone.
+      AdmittanceGains gains = run->gains;
+      gains.clearance += std::max(
+          0.0, planner_->largestDisplacement(state.position, run->joints) - hand.force.norm() / gains.stiffness);
+      step = stepReference(run->reference, run->joints, wanted, dt, max_step, gains, check, hand.force);
     }
     CartesianMotion motion;
     motion.path = std::make_shared<CartesianPath>(CartesianPath::through({run->reference}, {}));
-    motion.impedance.stiffness = Eigen::Vector3d::Constant(kStiffness);
-    motion.impedance.rotational_stiffness = Eigen::Vector3d::Constant(kRotationalStiffness);
+    motion.impedance.stiffness = Eigen::Vector3d::Constant(run->gains.stiffness);
+    motion.impedance.rotational_stiffness = Eigen::Vector3d::Constant(run->gains.rotational_stiffness);
     motion.impedance.damping_ratio = 1.0;
     motion.force_limit = kForceLimit;
     // The checked joints held, not only the tool: near a singularity the tool's impedance alone

@@ -108,6 +108,8 @@ std::optional<planning::Contact> MotionPlanner::collisionAlong(const JointVector
   return collisions_.checkSegment(from.eigen(), to.eigen(), scene);
 }
 
+std::vector<std::string> MotionPlanner::obstacleNames() const { return collisions_.obstacleNames(); }
+
 double MotionPlanner::largestDisplacement(const JointVector& from, const JointVector& to) const {
   const planning::RobotModel& robot = collisions_.robot();
   std::vector<world::Pose> before;

@@ -48,6 +48,8 @@ class MotionPlanner final : public MotionService {
   /// at the collision world's resolution), or nullopt.
   std::optional<planning::Contact> collisionAlong(const JointVector& from, const JointVector& to,
                                                   const QueryScene& scene = {}) const;
+  /// The obstacles of the collision world now (the table, the known parts).
+  std::vector<std::string> obstacleNames() const;
   /// How far (m) the point of the arm's collision shapes (links, gripper, tool) that moves most
   /// moves from `from` to `to`: each shape's centre's displacement plus its turn times its reach.
   double largestDisplacement(const JointVector& from, const JointVector& to) const;

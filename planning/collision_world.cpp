@@ -143,6 +143,7 @@ struct CollisionWorld::Query::State {
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> own_obstacles;
   std::vector<std::pair<std::string_view, const fcl::CollisionObjectd*>> obstacles;  // in name order
   AllowedContacts allowed;
+  bool workspace = true;
   std::vector<world::Pose> poses;
 };
 
@@ -231,6 +232,7 @@ CollisionWorld::Query CollisionWorld::query(const QueryScene& scene) const {
   auto state = std::make_unique<Query::State>();
   state->world = this;
   state->allowed = scene.allowed;
+  state->workspace = scene.workspace;
   state->links.reserve(impl_->links.size());
   for (const LinkObjects& link : impl_->links) {
     state->links.push_back(link.copy());
@@ -271,7 +273,8 @@ CollisionWorld::Query::Query(Query&&) noexcept = default;
 std::optional<Contact> CollisionWorld::Query::check(const Eigen::VectorXd& q) {
   const CollisionWorld& world = *state_->world;
   world.checks_.fetch_add(1, std::memory_order_relaxed);
-  if (world.workspace_ && !world.workspace_->contains((world.impl_->base * world.robot_.forward(q)).translation())) {
+  if (state_->workspace && world.workspace_ &&
+      !world.workspace_->contains((world.impl_->base * world.robot_.forward(q)).translation())) {
     return Contact{"tcp", "the workspace boundary"};
   }
   place(world.robot_, world.impl_->base, q, state_->links, state_->poses);

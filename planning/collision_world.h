@@ -75,6 +75,9 @@ struct QueryScene {
   /// Obstacles of the world this query leaves out (the part held); names the world does not
   /// have are ignored.
   std::vector<std::string> removed;
+  /// Whether the tool centre point is kept in the world's workspace (setWorkspace); false: a
+  /// query about the links alone (free-drive's look-ahead of the arm's links past the tool).
+  bool workspace = true;
 };
 
 struct CollisionOptions {

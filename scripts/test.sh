@@ -106,6 +106,8 @@ if [[ "${EDITOR_E2E:-1}" != "0" ]]; then
   for e2e in assemble_by_clicks paper_tasks control_panel cells polishing_by_clicks wire_bending_by_clicks teach_by_demonstration collaborative_assembly; do
     node "web/e2e/$e2e.mjs" --costar "$BUILD_DIR/cli/costar" --artifacts "$BUILD_DIR/test-artifacts"
   done
+  # Teaching on the 3-finger gripper's cell too (its grasps, its modes).
+  node web/e2e/teach_by_demonstration.mjs --costar "$BUILD_DIR/cli/costar" --artifacts "$BUILD_DIR/test-artifacts/iiwa-3f-sim" --cell iiwa-3f-sim
 fi
 echo
 echo "test: all passed in $(( $(date +%s) - start )) s"

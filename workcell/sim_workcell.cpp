@@ -356,6 +356,13 @@ class SimWorkcell final : public Workcell {
     arm_config.base_in_world = cell_.robot_base;
     arm_config.home = robot_description_.home;
     arm_config.tcp_in_flange = gripper_model_.tcp_in_flange;
+    // The gripper's body is mounted on the flange link (planning::mountUrdf); its fingers are its
+    // own links. The description's gripper_links add the wrist (SmartMove lets them touch the part
+    // grasped), which free-drive must keep a whole look-ahead off the table.
+    arm_config.gripper_links = {robot_description_.urdf_tool_link};
+    for (const std::string& link : gripper_model_.links) {
+      arm_config.gripper_links.push_back(link);
+    }
     arm_config.joint_names = robot_description_.joint_names;
     arm_config.joint_labels = robot_description_.joint_labels;
     const std::shared_ptr<const arm::Kinematics> kinematics = arm::makeKinematics(robot_description_);

@@ -136,6 +136,8 @@ TEST(FreeDrive, AStepTowardAWallStopsTheLookAheadShortOfItAndAnAslantPushSlidesA
     }
     return true;
   };
+  // The wall is the gripper's (a part under it): the arm's other links are clear of it.
+  check.sweep_arm = [](const JointVector&, const JointVector&, std::string&) { return true; };
   check.displacement = [](const JointVector& from, const JointVector& to) {
     return (to.eigen() - from.eigen()).norm();
   };
@@ -146,10 +148,11 @@ TEST(FreeDrive, AStepTowardAWallStopsTheLookAheadShortOfItAndAnAslantPushSlidesA
   const JointVector max_step = JointVector(3, 1.0);
   Twist down;
   down.velocity = Eigen::Vector3d(0.05, 0.0, -0.2);
+  const Eigen::Vector3d push(8.0, 0.0, -32.0);  // the hand pushes along the motion
   double lowest = 1.0;
   std::string blocked;
   for (int i = 0; i < 200; ++i) {
-    const FreeDriveStep step = stepReference(reference, joints, down, 0.01, max_step, gains, check);
+    const FreeDriveStep step = stepReference(reference, joints, down, 0.01, max_step, gains, check, push);
     reference = step.reference;
     joints = step.joints;
     lowest = std::min(lowest, reference.translation().z());
@@ -157,12 +160,77 @@ TEST(FreeDrive, AStepTowardAWallStopsTheLookAheadShortOfItAndAnAslantPushSlidesA
       blocked = step.blocked;
     }
   }
-  // It stops the look-ahead short of the wall (and a step), never at it.
-  EXPECT_GE(lowest, 0.1 + gains.look_ahead - 0.01);
-  EXPECT_LE(lowest, 0.1 + gains.look_ahead + 0.01);
+  // It stops the gripper's look-ahead short of the wall (and a step), never at it: the distance to
+  // stop from 0.21 m/s (14 mm) and the clearance (2 mm) along the motion, and the push's give (8 mm
+  // down): 23.7 mm above the wall, not the 4 cm the arm's other links keep.
+  const double ahead = -gripperLookAhead(down.velocity, push, gains).z();
+  EXPECT_NEAR(ahead, 0.0237, 0.0005);
+  EXPECT_GE(lowest, 0.1 + ahead);
+  EXPECT_LE(lowest, 0.1 + ahead + 0.003);
   EXPECT_EQ(blocked, "tool would touch table");
   // Pushed down and sideways, it slides along the wall at the sideways speed: 2 s at 0.05 m/s.
   EXPECT_NEAR(reference.translation().x(), 0.1, 1e-9);
+}
+
+TEST(FreeDrive, TheGrippersLookAheadIsTheDistanceToStopAndThePushsGiveNotAFixedFourCentimetres) {
+  // A fixed 4 cm kept a gripper guided down onto a part 3.2 cm above where it would grasp it.
+  const AdmittanceGains gains;
+  const Eigen::Vector3d none = Eigen::Vector3d::Zero();
+  EXPECT_EQ(gripperLookAhead(none, none, gains), none);
+  const Eigen::Vector3d down(0.0, 0.0, -0.15);
+  EXPECT_NEAR(gripperLookAhead(down, none, gains).z(), -(0.0075 + gains.clearance), 1e-12);  // 0.15^2 / (2 x 1.5)
+  // The push's give, wherever it pushes: 40 N down while the tool slides along x.
+  const Eigen::Vector3d slide =
+      gripperLookAhead(Eigen::Vector3d(0.05, 0.0, 0.0), Eigen::Vector3d(10.0, 0.0, -40.0), gains);
+  EXPECT_NEAR(slide.z(), -0.01, 1e-12);
+  EXPECT_NEAR(slide.x(), 0.0025 + 0.05 * 0.05 / 3.0 + gains.clearance, 1e-12);
+  EXPECT_NEAR(gripperLookAhead(Eigen::Vector3d(0.5, 0.0, 0.0), Eigen::Vector3d(150.0, 0.0, 0.0), gains).norm(),
+              gains.look_ahead, 1e-12);  // at most look_ahead
+}
+
+TEST(FreeDrive, AHandPushingIntoAWallAlmostSquarelyDoesNotCreepAlongIt) {
+  // The tool held back by a wall at z = 0.1 (the look-ahead above it), the hand pushing into it 1 degree aslant: the
+  // push along the wall (0.7 N) is within the dead band, so the reference holds; 10 degrees
+  // aslant (6.9 N) it slides.
+  AdmittanceGains gains;
+  StepChecks check;
+  check.reach = [](const world::Pose& pose, const JointVector&, std::string&) -> std::optional<JointVector> {
+    JointVector q = JointVector::zero(3);
+    for (int i = 0; i < 3; ++i) {
+      q[i] = pose.translation()[i];
+    }
+    return q;
+  };
+  check.sweep = [](const JointVector& from, const JointVector& to, std::string& why) {
+    if (std::min(from[2], to[2]) < 0.1) {
+      why = "fingers would touch part:node_1";
+      return false;
+    }
+    return true;
+  };
+  check.displacement = [](const JointVector& from, const JointVector& to) {
+    return (to.eigen() - from.eigen()).norm();
+  };
+  const auto slid = [&](double degrees) {
+    const double aslant = degrees * M_PI / 180.0;
+    const Eigen::Vector3d push = 40.0 * Eigen::Vector3d(std::sin(aslant), 0.0, -std::cos(aslant));
+    world::Pose reference = world::Pose::Identity();
+    reference.translation() = Eigen::Vector3d(0.0, 0.0, 0.1 + 40.0 / gains.stiffness + 0.001);
+    JointVector joints = JointVector::zero(3);
+    joints[2] = reference.translation().z();
+    Twist twist;
+    for (int i = 0; i < 100; ++i) {
+      twist = admittance({push, Eigen::Vector3d::Zero()}, twist, 0.01, GuidingMode::parse("translation", "", "world"),
+                         reference.linear(), gains);
+      const FreeDriveStep step = stepReference(reference, joints, twist, 0.01, JointVector(3, 1.0), gains, check, push);
+      reference = step.reference;
+      joints = step.joints;
+      twist = step.twist;
+    }
+    return reference.translation().x();
+  };
+  EXPECT_EQ(slid(1.0), 0.0);
+  EXPECT_GT(slid(10.0), 0.01);  // 0.026 m/s at most
 }
 
 TEST(FreeDrive, FastJointsNearASingularitySlowTheStep) {
@@ -177,8 +245,8 @@ TEST(FreeDrive, FastJointsNearASingularitySlowTheStep) {
   check.displacement = [](const JointVector& from, const JointVector& to) { return 0.1 * std::abs(to[0] - from[0]); };
   Twist twist;
   twist.velocity = Eigen::Vector3d(0.2, 0, 0);
-  const FreeDriveStep step =
-      stepReference(world::Pose::Identity(), JointVector::zero(1), twist, 0.01, JointVector(1, 0.01), gains, check);
+  const FreeDriveStep step = stepReference(world::Pose::Identity(), JointVector::zero(1), twist, 0.01,
+                                           JointVector(1, 0.01), gains, check, Eigen::Vector3d::Zero());
   EXPECT_LE(std::abs(step.joints[0]), 0.01);
   EXPECT_GT(step.twist.velocity.x(), 0.0);
   EXPECT_LT(step.twist.velocity.x(), 0.1);
@@ -198,8 +266,8 @@ TEST(FreeDrive, ALinkSwingingFasterThanTheToolSlowsTheStepToTheLinksSpeedLimit) 
   check.displacement = [](const JointVector& from, const JointVector& to) { return 5.0 * std::abs(to[0] - from[0]); };
   Twist twist;
   twist.velocity = Eigen::Vector3d(0.15, 0, 0);
-  const FreeDriveStep step =
-      stepReference(world::Pose::Identity(), JointVector::zero(1), twist, 0.01, JointVector(1, 1.0), gains, check);
+  const FreeDriveStep step = stepReference(world::Pose::Identity(), JointVector::zero(1), twist, 0.01,
+                                           JointVector(1, 1.0), gains, check, Eigen::Vector3d::Zero());
   EXPECT_GT(step.twist.velocity.x(), 0.0);
   EXPECT_LE(5.0 * step.twist.velocity.x(), gains.max_point_speed + 1e-12);
   EXPECT_EQ(step.blocked, "a link would move faster than 0.20 m/s");
@@ -233,8 +301,8 @@ TEST(FreeDrive, ALinkWhoseMotionAheadReachesAWallStopsTheStepThoughTheToolsLookA
   joints[1] = 0.02;
   Twist twist;
   twist.velocity = Eigen::Vector3d(0.05, 0, 0);
-  const FreeDriveStep step =
-      stepReference(world::Pose::Identity(), joints, twist, 0.01, JointVector(2, 1.0), gains, check);
+  const FreeDriveStep step = stepReference(world::Pose::Identity(), joints, twist, 0.01, JointVector(2, 1.0), gains,
+                                           check, Eigen::Vector3d(20.0, 0.0, 0.0));
   EXPECT_EQ(step.twist.velocity.norm(), 0.0);
   EXPECT_EQ(step.blocked, "forearm_link would touch table");
 }
@@ -312,7 +380,8 @@ WristPull pullThroughTheWrist(bool guard) {
                                          : Eigen::Vector3d::Zero();
     const Eigen::AngleAxisd turn(goal.linear() * reference.linear().transpose());
     twist.angular_velocity = turn.axis() * std::min(0.4, turn.angle() / 0.01);
-    const FreeDriveStep step = stepReference(reference, joints, twist, 0.01, max_step, gains, check);
+    const FreeDriveStep step =
+        stepReference(reference, joints, twist, 0.01, max_step, gains, check, Eigen::Vector3d::Zero());
     pull.fastest = std::max(pull.fastest, (step.reference.translation() - reference.translation()).norm() / 0.01);
     reference = step.reference;
     joints = step.joints;
@@ -359,7 +428,8 @@ TEST(FreeDrive, AStepAwayFromASingularityIsNotSlowed) {
   twist.velocity = (to.translation() - from.translation()).normalized() * 0.02;
   const Eigen::AngleAxisd turn(to.linear() * from.linear().transpose());
   twist.angular_velocity = turn.axis() * 0.02 * turn.angle() / (to.translation() - from.translation()).norm();
-  const FreeDriveStep step = stepReference(from, joints, twist, 0.01, JointVector(6, 0.0157), gains, check);
+  const FreeDriveStep step =
+      stepReference(from, joints, twist, 0.01, JointVector(6, 0.0157), gains, check, Eigen::Vector3d::Zero());
   EXPECT_EQ(step.blocked, "");
   EXPECT_GT(step.joints[4], joints[4]);
 }

@@ -315,6 +315,10 @@ TEST_F(Collisions, TheToolStaysInsideTheWorkspace) {
   const auto contact = world.check(kHome);  // home's tool is at x = 0.17
   ASSERT_TRUE(contact.has_value());
   EXPECT_EQ(contact->str(), "tcp would touch the workspace boundary");
+  // A query about the links alone (free-drive's look-ahead of the arm past the tool) leaves it out.
+  QueryScene links_only;
+  links_only.workspace = false;
+  EXPECT_FALSE(world.check(kHome, links_only).has_value());
 }
 
 TEST_F(Collisions, ThePlannerSaysWhyWhenTheGoalIsInCollision) {

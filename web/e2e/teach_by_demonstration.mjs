@@ -1,5 +1,5 @@
 // End-to-end test of teaching by demonstration in the editor (docs/TEACHING.md) on the UR5
-// (ur5-sim) at 1280x800: the tool guided by hand in the 3D view (its handle grabbed and dragged,
+// (ur5-sim; --cell another simulated cell: scripts/test.sh runs iiwa-3f-sim too) at 1280x800: the tool guided by hand in the 3D view (its handle grabbed and dragged,
 // the top view to bring it over a part, the side view to lower it), a waypoint taught above the
 // part relative to it, a grasp taught there, a short stroke recorded while guiding, and a plan
 // built from them by clicks (Move, SmartGrasp with the taught grasp, FollowTrajectory of the
@@ -9,11 +9,14 @@
 // and for the whole task (the stroke and the plan, its name and Run included).
 //
 //   node web/e2e/teach_by_demonstration.mjs [--costar build/cli/costar] [--artifacts build/test-artifacts]
+//                                           [--cell ur5-sim|iiwa-sim|iiwa-3f-sim|panda-sim]
 
 import fs from 'node:fs';
 import path from 'node:path';
-import { actionCounter, api, artifacts, costar, groundTruth, launchBrowser, makeLog, openPage, root, runScript, startServer, waitForRunEnd } from './lib.mjs';
+import { actionCounter, api, args, artifacts, costar, groundTruth, launchBrowser, makeLog, openPage, root, runScript, startServer, waitForRunEnd } from './lib.mjs';
 
+/** The simulated cell (workcells/NAME.json): the UR5's unless asked. */
+const CELL = args.cell ?? 'ur5-sim';
 const MAX_PICK_ACTIONS = 21;
 const MAX_ACTIONS = 35;
 const { log, check } = makeLog('teach');
@@ -31,7 +34,8 @@ async function main() {
   check(fs.existsSync(costar), `the costar executable exists (${costar})`);
   check(fs.existsSync(path.join(root, 'web/dist/index.html')), 'the page is built (web/dist)');
   // Real time: the page's pushes come every 50 ms of wall time, as a person's hand would.
-  server = await startServer({ workcell: 'ur5-sim', pace: 1 });
+  server = await startServer({ workcell: CELL, pace: 1 });
+  log(`the cell: ${CELL}`);
   const { url, open, token } = server;
   browser = await launchBrowser();
   const pageErrors = [];
