@@ -1,7 +1,8 @@
 // Overhead of a component in another process over DDS on loopback (dds/), against the same
 // component in this process, in the same run: an operation's round trip (start, then poll
 // until it ends), a cancel's round trip (cancel until the host confirms it stopped), one poll,
-// and how long a killed host takes to be noticed. Figures: docs/BENCHMARKS.md.
+// and how long a killed host takes to be noticed; in lockstep (a simulated cell's hosts), a
+// report's and an operation's calls. Figures: docs/BENCHMARKS.md.
 //   build/bench/dds_bench [ROUND_TRIPS=2000] [KILLS=5]
 
 #include <signal.h>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "dds/host.h"
+#include "dds/lockstep.h"
 #include "dds/remote_component.h"
 #include "testing/test_components.h"
 
@@ -43,12 +45,34 @@ int serveTestComponents(const std::string& partition) {
   return 0;
 }
 
+/// `dds_bench --lockstep-host PARTITION`: serves the test logger in lockstep with an executor's
+/// simulated clock (as a simulated cell's hosts do) until SIGTERM.
+int serveLockstep(const std::string& partition) {
+  std::signal(SIGTERM, onTerm);
+  costar::dds::RemoteConfig config;
+  config.partition = partition;
+  config.lockstep = true;
+  costar::dds::SimulatorLink link(config);
+  costar::dds::ComponentHost::Lockstep lockstep;
+  lockstep.new_run = [&](std::uint64_t executor) {
+    link.setExecutor(executor);
+    return std::vector<std::shared_ptr<Component>>{std::make_shared<costar::testing::TestLogger>()};
+  };
+  lockstep.reach_time = [&](std::int64_t stamp_ns) { link.reachTime(stamp_ns); };
+  lockstep.prepare = [&](const std::string& prepared_json) { link.prepare(prepared_json); };
+  lockstep.prepared_used = [&] { return link.preparedUsed(); };
+  costar::dds::ComponentHost host(config, {std::make_shared<costar::testing::TestLogger>()}, lockstep);
+  link.setHost(host.id());
+  host.serve(g_stop);
+  return 0;
+}
+
 /// This executable again, as a host in a child process (exec: the fork of a process that uses
-/// DDS cannot use DDS).
-pid_t startHost(const costar::dds::RemoteConfig& config) {
+/// DDS cannot use DDS); `flag` --host or --lockstep-host.
+pid_t startHost(const costar::dds::RemoteConfig& config, std::string flag = "--host") {
   const pid_t pid = ::fork();
   if (pid == 0) {
-    std::string self = "/proc/self/exe", flag = "--host", partition = config.partition;
+    std::string self = "/proc/self/exe", partition = config.partition;
     char* argv[] = {self.data(), flag.data(), partition.data(), nullptr};
     ::execv(argv[0], argv);
     ::_exit(127);
@@ -110,6 +134,9 @@ int main(int argc, char** argv) {
   if (argc == 3 && std::string(argv[1]) == "--host") {
     return serveTestComponents(argv[2]);
   }
+  if (argc == 3 && std::string(argv[1]) == "--lockstep-host") {
+    return serveLockstep(argv[2]);
+  }
   const int count = argc > 1 ? std::atoi(argv[1]) : 2000;
   const int kills = argc > 2 ? std::atoi(argv[2]) : 5;
   if (count < 10 || kills < 0) {
@@ -153,6 +180,43 @@ int main(int argc, char** argv) {
     remote_cancels.push_back(micros(Clock::now() - begin));
   }
   print("cancel round trip (cancel..host confirms)", stats(local_cancels), stats(remote_cancels));
+
+  // Lockstep (a simulated cell's hosts): each call answered at once at the executor's simulated
+  // time; a report at a new time is one call, an operation (start, then poll) two.
+  {
+    costar::dds::RemoteConfig lockstep_config;
+    lockstep_config.partition = config.partition + "-lockstep";
+    lockstep_config.lockstep = true;
+    const pid_t lockstep_host = startHost(lockstep_config, "--lockstep-host");
+    const auto lockstep_client = costar::dds::RemoteClient::create(lockstep_config);
+    const auto lockstep_logger = lockstep_client->connect("test_logger", std::chrono::seconds(20));
+    std::int64_t tick = 0;
+    const auto nextTick = [&] {
+      lockstep_client->publishClock(costar::TimePoint(std::chrono::milliseconds(10 * ++tick)));
+    };
+    const auto reports = [&](Component& component, int n) {
+      std::vector<double> samples;
+      for (int i = 0; i < n; ++i) {
+        nextTick();
+        const auto begin = Clock::now();
+        (void)component.report();
+        samples.push_back(micros(Clock::now() - begin));
+      }
+      return samples;
+    };
+    reports(*lockstep_logger, 100);  // warm up
+    print("lockstep: a report at a new simulated time", stats(reports(local_logger, count)),
+          stats(reports(*lockstep_logger, count)));
+    std::vector<double> local_operations, remote_operations;
+    for (int i = 0; i < count; ++i) {
+      nextTick();
+      local_operations.push_back(roundTrips(local_logger, "TestLog", log, 1).front());
+      remote_operations.push_back(roundTrips(*lockstep_logger, "TestLog", log, 1).front());
+    }
+    print("lockstep: an operation (start, poll)", stats(local_operations), stats(remote_operations));
+    ::kill(lockstep_host, SIGTERM);
+    ::waitpid(lockstep_host, nullptr, 0);
+  }
 
   // A host killed with SIGKILL in the middle of an operation: time until poll says FAILURE.
   std::vector<double> noticed;
