@@ -219,10 +219,13 @@ double ClassPoseEstimator::meanSupport(const std::vector<Detection>& detections)
 std::optional<Detection> ClassPoseEstimator::verify(const Cloud& cloud, const world::Pose& start, double raw_score,
                                                     const camera::RgbdFrame& frame, const std::vector<bool>& taken,
                                                     const std::vector<Detection>& accepted, int* checked) const {
+  std::vector<PlacedModel> placed;
+  placed.reserve(accepted.size());
+  for (const Detection& other : accepted) {
+    placed.push_back({&model_, other.pose_in_camera});
+  }
   const auto overlapsAccepted = [&](const world::Pose& pose) {
-    return std::any_of(accepted.begin(), accepted.end(), [&](const Detection& other) {
-      return overlapFraction(model_, pose, model_, other.pose_in_camera) > 0.2;
-    });
+    return overlapFraction(model_, pose, placed) > kOverlapTaken;
   };
   if (overlapsAccepted(start)) {
     return std::nullopt;  // explained already

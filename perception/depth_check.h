@@ -36,4 +36,16 @@ DepthAgreement compareWithDepth(const ObjectModel& model, const world::Pose& pos
 double overlapFraction(const ObjectModel& a, const world::Pose& pose_a, const ObjectModel& b, const world::Pose& pose_b,
                        double margin = 0.001);
 
+/// A model under a pose (object -> optical frame).
+struct PlacedModel {
+  const ObjectModel* model = nullptr;
+  world::Pose pose = world::Pose::Identity();
+};
+/// Fraction of `a`'s interior samples (under pose_a) that lie inside the boxes of any of
+/// `others` shrunk by `margin` (m): how much of a's volume they claim together (a box fitted into
+/// the gap between four touching nodes' tops lies a fifth or less in each of them, and almost
+/// wholly in them together).
+double overlapFraction(const ObjectModel& a, const world::Pose& pose_a, const std::vector<PlacedModel>& others,
+                       double margin = 0.001);
+
 }  // namespace costar::perception

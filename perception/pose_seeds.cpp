@@ -9,6 +9,10 @@ namespace costar::perception {
 
 namespace {
 
+/// An elongated object's points spread along its length over less than this fraction of it:
+/// part of it is hidden (restingStarts).
+constexpr double kPartlySeenLength = 0.8;
+
 /// The mean of `indices` of `cloud` (not empty).
 Eigen::Vector3d meanOf(const Cloud& cloud, const std::vector<int>& indices) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -133,7 +137,11 @@ RestingStarts restingStarts(const Cloud& cloud, const std::vector<int>& indices,
     const double from = *first;
     std::nth_element(along.begin(), last, along.end());
     const double to = *last;
-    if (to - from > 1.5 * span) {
+    // An elongated object seen over less than most of its length (one end hidden under a part
+    // lying across it or behind a node) has its middle nearer its hidden end than its points'
+    // mean: the ends' starts stand with the object's end at either extreme of the points too.
+    const bool elongated = span >= 1.5 * bounds.sizes().head<2>().minCoeff();
+    if (to - from > 1.5 * span || (elongated && to - from < kPartlySeenLength * span)) {
       ends = {onPlane(mean + (from + 0.5 * span) * axis), onPlane(mean + (to - 0.5 * span) * axis)};
     }
   }

@@ -41,8 +41,10 @@ std::vector<world::Pose> restingSeeds(const Cloud& points, const std::vector<int
 
 /// The same poses at both ends of the points instead of under their middle, when the points
 /// spread along their main horizontal axis over more than one and a half times the object's
-/// length (touching parts of a class, whose middle lies between them): half an object in from
-/// the points' extremes (2nd and 98th percentiles); 24 poses (48 raised), else none.
+/// length (touching parts of a class, whose middle lies between them), or, for an elongated
+/// object, over less than 0.8 of it (one end hidden: its middle lies nearer the hidden end than
+/// the points' mean): half an object in from the points' extremes (2nd and 98th percentiles);
+/// 24 poses (48 raised), else none.
 std::vector<world::Pose> restingSeedsAtEnds(const Cloud& points, const std::vector<int>& indices,
                                             const TablePlane& support, const world::ObjectClass& object_class);
 
