@@ -642,7 +642,9 @@ INSTANTIATE_TEST_SUITE_P(Assembly, FixedAssemblyTrial,
 // the set force (issue 30: the 25 mm link got 37.5 N of a 40 N close, kp x 12.5 mm): 32.86 s and
 // 33.19 s; then with the UR5's model generated from robots/ur5/ur5.json (issue 35: UR's published
 // link masses, 17.0 kg moving where the hand-written model's geoms gave 12.6; capsules in the planner's
-// URDF where it had covering cylinders): 32.85 s and 33.14 s.
+// URDF where it had covering cylinders): 32.85 s and 33.14 s; then with ICP on a subset of the
+// points while its gate shrinks (issue 33: the refined poses move by a fraction of a millimetre,
+// and the grasps follow): 32.83 s and 33.09 s.
 TEST(Trials, TheSameSeedsGiveTheSameAssemblyTrials) {
   TrialOptions options;
   options.plan = dataRoot() / "examples/ur5/assemble_structure.xml";
@@ -653,7 +655,7 @@ TEST(Trials, TheSameSeedsGiveTheSameAssemblyTrials) {
   options.jobs = 2;
   const Summary summary = runTrials(options);
   ASSERT_EQ(summary.trials.size(), 2u);
-  const double recorded[] = {32.85, 33.14};
+  const double recorded[] = {32.83, 33.09};
   for (std::size_t i = 0; i < 2; ++i) {
     const TrialResult& trial = summary.trials[i];
     EXPECT_TRUE(trial.success) << "seed " << trial.seed << ": " << trial.failure_path << ": " << trial.reason;
