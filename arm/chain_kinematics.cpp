@@ -79,7 +79,7 @@ ChainGeometry readChainGeometry(const std::filesystem::path& file) {
   nlohmann::json root;
   try {
     root = core::parseJson(readFile(file, "robot description"));
-  } catch (const nlohmann::json::parse_error& error) {
+  } catch (const core::JsonSyntaxError& error) {
     throw std::runtime_error(file.string() + ": not valid JSON: " + error.what());
   }
   const nlohmann::json& joints = root.contains("joints") ? root["joints"] : nlohmann::json();

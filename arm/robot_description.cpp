@@ -234,7 +234,7 @@ RobotDescription loadRobotDescription(const std::filesystem::path& file) {
     json parsed;
     try {
       parsed = core::parseJson(content);
-    } catch (const json::parse_error& e) {
+    } catch (const core::JsonSyntaxError& e) {
       throw std::runtime_error(std::string("not valid JSON: ") + e.what());
     }
     if (!parsed.is_object()) {

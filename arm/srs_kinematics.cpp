@@ -167,7 +167,7 @@ SrsArmDescription readSrsArmDescription(const std::filesystem::path& file) {
   nlohmann::json root;
   try {
     root = core::parseJson(text_of_file);
-  } catch (const nlohmann::json::parse_error& error) {
+  } catch (const core::JsonSyntaxError& error) {
     throw std::runtime_error(file.string() + ": not valid JSON: " + error.what());
   } catch (const std::runtime_error& error) {
     throw std::runtime_error(file.string() + ": " + error.what());

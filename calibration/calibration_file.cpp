@@ -119,7 +119,7 @@ std::optional<CellCalibration> loadCalibration(const std::filesystem::path& file
   nlohmann::json json;
   try {
     json = core::parseJson(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const core::JsonSyntaxError& e) {
     throw std::runtime_error("calibration '" + file.string() + "': not valid JSON: " + e.what());
   } catch (const std::exception& e) {
     throw std::runtime_error("calibration '" + file.string() + "': " + e.what());

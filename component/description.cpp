@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "core/json_file.h"
+
 namespace costar::component {
 
 namespace {
@@ -48,7 +50,7 @@ T field(const nlohmann::json& json, const char* key) {
   try {
     return json.at(key).get<T>();
   } catch (const nlohmann::json::exception& e) {
-    throw std::invalid_argument(std::string("field '") + key + "': " + e.what());
+    throw std::invalid_argument(std::string("field '") + key + "': " + core::jsonErrorText(e));
   }
 }
 

@@ -91,7 +91,27 @@ nlohmann::json parseJson(std::string_view text) {
     }
     return true;
   };
-  return nlohmann::json::parse(text.begin(), text.end(), check);
+  try {
+    return nlohmann::json::parse(text.begin(), text.end(), check);
+  } catch (const nlohmann::json::parse_error& error) {
+    std::string message = jsonErrorText(error);
+    constexpr std::string_view kPrefix = "parse error at ";
+    if (message.starts_with(kPrefix)) {
+      message.erase(0, kPrefix.size());
+    }
+    throw JsonSyntaxError(message);
+  }
+}
+
+std::string jsonErrorText(const std::exception& error) {
+  std::string message = error.what();
+  if (message.starts_with("[json.exception.")) {
+    const auto end = message.find("] ");
+    if (end != std::string::npos) {
+      message.erase(0, end + 2);
+    }
+  }
+  return message;
 }
 
 nlohmann::json readJsonFile(const std::filesystem::path& path) { return parseJson(readFile(path)); }

@@ -21,7 +21,7 @@ nlohmann::json parse(const std::filesystem::path& file, const detail::Fields& fi
   nlohmann::json root;
   try {
     root = core::parseJson(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const core::JsonSyntaxError& e) {
     fields.fail("(syntax)", e.what());
   } catch (const std::runtime_error& e) {  // a key given twice: "FIELD: key 'K' appears twice ..."
     throw std::runtime_error("gripper description '" + file.string() + "': " + e.what());

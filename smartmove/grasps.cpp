@@ -21,7 +21,7 @@ void read(const std::filesystem::path& file, std::map<Key, Grasp>& into, std::ve
   nlohmann::json json;
   try {
     json = core::parseJson(readFile(file, "grasp file"));
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const core::JsonSyntaxError& e) {
     throw std::runtime_error("grasp file '" + file.string() + "': not valid JSON: " + e.what());
   } catch (const std::exception& e) {
     const std::string message = e.what();

@@ -112,7 +112,7 @@ PowerToolDescription loadPowerToolDescription(const std::filesystem::path& file)
   nlohmann::json root;
   try {
     root = core::parseJson(readFile(file, "power tool"));
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const core::JsonSyntaxError& e) {
     fields.fail("(syntax)", e.what());
   } catch (const std::runtime_error& e) {
     throw std::runtime_error("power tool '" + file.string() + "': " + e.what());

@@ -359,7 +359,7 @@ CampaignSummary readJsonLines(const std::filesystem::path& file, std::vector<std
     nlohmann::json json;
     try {
       json = core::parseJson(content);
-    } catch (const nlohmann::json::parse_error& e) {
+    } catch (const core::JsonSyntaxError& e) {
       if (last_cut_short) {
         notes.push_back(where + "the last line is cut short (the campaign was stopped while writing it): left out");
         break;

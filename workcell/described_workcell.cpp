@@ -51,7 +51,7 @@ WorkcellDescription workcellDescriptionFromJson(const nlohmann::json& json) {
     description.references = json.at("references").get<std::vector<std::string>>();
     description.object_classes = json.at("object_classes").get<std::vector<std::string>>();
   } catch (const nlohmann::json::exception& e) {
-    throw std::invalid_argument(std::string("not a workcell description: ") + e.what());
+    throw std::invalid_argument(std::string("not a workcell description: ") + core::jsonErrorText(e));
   }
   return description;
 }

@@ -29,7 +29,7 @@ std::unique_ptr<Workcell> makeCellWithRemoteComponents(const WorkcellOptions& op
   nlohmann::json json;
   try {
     json = core::readJsonFile(options.remote);
-  } catch (const nlohmann::json::exception& error) {
+  } catch (const core::JsonSyntaxError& error) {
     throw std::invalid_argument(where + ": " + error.what());
   }
   const dds::RemoteConfig remote = dds::remoteConfigFromJson(json, where);

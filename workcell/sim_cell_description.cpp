@@ -164,7 +164,7 @@ SimCellDescription loadSimCellDescription(const std::filesystem::path& path, con
     json parsed;
     try {
       parsed = core::parseJson(content);
-    } catch (const json::parse_error& e) {
+    } catch (const core::JsonSyntaxError& e) {
       throw std::runtime_error(std::string("not valid JSON: ") + e.what());
     }
     SimCellDescription cell = parse(parsed, data_root.empty() ? dataRoot() : data_root);

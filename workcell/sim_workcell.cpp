@@ -261,7 +261,7 @@ std::optional<dds::RemoteConfig> remoteComponents(const WorkcellOptions& options
     nlohmann::json json;
     try {
       json = core::readJsonFile(options.remote);
-    } catch (const nlohmann::json::exception& error) {
+    } catch (const core::JsonSyntaxError& error) {
       throw std::invalid_argument(where + ": " + error.what());
     }
     remote = dds::remoteConfigFromJson(json, where);

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -133,6 +134,15 @@ TEST_F(FilesTest, AFingerprintTellsContentsApart) {
   EXPECT_EQ(fingerprint(""), "fnv1a64:cbf29ce484222325");  // FNV-1a's offset basis
   EXPECT_EQ(fingerprint("a"), "fnv1a64:af63dc4c8601ec8c");
   EXPECT_NE(fingerprint("{\"x\": 1}"), fingerprint("{\"x\": 2}"));
+}
+
+// Every test process writes under a temporary folder of its own (cmake/test_private_tmpdir.cpp):
+// two SmartMoveSim tests run at once by CTest -j2 read each other's scene from one fixed
+// /tmp name, and a CI run failed on it.
+TEST(TestProcess, WritesUnderATemporaryFolderOfItsOwn) {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path();
+  EXPECT_TRUE(folder.filename().string().starts_with("costar_test.")) << folder;
+  EXPECT_TRUE(std::filesystem::is_directory(folder)) << folder;
 }
 
 }  // namespace
