@@ -15,6 +15,9 @@ using component::ValueType;
 
 namespace {
 
+/// The longest JogCartesian along one axis (a jog is a small move).
+constexpr double kMaxJogMetres = 0.2;
+
 std::unique_ptr<component::RunningOperation> finished(OperationResult result) {
   return std::make_unique<component::FinishedOperation>(std::move(result));
 }
@@ -103,7 +106,8 @@ void ArmComponent::declareOperations() {
   degrees.min = -90;
   degrees.max = 90;
   ParamSpec axis{"axis", ValueType::kString, "direction to jog", {}, {"x", "y", "z", "roll", "pitch", "yaw"}};
-  ParamSpec amount{"amount", ValueType::kDouble, "metres along x/y/z, degrees about roll/pitch/yaw", {}};
+  ParamSpec amount{
+      "amount", ValueType::kDouble, "metres along x/y/z (up to 0.2), degrees about roll/pitch/yaw (up to 90)", {}};
   amount.min = -90;
   amount.max = 90;
   const ParamSpec speed = speedParam(config_.default_speed);
@@ -142,9 +146,22 @@ void ArmComponent::declareOperations() {
                  [this](const Params& params) { return renameOrDelete(false, params); });
   operations.add({"JogJoint", "Turns one joint by a few degrees.", {joint, degrees, speed}},
                  [this](const Params& params) { return jogJoint(params); });
-  operations.add({"JogCartesian",
-                  "Moves the tool a little along or about one axis, in a straight line.",
-                  {axis, amount, axis_frame, speed}},
+  component::OperationSpec jog_cartesian{"JogCartesian",
+                                         "Moves the tool a little along or about one axis, in a straight line.",
+                                         {axis, amount, axis_frame, speed}};
+  // One range for metres and degrees would allow a jog of 90 m (a hostile tester's finding):
+  // checked when the plan is validated.
+  jog_cartesian.check = [](const Params& params) -> std::string {
+    const auto axis = params.find("axis");
+    const auto amount = params.find("amount");
+    if (axis == params.end() || amount == params.end() || axis->second.asString().size() != 1 ||
+        std::abs(amount->second.asDouble()) <= kMaxJogMetres) {
+      return {};
+    }
+    return "amount " + component::formatValue(amount->second) + " along " + axis->second.asString() +
+           ": JogCartesian moves at most 0.2 m at a time";
+  };
+  operations.add(std::move(jog_cartesian),
                  [this](const Params& params) { return straightLine("JogCartesian", params); });
   ParamSpec path{"path",
                  ValueType::kString,
@@ -247,7 +264,7 @@ std::unique_ptr<component::RunningOperation> ArmComponent::straightLine(const st
     const double amount = params.at("amount").asDouble();
     const int index = axis == "x" || axis == "roll" ? 0 : axis == "y" || axis == "pitch" ? 1 : 2;
     if (axis.size() == 1) {
-      if (std::abs(amount) > 0.2) {
+      if (std::abs(amount) > kMaxJogMetres) {
         return finished(OperationResult::failure("JogCartesian moves at most 0.2 m at a time"));
       }
       offset.translation()[index] = amount;

@@ -7,6 +7,7 @@
 
 #include "calibration/hand_eye.h"
 #include "cli/number_options.h"
+#include "cli/output_options.h"
 #include "core/files.h"
 #include "sim/simulation.h"
 #include "trials/calibration_eval.h"
@@ -239,7 +240,7 @@ void addCellOptions(CLI::App* command, CalibrateOptions& options) {
                       "calibration file to read and write (default: the cell's, beside its waypoints)");
   command->add_option("--views", options.views, "views of the marker to take")->check(CLI::Range(1, 40));
   command->add_option("--speed", options.speed, "fraction of the arm's top speed")->check(numberIn(0.05, 1.0));
-  command->add_option("--json", options.json, "write the result as JSON");
+  command->add_option("--json", options.json, "write the result as JSON")->check(aFileName());
   command->add_flag("--truth", options.truth, "simulation: also print the error against the true camera pose");
 }
 
@@ -295,7 +296,7 @@ void addCalibrateCommand(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(6, 40));
   eval->add_option("--views", eval_options->eval.camera_views, "views of Calibrate (default: the cell's)")
       ->check(CLI::Range(3, 20));
-  eval->add_option("--json", eval_options->json, "write every sample as JSON");
+  eval->add_option("--json", eval_options->json, "write every sample as JSON")->check(aFileName());
   eval->callback([eval_options, &exit_code] { exit_code = evaluate(*eval_options); });
 
   command->callback([options, command, &exit_code] {

@@ -2,6 +2,7 @@
 
 #include <iostream>
 
+#include "cli/output_options.h"
 #include "core/files.h"
 #include "sim/simulation.h"
 #include "workcell/described_workcell.h"
@@ -48,7 +49,7 @@ void addDescribeWorkcellCommand(CLI::App& app, int& exit_code) {
       "simulated UR5 cell's, so that `costar validate` needs no simulator");
   command->group("");  // for the build, not for users
   command->add_option("-w,--workcell", options->workcell, "workcell")->capture_default_str();
-  command->add_option("-o,--out", options->out, "write to FILE instead of standard output");
+  command->add_option("-o,--out", options->out, "write to FILE instead of standard output")->check(aFileName());
   command->callback([options, &exit_code] { exit_code = describe(*options); });
 }
 

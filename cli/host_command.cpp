@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "cli/output_options.h"
 #include "cli/robot_commands.h"
 #include "cli/stop_signals.h"
 #include "core/paths.h"
@@ -173,7 +174,7 @@ void addHostCommand(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   kill->add_option("--waypoints", campaign->waypoints, "a waypoint file the plan reads: must stay unchanged")
       ->check(CLI::ExistingFile);
-  kill->add_option("--json", *json_file, "write every run and the summary here");
+  kill->add_option("--json", *json_file, "write every run and the summary here")->check(aFileName());
   kill->callback([campaign, json_file, &exit_code] { exit_code = hostCampaign(*campaign, *json_file); });
 }
 

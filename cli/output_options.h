@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 namespace costar::cli {
 
 /// The files a command reads, each with what names it for people ("the plan", "--waypoints").
@@ -44,6 +46,16 @@ inline void refuseWritingAnInput(const std::filesystem::path& output, const std:
                                   ", which this command reads");
     }
   }
+}
+
+/// A validator for an output file's name: not empty (`costar run --trace ''` ran and wrote
+/// nothing, without a word).
+inline CLI::Validator aFileName() {
+  return CLI::Validator(
+      [](const std::string& text) -> std::string {
+        return text.empty() ? std::string("needs a file name, not ''") : std::string();
+      },
+      "FILE");
 }
 
 }  // namespace costar::cli

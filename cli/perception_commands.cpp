@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cli/number_options.h"
+#include "cli/output_options.h"
 #include "core/files.h"
 #include "core/image.h"
 #include "core/paths.h"
@@ -297,9 +298,15 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
       "marker",
       "Write the ArUco marker image (DICT_4X4_50) that marks the workspace centre, e.g. for printing or "
       "as the simulated table's texture");
-  marker_command->add_option("--id", marker->id, "marker id")->capture_default_str();
-  marker_command->add_option("--cell", marker->cell_pixels, "pixels per marker cell")->capture_default_str();
-  marker_command->add_option("-o,--out", marker->out, "PNG to write")->capture_default_str();
+  // Checked here: OpenCV's assertion text answered --id -1, and --cell 100000 asked for a
+  // 64-gigapixel image (a hostile tester's findings).
+  marker_command->add_option("--id", marker->id, "marker id (DICT_4X4_50 has ids 0 to 49)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 49));
+  marker_command->add_option("--cell", marker->cell_pixels, "pixels per marker cell")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 500));
+  marker_command->add_option("-o,--out", marker->out, "PNG to write")->capture_default_str()->check(aFileName());
   marker_command->callback([marker, &exit_code] { exit_code = writeMarker(*marker); });
 
   auto collect_options = std::make_shared<trials::CollectOptions>();
@@ -310,7 +317,8 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
       "them into one example per object by Euclidean clustering, and add negative examples (the robot and gripper "
       "over the table, the table, clutter). Writes the workspace centre and the examples.");
   collect_command->add_option("-o,--out", collect_options->out, "folder for the examples (dataset.json + binary)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(aFileName());
   collect_command->add_option("--workspace", collect_options->workspace_file,
                               "where to write the workspace centre (default: OUT/workspace.json; the pipeline "
                               "reads data/perception/workspace.json)");
@@ -355,9 +363,11 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
       "write the model (with -w: the cell's, which DetectObjects in that cell loads). Deterministic for a seed.");
   train_command->add_option("--dataset", train_options->dataset, "folder written by `costar perception collect`")
       ->capture_default_str();
-  train_command->add_option("-o,--out", train_options->out,
-                            "model file (default: the cell's perception_model with -w, else "
-                            "data/perception/svm/ur5-sim.json)");
+  train_command
+      ->add_option("-o,--out", train_options->out,
+                   "model file (default: the cell's perception_model with -w, else "
+                   "data/perception/svm/ur5-sim.json)")
+      ->check(aFileName());
   train_command->add_option("-w,--workcell", train_options->workcell,
                             "write the model the cell names (workcells/NAME.json's perception_model)");
   train_command->add_option("--cost", train_options->svm.cost, "SVM soft-margin cost C")
@@ -367,6 +377,14 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
       ->check(numberIn(0.0, 1e9))
       ->capture_default_str();
   train_command->add_option("--folds", train_options->svm.folds, "cross-validation folds (0: none)")
+      ->check(CLI::Validator(
+          [](const std::string& text) -> std::string {
+            const std::optional<double> folds = parseNumber(text);
+            return folds && *folds == std::floor(*folds) && (*folds == 0 || (*folds >= 2 && *folds <= 100))
+                       ? std::string()
+                       : "must be 0 (none) or a whole number from 2 to 100, not " + typed(text);
+          },
+          "0|2..100"))
       ->capture_default_str();
   train_command
       ->add_option("--max-per-label", train_options->svm.max_per_label,
@@ -429,10 +447,12 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
   eval_command->add_option("--seed", eval_options->eval.seed, "seed of the scenes, pushes and sensor noise")
       ->check(wholeNumber())
       ->capture_default_str();
-  eval_command->add_option("--json", eval_options->json, "write the summary as JSON to this file");
-  eval_command->add_option("--out", eval_options->eval.pictures,
-                           "folder for a PNG per scene with the detections drawn, and each scene's file (and each "
-                           "push's) to run again with `perception detect`");
+  eval_command->add_option("--json", eval_options->json, "write the summary as JSON to this file")->check(aFileName());
+  eval_command
+      ->add_option("--out", eval_options->eval.pictures,
+                   "folder for a PNG per scene with the detections drawn, and each scene's file (and each "
+                   "push's) to run again with `perception detect`")
+      ->check(aFileName());
   eval_command
       ->add_option("--repeats", eval_options->eval.repeats, "DetectObjects runs per scene while the parts stay still")
       ->capture_default_str()
@@ -486,7 +506,7 @@ void addPerceptionCommands(CLI::App& app, int& exit_code) {
       ->check(CLI::ExistingFile);
   detect_command->add_option("--seed", detect_options->seed, "seed of the part placement and the sensor noise")
       ->check(wholeNumber());
-  detect_command->add_option("--out", detect_options->out, "write the picture to this PNG file");
+  detect_command->add_option("--out", detect_options->out, "write the picture to this PNG file")->check(aFileName());
   detect_command
       ->add_option("--look", detect_options->look,
                    "scene_NNN_look.json that perception eval wrote beside the scene: the camera's noise and "

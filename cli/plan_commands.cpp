@@ -101,6 +101,7 @@ void addWorkcellOptions(CLI::App* command, workcell::WorkcellOptions& options) {
 
 std::unique_ptr<workcell::Workcell> openWorkcell(const workcell::WorkcellOptions& options, WorkcellUse use) {
   try {
+    workcell::refuseSimulationOptionsOfLightCells(options);  // what the user gave applies
     return openWorkcellFor(options, use);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -314,7 +315,8 @@ void addPlanCommands(CLI::App& app, int& exit_code) {
   run->add_option("plan", options->plan, "plan file")->required()->check(CLI::ExistingFile);
   addWorkcellOptions(run, options->workcell);
   run->add_option("--trace", options->trace,
-                  "write every status transition to FILE as JSON lines, as the run goes (each tick's at the next)");
+                  "write every status transition to FILE as JSON lines, as the run goes (each tick's at the next)")
+      ->check(aFileName());
   run->add_option("--rate", options->rate_hz, "ticks per second of clock time")
       ->check(numberIn(0.1, 10000.0, false, " Hz"))
       ->capture_default_str();
@@ -347,7 +349,7 @@ void addPlanCommands(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"xml", "json"}))
       ->capture_default_str();
   nodes->add_flag("--all", *nodes_all, "also describe nodes that BehaviorTree.CPP has built in");
-  nodes->add_option("-o,--out", *nodes_out, "write to FILE instead of standard output");
+  nodes->add_option("-o,--out", *nodes_out, "write to FILE instead of standard output")->check(aFileName());
   nodes->footer("Exit code: 0 written, 2 bad options or a file that could not be written.");
   nodes->callback([=, &exit_code] { exit_code = writeNodes(*nodes_workcell, *nodes_format, *nodes_all, *nodes_out); });
 

@@ -9,6 +9,7 @@
 #include "bt/executor.h"
 #include "bt/plan_xml.h"
 #include "cli/number_options.h"
+#include "cli/output_options.h"
 #include "core/clock.h"
 #include "core/image.h"
 #include "sim/simulation.h"
@@ -66,8 +67,8 @@ void printJig(const sim::Simulation& simulation) {
   if (!jig || !jig->has_wire) {
     return;
   }
-  std::printf("wire: %.1f mm out of the clamp, E %.0f GPa, yield strength %.0f MPa; bends", jig->draw.wire_length * 1000,
-              jig->draw.youngs_modulus_gpa, jig->draw.yield_strength_mpa);
+  std::printf("wire: %.1f mm out of the clamp, E %.0f GPa, yield strength %.0f MPa; bends",
+              jig->draw.wire_length * 1000, jig->draw.youngs_modulus_gpa, jig->draw.yield_strength_mpa);
   for (const sim::MeasuredBend& bend : jig->bends) {
     std::printf(" %.1f (drawing %.0f, out of plane %.1f)", bend.angle_deg, bend.target_deg, bend.out_of_plane_deg);
   }
@@ -162,7 +163,7 @@ void addSimCommands(CLI::App& app, int& exit_code) {
   snap->add_option("scene", options->scene, "scene file (e.g. sim/scenes/assembly.json)")
       ->required()
       ->check(CLI::ExistingFile);
-  snap->add_option("-o,--out", options->out, "PNG to write")->capture_default_str();
+  snap->add_option("-o,--out", options->out, "PNG to write")->capture_default_str()->check(aFileName());
   snap->add_option("--camera", options->camera, "overview, rgbd, or jig (straight above a scene's bending jig)")
       ->check(CLI::IsMember({"overview", "rgbd", "jig"}))
       ->capture_default_str();

@@ -54,6 +54,11 @@ void parseShard(const std::string& text, trials::TrialOptions& options) {
   if (options.shard_count < 1 || options.shard_index < 0 || options.shard_index >= options.shard_count) {
     throw std::invalid_argument("--shard: '" + text + "': needs 0 <= I < N (slices are numbered from 0)");
   }
+  if (options.shard_index >= options.count) {
+    // A hostile tester's --shard 5/10 -n 2 ran no trial and exited 0.
+    throw std::invalid_argument("--shard: slice " + std::to_string(options.shard_index) + " of " +
+                                std::to_string(options.count) + " trial(s) has none (slice I runs trials I, I+N, ...)");
+  }
 }
 
 /// Prints the summary, writes the JSON and the plot where asked; the exit code (`code` unless an
@@ -157,6 +162,11 @@ int run(Options options) {
   std::printf("costar trials: %d trial(s) of %s on scene %s, judge '%s', seeds %llu.., %d at a time\n",
               options.trials.count, options.trials.plan.c_str(), scene.c_str(), options.trials.judge.c_str(),
               static_cast<unsigned long long>(options.trials.seed), options.trials.jobs);
+  if ((options.trials.camera_move_m > 0 || options.trials.camera_turn_deg > 0) && !options.trials.calibrate) {
+    // A hostile tester's --camera-move 0.05 failed every trial at DetectObjects, unexplained.
+    std::printf("note: --camera-move without --calibrate: the cell believes the camera is where it was drawn, as a "
+                "cell whose camera was knocked (add --calibrate to calibrate it first in each trial)\n");
+  }
   if (options.trials.shard_count > 1) {
     std::printf("shard %d/%d: trials %d, %d, ... of them\n", options.trials.shard_index, options.trials.shard_count,
                 options.trials.shard_index, options.trials.shard_index + options.trials.shard_count);
@@ -273,15 +283,18 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
             return {};
           },
           "KIND[@grasp=N]"));
-  command->add_option("--json", options->json, "write the summary and every trial as JSON");
+  command->add_option("--json", options->json, "write the summary and every trial as JSON")->check(aFileName());
   command
       ->add_option("--trace", options->trials.trace_dir,
                    "write every trial's status transitions to DIR/trial_SEED.jsonl (JSON lines, as costar run "
                    "--trace: the reasons of failures a retry recovered too)")
-      ->check(CLI::ExistingDirectory);
-  command->add_option("--plot", options->plot,
-                      "write a PNG: success rate, failures, cycle times (and, in a scene with a workpiece, "
-                      "PLOT_force.png and PLOT_coverage.png of the first trial: the pad's force, the area worked)");
+      ->check(CLI::ExistingDirectory)
+      ->check(aFileName());
+  command
+      ->add_option("--plot", options->plot,
+                   "write a PNG: success rate, failures, cycle times (and, in a scene with a workpiece, "
+                   "PLOT_force.png and PLOT_coverage.png of the first trial: the pad's force, the area worked)")
+      ->check(aFileName());
   command->add_option("--require", options->require, "exit 1 when the success rate is below this (0..1)")
       ->check(numberIn(0.0, 1.0, false, ""));
   command->add_option("--shard", options->shard,
@@ -293,8 +306,9 @@ void addTrialsCommand(CLI::App& app, int& exit_code) {
   merge_command->add_option("results", options->merge_inputs, "JSON files written by `costar trials --json`")
       ->required()
       ->check(CLI::ExistingFile);
-  merge_command->add_option("--json", options->json, "write the merged summary as JSON");
-  merge_command->add_option("--plot", options->plot, "write a PNG: success rate, failures, cycle times");
+  merge_command->add_option("--json", options->json, "write the merged summary as JSON")->check(aFileName());
+  merge_command->add_option("--plot", options->plot, "write a PNG: success rate, failures, cycle times")
+      ->check(aFileName());
   merge_command->add_option("--require", options->require, "exit 1 when the success rate is below this (0..1)")
       ->check(numberIn(0.0, 1.0, false, ""));
   merge_command->callback([options, &exit_code] { exit_code = merge(*options); });

@@ -359,6 +359,12 @@ HttpResponse saveDocument(const Call& call) {
 template <DocumentKind kind>
 HttpResponse deleteDocument(const Call& call) {
   const std::string& name = call.params[0];
+  if (!call.target.query.empty()) {
+    // A hostile tester's DELETE .../NAME?version=1 removed every version.
+    throw RequestError(400, std::string("DELETE removes the ") + noun(kind) + " '" + name +
+                                "' with all its versions and takes no query ('" + call.target.query.begin()->first +
+                                "' given); one version cannot be deleted");
+  }
   return call.store.remove(kind, name) ? jsonResponse({{"deleted", name}}) : noDocument(kind, name);
 }
 
@@ -429,7 +435,12 @@ HttpResponse startPlanRun(const Call& call) {
     }
     const auto document = call.store.load(DocumentKind::kPlan, name, version);
     if (!document) {
-      return errorResponse(404, "no plan '" + name + "'");
+      const auto versions = call.store.versions(DocumentKind::kPlan, name);
+      return versions.empty() || !version
+                 ? noDocument(DocumentKind::kPlan, name)
+                 : noDocument(DocumentKind::kPlan, name,
+                              " with version " + std::to_string(*version) + " (its latest is version " +
+                                  std::to_string(versions.front().version) + ")");
     }
     run.plan = bt::loadPlanText(document->xml, name + ".xml", {.follow_includes = false});
     run.xml = document->xml;

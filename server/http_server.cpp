@@ -278,7 +278,7 @@ std::vector<std::string> answerStreamMessage(ServerCore& core, const std::string
   if (type == "auth") {
     const bool ok = message.contains("token") && message["token"].is_string() &&
                     core.api.tokenMatches(message["token"].get_ref<const std::string&>());
-    authenticated = authenticated || ok;
+    authenticated = ok;  // the last auth counts: a wrong token ends an authenticated session
     return answer({{"type", "auth"}, {"ok", ok}});
   }
   if (type == "control") {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -587,6 +588,12 @@ Simulation::Simulation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Simulation::~Simulation() = default;
 
 std::unique_ptr<Simulation> Simulation::create(const Scene& scene, const SimulationOptions& options) {
+  // MuJoCo's warnings ("Nan, Inf or huge value in QACC ...") go to standard error like the rest
+  // of the log, not to a MUJOCO_LOG.TXT it would write in whatever folder the user ran from.
+  static std::once_flag route_warnings;
+  std::call_once(route_warnings, [] {
+    mju_user_warning = [](const char* message) { std::fprintf(stderr, "MuJoCo warning: %s\n", message); };
+  });
   auto impl = std::make_unique<Impl>();
   const std::filesystem::path root = options.data_root.empty() ? dataRoot() : options.data_root;
   impl->classes = world::loadObjectClasses(root / "data" / "objects");

@@ -244,6 +244,10 @@ std::string shown(double value) {
 }  // namespace
 
 void checkOptions(const TrialOptions& options) {
+  if (options.workcell == "test" || options.workcell == "none") {
+    throw std::invalid_argument("costar trials judges a simulated world, and the '" + options.workcell +
+                                "' workcell has none (simulated cells: " + workcell::knownWorkcellNames(true) + ")");
+  }
   if (options.count < 1) {
     throw std::invalid_argument("the number of trials must be at least 1, not " + std::to_string(options.count));
   }

@@ -81,7 +81,18 @@ class DescribedWorkcell final : public Workcell {
     const std::filesystem::path waypoint_file =
         !options.waypoints.empty() ? options.waypoints
                                    : (options.memory_only ? std::filesystem::path() : defaultWaypointFile(name_));
-    for (const arm::Waypoint& waypoint : arm::WaypointStore(waypoint_file, /*persist=*/false).all()) {
+    // The waypoints are read as the robot binary's arm reads them, with its joint count (the
+    // range of its JogJoint's joint number): `costar validate` said valid of a joint waypoint
+    // with 7 values for the UR5, and `costar run` refused the file.
+    int joint_count = 0;
+    for (const auto& component : description.components) {
+      if (const component::OperationSpec* jog = component.operation("JogJoint")) {
+        if (const component::ParamSpec* joint = jog->param("joint"); joint != nullptr && joint->max) {
+          joint_count = static_cast<int>(*joint->max);
+        }
+      }
+    }
+    for (const arm::Waypoint& waypoint : arm::WaypointStore(waypoint_file, /*persist=*/false, joint_count).all()) {
       references_.insert(waypoint.name);
     }
     for (component::ComponentDescription component : description.components) {

@@ -154,7 +154,17 @@ SimCellDescription parse(const json& root, const std::filesystem::path& data_roo
 }  // namespace
 
 std::filesystem::path simCellFile(const std::string& name, const std::filesystem::path& data_root) {
-  return (data_root.empty() ? dataRoot() : data_root) / "workcells" / (name + ".json");
+  const std::filesystem::path file = (data_root.empty() ? dataRoot() : data_root) / "workcells" / (name + ".json");
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(file, error)) {
+    // `costar perception detect -w none` said "cannot read workcell description '.../none.json'".
+    std::string known;
+    for (const auto& [cell, label] : simCells(data_root)) {
+      known += (known.empty() ? "" : ", ") + cell;
+    }
+    throw std::invalid_argument("'" + name + "' is not a simulated workcell (those are: " + known + ")");
+  }
+  return file;
 }
 
 SimCellDescription loadSimCellDescription(const std::filesystem::path& path, const std::filesystem::path& data_root) {

@@ -42,11 +42,25 @@ component::OperationResult runOperation(Workcell& cell, const std::string& opera
                                 "'");
   }
   const component::OperationSpec* spec = component->description().operation(operation);
+  // Checked as plan validation checks a node's ports, before anything moves (a hostile tester's
+  // `costar calibrate --views 1` moved the arm to its first view, then failed).
+  for (const auto& [name, value] : params) {
+    const component::ParamSpec* param = spec->param(name);
+    if (param == nullptr) {
+      return component::OperationResult::failure(operation + " has no parameter '" + name + "'");
+    }
+    if (const std::string problem = param->check(component::formatValue(value)); !problem.empty()) {
+      return component::OperationResult::failure(operation + "'s " + name + ": " + problem);
+    }
+  }
   component::ParamMap full = params;
   for (const auto& param : spec->params) {
     if (full.find(param.name) == full.end() && param.default_value) {
       full.emplace(param.name, *param.default_value);
     }
+  }
+  if (const std::string problem = spec->checkParams(full); !problem.empty()) {
+    return component::OperationResult::failure(operation + ": " + problem);
   }
   cell.beforeTick();
   const component::OperationId id = component->start(operation, full);
@@ -144,6 +158,15 @@ std::unique_ptr<Workcell> makeTestWorkcell(const ComponentWrapper& wrap,
 }
 
 std::unique_ptr<Workcell> makeBareWorkcell() { return std::make_unique<BareWorkcell>(); }
+
+void refuseSimulationOptionsOfLightCells(const WorkcellOptions& options) {
+  if ((options.name == "test" || options.name == "none") && (!options.scene.empty() || options.camera_move)) {
+    // A hostile tester's `-w none --scene bad.json` ran without a word about the scene.
+    throw std::invalid_argument("the '" + options.name + "' workcell has no simulation: " +
+                                (options.scene.empty() ? "--camera-move" : "a scene (--scene)") +
+                                " applies to the simulated cells only (" + knownWorkcellNames(true) + ")");
+  }
+}
 
 std::unique_ptr<Workcell> makeLightWorkcell(const WorkcellOptions& options) {
   const std::string& name = options.name;

@@ -129,6 +129,9 @@ std::vector<WorkcellInfo> knownWorkcells();
 std::string knownWorkcellNames(bool simulated_only = false);
 /// @throws std::invalid_argument naming the known workcells when `name` is not one of them.
 void requireKnownWorkcell(const std::string& name);
+/// @throws std::invalid_argument when a scene or a camera move is given for a cell without a
+/// simulation ("test", "none").
+void refuseSimulationOptionsOfLightCells(const WorkcellOptions& options);
 
 /// Creates a workcell. @throws std::invalid_argument naming the known ones for an unknown
 /// name; std::runtime_error when its files cannot be read. In costar_workcell, which links

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 namespace costar::world {
@@ -63,6 +64,20 @@ std::optional<Pose> parsePose(std::string_view text, std::string* error) {
                " numbers: a pose is \"x;y;z\" or \"x;y;z;roll;pitch;yaw\" (metres, degrees)";
     }
     return std::nullopt;
+  }
+  // A hostile tester's MoveToPose with a roll of 1e308 degrees was accepted (the rotation is
+  // all rounding there); a workcell is not kilometres wide either.
+  static constexpr const char* kNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const double most = i < 3 ? 100.0 : 360.0;  // metres, degrees
+    if (std::abs(values[i]) > most) {
+      if (error != nullptr) {
+        char range[64];
+        std::snprintf(range, sizeof(range), "%g is not within %g %s", values[i], most, i < 3 ? "m" : "degrees");
+        *error = "'" + std::string(text) + "': " + kNames[i] + " " + range + " either way";
+      }
+      return std::nullopt;
+    }
   }
   values.resize(6, 0.0);
   constexpr double kDeg = M_PI / 180.0;

@@ -262,6 +262,20 @@ TEST_F(ArmTest, TeachSavesWhereTheArmIsAndJoggingMovesIt) {
             "cannot save the waypoint: waypoint name 'bad name!' may contain only letters, digits, '_' and '-'");
 }
 
+// JogCartesian's amount is metres along x/y/z and degrees about roll/pitch/yaw: its one range
+// [-90, 90] let a plan ask for a 90 m jog, refused only when it ran (a hostile tester).
+TEST_F(ArmTest, AJogOfMoreThanTwentyCentimetresIsRefusedWhenThePlanIsValidated) {
+  const component::OperationSpec* jog = arm.description().operation("JogCartesian");
+  ASSERT_NE(jog, nullptr);
+  const auto problem = [jog](const std::string& axis, double amount) {
+    return jog->checkParams({{"axis", component::Value(axis)}, {"amount", component::Value(amount)}});
+  };
+  EXPECT_EQ(problem("x", 90.0), "amount 90 along x: JogCartesian moves at most 0.2 m at a time");
+  EXPECT_EQ(problem("z", -0.25), "amount -0.25 along z: JogCartesian moves at most 0.2 m at a time");
+  EXPECT_EQ(problem("z", 0.2), "");
+  EXPECT_EQ(problem("yaw", 90.0), "");
+}
+
 // A waypoint named "endpoint" hid the arm's tool pose from the editor (it showed the taught pose
 // while the arm moved) and could be neither moved to nor deleted there; "camera" and
 // "table_center" were listed twice.

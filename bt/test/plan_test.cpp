@@ -467,6 +467,19 @@ TEST(PlanXml, CharacterReferencesToSurrogatesAndNonCharactersAreRefused) {
   EXPECT_TRUE(problems(planXml("<!-- &#xD800; --><AlwaysSuccess/>")).empty());
 }
 
+// A hostile tester: a NUL byte ended the plan there without a word (the nodes after it vanished),
+// and a <!DOCTYPE>'s entities were left as written ("&part;" became a node's name).
+TEST(PlanXml, ControlCharactersAndADoctypeAreRefusedWithLineAndColumn) {
+  const std::string nul = planXml("\n<AlwaysSuccess/>" + std::string(1, '\0') + "<AlwaysFailure/>");
+  EXPECT_EQ(problem(nul), "2: column 17: a control character (byte 0x00) is not allowed in XML");
+  EXPECT_NE(problem(planXml("<AlwaysSuccess name=\"a\x07" "b\"/>")).find("byte 0x07"), std::string::npos);
+  EXPECT_EQ(problem("<?xml version=\"1.0\"?>\n<!DOCTYPE root [<!ENTITY part \"node\">]>\n<root BTCPP_format=\"4\">"
+                    "<BehaviorTree ID=\"m\"><AlwaysSuccess name=\"&part;\"/></BehaviorTree></root>"),
+            "2: column 1: a <!DOCTYPE> is not allowed in a plan (its entities would not be expanded)");
+  // Tabs, line feeds and carriage returns are text.
+  EXPECT_TRUE(problems(planXml("\t<AlwaysSuccess/>\r\n")).empty());
+}
+
 // --- includes ---------------------------------------------------------------------------------
 
 class IncludeTest : public ::testing::Test {

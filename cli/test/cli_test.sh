@@ -508,4 +508,25 @@ check "no costar-robot: run on ur5-sim" 2 "needs the robot libraries" \
   -- "$tmp/alone/costar" run examples/ur5/pick_up_node.xml
 check "no costar-robot: run -w none" 0 '^SUCCESS' -- "$tmp/alone/costar" run bench/plans/reference_1000_leaves.xml -w none -q
 
+# A hostile tester's findings, the second part: each refused with a clear message before anything
+# runs (they ran silently, ran nothing and exited 0, or showed a library's internal text).
+check "an empty --trace is refused" 2 "^--trace: needs a file name, not ''" \
+  -- "$costar" run examples/test_workcell/demo.xml -w test --trace ''
+check "a shard without trials is refused" 2 '^error: --shard: slice 5 of 2 trial\(s\) has none' \
+  -- "$costar" trials examples/ur5/pick_up_node.xml --judge lift -n 2 --shard 5/10
+check "trials on a cell without a simulation" 2 "^error: costar trials judges a simulated world, and the 'none' workcell has none" \
+  -- "$costar" trials examples/ur5/pick_up_node.xml --judge lift -n 1 -w none
+check "a scene for a cell without a simulation" 2 "the 'none' workcell has no simulation: a scene \(--scene\) applies" \
+  -- "$costar" run bench/plans/reference_1000_leaves.xml -w none --scene sim/scenes/one_node.json
+check "perception detect on a cell that is not simulated" 2 "'none' is not a simulated workcell \(those are: .*ur5-sim" \
+  -- "$costar" perception detect sim/scenes/one_node.json -w none
+check "cross-validation folds" 2 '^--folds: must be 0 \(none\) or a whole number from 2 to 100, not -1' \
+  -- "$costar" perception train --folds -1
+check "a marker id beyond the dictionary" 2 '^--id: Value -1 not in range 0 to 49' -- "$costar" perception marker --id -1
+check "JSON syntax errors without the library's prefix" 2 "scene '.*bad_scene.json': line 2, column 1[0-9]: syntax error" \
+  -- bash -c "printf '{\"parts\": [\n {\"class\": ,}]}' > '$tmp/bad_scene.json' && '$costar' run examples/ur5/pick_up_node.xml --scene '$tmp/bad_scene.json'"
+printf '{"waypoints": [{"name": "seven", "joints": [0, -1.57, 1.57, -1.57, -1.57, 0, 0]}]}\n' >"$tmp/seven.json"
+check "validate reads joint waypoints as run does" 2 'waypoints\[0\]\.joints: must be 6 angles' \
+  -- "$costar" validate examples/ur5/pick_up_node.xml --waypoints "$tmp/seven.json"
+
 exit $((failures > 0))

@@ -180,6 +180,17 @@ TEST(Api, SavesVersionsAndExportsTheXmlTheCliRuns) {
   EXPECT_EQ(h.call("PUT", "/api/plans/imported", {{"xml", xml.body}}).status, 201);
   EXPECT_EQ(h.get("/api/plans/imported")["plan"], p);
 
+  // A hostile tester: DELETE ...?version=1 removed every version, and a run of version 99
+  // answered "no plan" of a plan that exists.
+  const HttpResponse one_version = h.call("DELETE", "/api/plans/demo?version=1");
+  EXPECT_EQ(one_version.status, 400) << one_version.body;
+  EXPECT_NE(one_version.body.find("one version cannot be deleted"), std::string::npos) << one_version.body;
+  EXPECT_EQ(h.get("/api/plans/demo/versions").size(), 2u);
+  const HttpResponse missing_version = h.call("POST", "/api/runs", {{"name", "demo"}, {"version", 99}});
+  EXPECT_EQ(missing_version.status, 404);
+  EXPECT_NE(missing_version.body.find("no plan 'demo' with version 99 (its latest is version 2)"), std::string::npos)
+      << missing_version.body;
+
   EXPECT_EQ(h.call("DELETE", "/api/plans/demo").status, 200);
   EXPECT_EQ(h.call("GET", "/api/plans/demo").status, 404);
 }

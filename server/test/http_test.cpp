@@ -218,6 +218,11 @@ TEST_F(HttpTest, StreamCommandsNeedTheToken) {
   const json answer = next("control");
   EXPECT_EQ(answer["type"], "control");
   EXPECT_FALSE(answer["ok"].get<bool>());  // nothing runs
+  // A hostile tester: a wrong token after the right one left the stream authenticated.
+  ws.send(R"({"type": "auth", "token": "not-the-token-1234"})");
+  EXPECT_FALSE(next("auth")["ok"].get<bool>());
+  ws.send(R"({"type": "control", "action": "stop"})");
+  EXPECT_EQ(next("control")["type"], "error");
 }
 
 TEST_F(HttpTest, StreamShowsARunAndStopHaltsIt) {

@@ -4,6 +4,7 @@
 #include "sim/simulation.h"
 
 #include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
 
 #include <filesystem>
 #include <random>
@@ -112,6 +113,22 @@ TEST(Simulation, MujocoKinematicsMatchTheDhModelToATenthOfAMillimetre) {
     EXPECT_LT((sim->tcpPose().translation() - expected.translation()).norm(), 1e-4);
     EXPECT_LT(world::rotationAngle(sim->tcpPose(), expected), 1e-6);
   }
+}
+
+// A hostile tester found MUJOCO_LOG.TXT in the folder they ran costar from: MuJoCo's default
+// warning handler appends to that file in the working directory.
+TEST(Simulation, MujocoWarningsGoToStandardErrorNotToAFileInTheWorkingDirectory) {
+  const auto sim = Simulation::create(sceneOf(R"({"parts": []})"));
+  const std::filesystem::path before = std::filesystem::current_path();
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / "mujoco_warning";
+  std::filesystem::create_directories(folder);
+  std::filesystem::current_path(folder);
+  ::testing::internal::CaptureStderr();
+  mju_warning("a test warning");
+  const std::string printed = ::testing::internal::GetCapturedStderr();
+  std::filesystem::current_path(before);
+  EXPECT_FALSE(std::filesystem::exists(folder / "MUJOCO_LOG.TXT"));
+  EXPECT_NE(printed.find("MuJoCo warning: a test warning"), std::string::npos) << printed;
 }
 
 TEST(Simulation, PartsSettleOnTheTable) {

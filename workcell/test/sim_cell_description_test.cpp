@@ -134,6 +134,18 @@ TEST(SimCellDescription, AMissingFileIsNamed) {
   }
 }
 
+// A hostile tester's `costar perception detect -w none` answered "cannot read workcell
+// description '.../workcells/none.json'".
+TEST(SimCellDescription, ANameThatIsNotASimulatedCellListsThoseThatAre) {
+  try {
+    simCellFile("none");
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("'none' is not a simulated workcell (those are: ", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("ur5-sim"), std::string::npos) << e.what();
+  }
+}
+
 // Issue 27: numbers of 1e308 were accepted (a robot standing 1e308 m away); a key given twice
 // was taken silently.
 TEST_F(BadCellFile, NumbersBeyondACellsSizeAndKeysGivenTwiceAreRefused) {

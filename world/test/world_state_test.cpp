@@ -66,6 +66,16 @@ TEST(Pose, ParsesMetresAndDegreesAndRoundTrips) {
   EXPECT_FALSE(parsePose("1;nan;3").has_value());
 }
 
+// A hostile tester's MoveToPose pose="0.4;0;0.3;1e308;0;0" was accepted.
+TEST(Pose, AnglesBeyond360DegreesAndCoordinatesBeyond100MetresAreRefused) {
+  std::string error;
+  EXPECT_FALSE(parsePose("0.4;0;0.3;1e308;0;0", &error).has_value());
+  EXPECT_EQ(error, "'0.4;0;0.3;1e308;0;0': roll 1e+308 is not within 360 degrees either way");
+  EXPECT_FALSE(parsePose("0;-1000;0", &error).has_value());
+  EXPECT_EQ(error, "'0;-1000;0': y -1000 is not within 100 m either way");
+  EXPECT_TRUE(parsePose("100;0;0;-360;360;0").has_value());
+}
+
 TEST(Pose, RpyOfInvertsPoseFromXyzRpy) {
   for (double roll : {-2.0, 0.0, 0.7}) {
     for (double pitch : {-1.2, 0.0, 1.4}) {
