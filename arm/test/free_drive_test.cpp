@@ -117,10 +117,9 @@ TEST(FreeDrive, TheProtectiveStopTripsOnSpeedHeldPastItsWindowOrOnTrackingNaming
             "hand's, or a collision)");
 }
 
-TEST(FreeDrive, AStepTowardAWallStopsTheLookAheadShortOfItAndAnAslantPushSlidesAlongIt) {
-  // A one-joint-per-axis "arm": the joints are the tool's x, y, z; a wall at z = 0.1.
-  AdmittanceGains gains;
-  gains.max_point_speed = 1.0;  // the wall, not the speed, is what this checks
+/// A one-joint-per-axis "arm" (its joints are the tool's x, y, z) above a wall at z = 0.1 that
+/// the sweep refuses with `why`.
+StepChecks axesArmAboveAWall(const std::string& why_blocked) {
   StepChecks check;
   check.reach = [](const world::Pose& pose, const JointVector&, std::string&) -> std::optional<JointVector> {
     JointVector q = JointVector::zero(3);
@@ -129,18 +128,25 @@ TEST(FreeDrive, AStepTowardAWallStopsTheLookAheadShortOfItAndAnAslantPushSlidesA
     }
     return q;
   };
-  check.sweep = [](const JointVector& from, const JointVector& to, std::string& why) {
+  check.sweep = [why_blocked](const JointVector& from, const JointVector& to, std::string& why) {
     if (std::min(from[2], to[2]) < 0.1) {
-      why = "tool would touch table";
+      why = why_blocked;
       return false;
     }
     return true;
   };
-  // The wall is the gripper's (a part under it): the arm's other links are clear of it.
-  check.sweep_arm = [](const JointVector&, const JointVector&, std::string&) { return true; };
   check.displacement = [](const JointVector& from, const JointVector& to) {
     return (to.eigen() - from.eigen()).norm();
   };
+  return check;
+}
+
+TEST(FreeDrive, AStepTowardAWallStopsTheLookAheadShortOfItAndAnAslantPushSlidesAlongIt) {
+  AdmittanceGains gains;
+  gains.max_point_speed = 1.0;  // the wall, not the speed, is what this checks
+  StepChecks check = axesArmAboveAWall("tool would touch table");
+  // The wall is the gripper's (a part under it): the arm's other links are clear of it.
+  check.sweep_arm = [](const JointVector&, const JointVector&, std::string&) { return true; };
   world::Pose reference = world::Pose::Identity();
   reference.translation() = Eigen::Vector3d(0, 0, 0.2);
   JointVector joints = JointVector::zero(3);
@@ -193,24 +199,7 @@ TEST(FreeDrive, AHandPushingIntoAWallAlmostSquarelyDoesNotCreepAlongIt) {
   // push along the wall (0.7 N) is within the dead band, so the reference holds; 10 degrees
   // aslant (6.9 N) it slides.
   AdmittanceGains gains;
-  StepChecks check;
-  check.reach = [](const world::Pose& pose, const JointVector&, std::string&) -> std::optional<JointVector> {
-    JointVector q = JointVector::zero(3);
-    for (int i = 0; i < 3; ++i) {
-      q[i] = pose.translation()[i];
-    }
-    return q;
-  };
-  check.sweep = [](const JointVector& from, const JointVector& to, std::string& why) {
-    if (std::min(from[2], to[2]) < 0.1) {
-      why = "fingers would touch part:node_1";
-      return false;
-    }
-    return true;
-  };
-  check.displacement = [](const JointVector& from, const JointVector& to) {
-    return (to.eigen() - from.eigen()).norm();
-  };
+  const StepChecks check = axesArmAboveAWall("fingers would touch part:node_1");
   const auto slid = [&](double degrees) {
     const double aslant = degrees * M_PI / 180.0;
     const Eigen::Vector3d push = 40.0 * Eigen::Vector3d(std::sin(aslant), 0.0, -std::cos(aslant));
