@@ -263,6 +263,11 @@ void checkOptions(const TrialOptions& options) {
     throw std::invalid_argument("shard " + std::to_string(options.shard_index) + "/" +
                                 std::to_string(options.shard_count) + ": needs 0 <= I < N");
   }
+  if (options.shard_index >= options.count) {
+    // A hostile tester's --shard 5/10 -n 2 ran no trial and exited 0.
+    throw std::invalid_argument("--shard: slice " + std::to_string(options.shard_index) + " of " +
+                                std::to_string(options.count) + " trial(s) has none (slice I runs trials I, I+N, ...)");
+  }
   // nan compares false with everything: the conditions are written so that it fails them.
   if (!(options.time_limit_s > 0.0 && options.time_limit_s <= kMaxTimeLimitSeconds)) {
     throw std::invalid_argument("the time limit must be a number of simulated seconds above 0 and at most " +
